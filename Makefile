@@ -1,0 +1,48 @@
+# winder — the two commands of the README: `make demo` and `make test`.
+PYTHON ?= $(shell command -v python3.11 || command -v python3)
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.winder-installed
+OUT    ?= out
+
+.PHONY: demo test test-slow bench lint chromium clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[test,fmu]'
+	touch $(STAMP)
+
+venv: $(STAMP)
+
+# Headless Chromium for the browser test and the snapshots (Debian package; root only).
+chromium:
+	@if command -v chromium >/dev/null 2>&1; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  echo "installing chromium (apt-get)"; \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
+	    || echo "warning: could not install chromium; browser tests will be skipped"; \
+	else echo "warning: chromium not found and not root; browser tests will be skipped"; fi
+
+demo: $(STAMP) chromium
+	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
+	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
+	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
+	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
+	@echo "demo outputs in $(OUT)/"
+
+test: $(STAMP) chromium
+	$(PY) -m ruff check src viewer tests examples benchmarks
+	$(PY) -m pytest -q
+
+test-slow: $(STAMP) chromium
+	$(PY) -m pytest -q -m slow
+
+bench: $(STAMP)
+	$(PY) benchmarks/work_precision.py
+
+lint: $(STAMP)
+	$(PY) -m ruff check src viewer tests examples benchmarks
+
+clean:
+	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info
