@@ -5,9 +5,26 @@ Public API (everything else is private and may change):
 
 from ._errors import ModelError, SceneError, SimulationError, WinderError
 from ._mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
+from ._result import Result, load_result
+from ._scene import Scene, load_scene, scene_from_dict
+from ._simulate import DEFAULT_METHOD, simulate
+from ._system import CHANNELS, EXTRA_CHANNELS, WinderSystem
 from ._variable_mass import VariableMassModel
+from .effects import EFFECTS, Effect
 
 __all__ = [
+    "CHANNELS",
+    "DEFAULT_METHOD",
+    "EFFECTS",
+    "EXTRA_CHANNELS",
+    "Effect",
+    "Result",
+    "Scene",
+    "WinderSystem",
+    "load_result",
+    "load_scene",
+    "scene_from_dict",
+    "simulate",
     "FunctionMassLaw",
     "MassLaw",
     "MassProperties",

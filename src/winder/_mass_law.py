@@ -174,6 +174,28 @@ class PaperRollLaw(MassLaw):
         """``dJ/dr`` [kg·m]."""
         return 2.0 * math.pi * self.density * self.width * r**3
 
+    def write_inertia(self, r: float, Y: pin.Inertia) -> None:
+        """Fast path: overwrite mass and rotational inertia of ``Y`` (lever ``(e,0,0)``
+        must already be set) with ``Y(r)``."""
+        m, J = self.mass(r), self.polar_inertia(r)
+        It = 0.5 * J + m * self.width**2 / 12.0
+        me2 = m * self.com_offset**2
+        Y.mass = m
+        Y.inertia = np.diag((It, J - me2, It - me2))
+
+    def rate_into(self, r: float, r_dot: float, out: np.ndarray) -> None:
+        """Fast path: write ``Ẏ = dY/dr · ṙ`` into the 6×6 array ``out`` (only the
+        structurally non-zero entries are written; the others must be zero)."""
+        dm = self.mass_derivative(r) * r_dot
+        dJ = self.polar_inertia_derivative(r) * r_dot
+        dIt = 0.5 * dJ + dm * self.width**2 / 12.0
+        dme = dm * self.com_offset
+        out[0, 0] = out[1, 1] = out[2, 2] = dm
+        out[1, 5] = out[5, 1] = dme
+        out[2, 4] = out[4, 2] = -dme
+        out[3, 3] = out[5, 5] = dIt
+        out[4, 4] = dJ
+
     def properties(self, r: float) -> MassProperties:
         m, dm = self.mass(r), self.mass_derivative(r)
         J, dJ = self.polar_inertia(r), self.polar_inertia_derivative(r)

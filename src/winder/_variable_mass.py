@@ -97,6 +97,16 @@ class VariableMassModel:
             else:
                 self._rates.pop(j, None)
 
+    def bind_rate(self, joint_id: int) -> np.ndarray:
+        """Fast path: a writable 6×6 array that *is* the body's rate ``Ẏ`` from now on.
+
+        Fill it in place before each :meth:`aba_into` (no validation, no allocation).
+        ``set_body(joint_id, rate=None)`` unbinds it."""
+        j = self._check_joint(joint_id)
+        buf = np.zeros((6, 6))
+        self._rates[j] = buf
+        return buf
+
     def rate(self, joint_id: int) -> np.ndarray:
         """``Ẏ`` of a joint's body as a 6×6 matrix (zeros if none is set)."""
         j = self._check_joint(joint_id)
@@ -174,3 +184,12 @@ class VariableMassModel:
             for j, Yd in self._rates.items():
                 fext[j] = pin.Force(fext[j].vector - Yd @ self.data.v[j].vector)
         return pin.aba(self.model, self.data, q, v, tau, fext)
+
+    def rnea_into(self, q: np.ndarray, v: np.ndarray, a: np.ndarray,
+                  fext: pin.StdVec_Force) -> np.ndarray:
+        """Fast path of :meth:`rnea`, like :meth:`aba_into` (``fext`` modified in place)."""
+        if self._rates:
+            pin.forwardKinematics(self.model, self.data, q, v)
+            for j, Yd in self._rates.items():
+                fext[j] = pin.Force(fext[j].vector - Yd @ self.data.v[j].vector)
+        return pin.rnea(self.model, self.data, q, v, a, fext)

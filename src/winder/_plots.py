@@ -1,0 +1,139 @@
+"""The paper's figures from a result (matplotlib, PNG)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ._result import Result, atomic_write  # noqa: E402
+from ._scene import Scene  # noqa: E402
+
+__all__ = ["paper_figures"]
+
+
+def _save(fig: plt.Figure, path: Path) -> Path:
+    fig.tight_layout()
+    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    plt.close(fig)
+    return path
+
+
+def _first_liftoff(result: Result) -> float | None:
+    fn = result["normal_force"]
+    idx = np.flatnonzero(fn <= 0.0)
+    return float(result.t[idx[0]]) if len(idx) else None
+
+
+def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = None,
+                  closeup: Result | None = None) -> list[Path]:
+    """Write the paper's figures for ``result`` into ``out_dir``; returns the paths.
+
+    With contact: speeds + drum torque (Figs. 4/5), roll vertical velocity + radius
+    (Fig. 6), roll angular velocity + acceleration (Fig. 7), nip normal force with a
+    close-up of the first lift-off (Fig. 8; ``closeup`` is a finely sampled result of
+    that window, re-simulated from ``scene`` when not given). Without contact: the free
+    spin ω with the conserved ``J ω`` (Fig. 2).
+    """
+    out = Path(out_dir)
+    name = result.meta.get("scene", "result")
+    t = result.t
+    paths: list[Path] = []
+    web = "web_momentum" in result.meta.get("effects", [])
+    if np.all(result["normal_force"] == 0.0) and np.all(result["friction_force"] == 0.0):
+        fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+        ax[0].plot(t, result["roll_speed"], label="roll speed ω")
+        ax[0].set_ylabel("ω [rad/s]")
+        ax[0].set_title(f"{name}: free spin, paper added from rest (Fig. 2)")
+        jw = result["inertia"] * result["roll_speed"]
+        ax[1].plot(t, jw, color="C2", label="J ω")
+        ax[1].set_ylabel("J ω [kg m²/s]")
+        span = np.ptp(jw) / max(abs(jw[0]), 1e-300)
+        ax[1].set_title(f"angular momentum J ω (relative variation {span:.1e})")
+        ax[1].set_ylim(jw[0] * 0.9, jw[0] * 1.1) if jw[0] > 0 else None
+        ax[1].set_xlabel("t [s]")
+        for a in ax:
+            a.grid(True, alpha=0.3)
+            a.legend()
+        return [_save(fig, out / f"{name}_fig2_free_spin.png")]
+
+    fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    ax[0].plot(t, result["drum_speed"], label="drum Ω")
+    ax[0].plot(t, result["roll_speed"], label="roll ω", alpha=0.8)
+    ax[0].set_ylabel("speed [rad/s]")
+    ax[0].set_ylim(0, 1.05 * max(np.max(result["roll_speed"]), np.max(result["drum_speed"])))
+    R = float(result.meta.get("drum_radius", 0.5))
+    eq = np.flatnonzero(np.diff(np.sign(result["radius"] - R)))
+    if len(eq):
+        ax[0].axvline(t[eq[0]], color="k", ls=":", label=f"r = R at {t[eq[0]]:.0f} s")
+    ax[0].legend()
+    ax[0].set_title(f"{name}: drum and roll speed, drum torque "
+                    f"({'with' if web else 'without'} web momentum, Fig. {4 if web else 5})")
+    ax[1].plot(t, result["drum_torque"], color="C3", lw=0.6)
+    ax[1].set_ylabel("drum torque [N m]")
+    lo, hi = np.percentile(result["drum_torque"][t > 45], [0.5, 99.5]) if t[-1] > 50 else \
+        np.percentile(result["drum_torque"], [0.5, 99.5])
+    pad = 0.3 * (hi - lo) + 1.0
+    ax[1].set_ylim(lo - pad, hi + pad)
+    ax[1].axhline(0.0, color="k", lw=0.5)
+    ax[1].set_xlabel("t [s]")
+    for a in ax:
+        a.grid(True, alpha=0.3)
+    paths.append(_save(fig, out / f"{name}_fig{4 if web else 5}_speeds_torque.png"))
+
+    fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    ax[0].plot(t, result["z_dot"] * 1e3, lw=0.5)
+    ax[0].set_ylabel("roll vertical velocity ż [mm/s]")
+    ax[0].set_title(f"{name}: roll vertical velocity and radius (Fig. 6)")
+    ax[1].plot(t, result["radius"], label="roll radius r")
+    ax[1].plot(t, result["z"] - result["z"][0], label="rise of the roll axis z − z₀")
+    ax[1].set_ylabel("[m]")
+    ax[1].set_xlabel("t [s]")
+    ax[1].legend()
+    for a in ax:
+        a.grid(True, alpha=0.3)
+    paths.append(_save(fig, out / f"{name}_fig6_vertical_velocity_radius.png"))
+
+    fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    ax[0].plot(t, result["roll_speed"], lw=0.6)
+    ax[0].set_ylabel("roll speed ω [rad/s]")
+    ax[0].set_title(f"{name}: roll angular velocity and acceleration (Fig. 7)")
+    ax[1].plot(t, result["roll_accel"], lw=0.4, color="C1")
+    ax[1].set_ylabel("roll acceleration ω̇ [rad/s²]")
+    ax[1].set_xlabel("t [s]")
+    for a in ax:
+        a.grid(True, alpha=0.3)
+    paths.append(_save(fig, out / f"{name}_fig7_roll_speed_accel.png"))
+
+    fig, ax = plt.subplots(2, 1, figsize=(9, 7))
+    ax[0].plot(t, result["normal_force"] / 1e3, lw=0.4)
+    ax[0].plot(t, result["mass"] * 9.81 / 1e3, color="k", lw=0.8, label="weight m g")
+    ax[0].set_ylabel("normal force F_n [kN]")
+    ax[0].set_xlabel("t [s]")
+    ax[0].set_title(f"{name}: nip normal force (Fig. 8)")
+    ax[0].legend()
+    t_lift = _first_liftoff(result)
+    if closeup is None and t_lift is not None and scene is not None:
+        from ._simulate import simulate
+
+        closeup = simulate(scene, t_end=min(t_lift + 2.0, t[-1]), output_step=2e-4)
+    if closeup is not None and t_lift is not None:
+        tc = closeup.t
+        w = (tc >= t_lift - 0.3) & (tc <= t_lift + 1.0)
+        ax[1].plot(tc[w], closeup["normal_force"][w], lw=0.8)
+        ax[1].set_title(f"close-up: first lift-off at t ≈ {t_lift:.2f} s (F_n = 0: roll in "
+                        "the air, spikes: impacts)")
+    else:
+        w = t <= min(t[-1], 60.0)
+        ax[1].plot(t[w], result["normal_force"][w], lw=0.6)
+        ax[1].set_title("first 60 s (no lift-off in this run)")
+    ax[1].set_ylabel("F_n [N]")
+    ax[1].set_xlabel("t [s]")
+    for a in ax:
+        a.grid(True, alpha=0.3)
+    paths.append(_save(fig, out / f"{name}_fig8_normal_force.png"))
+    return paths

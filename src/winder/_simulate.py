@@ -1,0 +1,235 @@
+"""Time integration of a scene: breakpoints, contact events, guards, progress."""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from typing import Any
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ._errors import SimulationError
+from ._result import Result
+from ._scene import METHODS, Scene
+from ._system import WinderSystem
+
+__all__ = ["simulate", "DEFAULT_METHOD", "resolve_method"]
+
+#: What ``method="auto"`` picks (chosen from the work–precision study, docs/).
+DEFAULT_METHOD = "LSODA"
+
+
+def resolve_method(method: str | None, scene: Scene) -> str:
+    m = method or scene.solver.method
+    if m not in METHODS:
+        raise SimulationError(f"unknown method {m!r}; valid: {', '.join(METHODS)}")
+    return DEFAULT_METHOD if m == "auto" else m
+
+
+class _Progress:
+    """A one-line progress bar on stderr (updated at most every 0.2 s)."""
+
+    def __init__(self, t_end: float, label: str) -> None:
+        self.t_end, self.label = t_end, label
+        self.start = self.last = time.perf_counter()
+
+    def update(self, t: float) -> None:
+        now = time.perf_counter()
+        if now - self.last < 0.2:
+            return
+        self.last = now
+        frac = min(max(t / self.t_end, 0.0), 1.0)
+        bar = "#" * int(30 * frac)
+        sys.stderr.write(f"\r{self.label} [{bar:<30}] {100 * frac:5.1f}%  t = {t:8.2f} s"
+                         f"  {now - self.start:6.1f} s wall")
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        self.last = 0.0
+        self.update(self.t_end)
+        sys.stderr.write("\n")
+
+
+def _rk4(fun: Any, t0: float, t1: float, y0: np.ndarray, h: float,
+         t_eval: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """Classical fixed-step RK4 (real-time capable); output at ``t_eval`` by cubic
+    Hermite interpolation within a step."""
+    n = max(1, math.ceil((t1 - t0) / h - 1e-9))
+    h = (t1 - t0) / n
+    out = np.empty((len(y0), len(t_eval)))
+    k = 0
+    y, t = y0.astype(float), t0
+    f0 = fun(t, y)
+    nfev = 1
+    for i in range(n):
+        k1 = f0
+        k2 = fun(t + h / 2, y + h / 2 * k1)
+        k3 = fun(t + h / 2, y + h / 2 * k2)
+        k4 = fun(t + h, y + h * k3)
+        y1 = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        t1_ = t0 + (i + 1) * h
+        f1 = fun(t1_, y1)
+        nfev += 4
+        while k < len(t_eval) and t_eval[k] <= t1_ + 1e-12 * max(1.0, abs(t1_)):
+            s = (t_eval[k] - t) / h
+            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+            h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+            out[:, k] = h00 * y + h10 * h * f0 + h01 * y1 + h11 * h * f1
+            k += 1
+        y, t, f0 = y1, t1_, f1
+    return out, y, nfev
+
+
+def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = None,
+             rtol: float | None = None, atol: float | None = None, progress: bool = False,
+             output_step: float | None = None, events: bool = True,
+             max_step: float | None = None, max_rhs: int | None = None,
+             max_wall: float | None = None) -> Result:
+    """Simulate a scene and return its result channels.
+
+    Parameters
+    ----------
+    scene: from :func:`winder.load_scene`.
+    t_end: end time [s] (default: ``[scene] duration``).
+    method: one of ``auto``, RK45, DOP853, Radau, BDF, LSODA, RK23 (scipy) or RK4
+        (fixed step ``max_step``, default 1 ms); default ``[solver] method``.
+    rtol, atol: tolerances (default ``[solver]``).
+    progress: print a progress bar on stderr.
+    output_step: sampling of the result [s] (default ``[scene] output_step``).
+    events: locate contact lift-off and touch-down and restart the integrator there.
+    max_step: largest step [s] (the step of RK4).
+    max_rhs, max_wall: guards: right-hand side evaluations, wall-clock seconds; exceeding
+        one raises :class:`~winder.SimulationError` naming time and state.
+
+    Raises
+    ------
+    SimulationError: the integrator failed, a state went non-finite, or a guard tripped.
+    """
+    system = WinderSystem(scene)
+    T = scene.scene.duration if t_end is None else float(t_end)
+    if not (math.isfinite(T) and T > 0):
+        raise SimulationError(f"t_end must be finite and > 0, got {t_end!r}")
+    meth = resolve_method(method, scene)
+    rtol = scene.solver.rtol if rtol is None else float(rtol)
+    atol = scene.solver.atol if atol is None else float(atol)
+    dt = scene.scene.output_step if output_step is None else float(output_step)
+    limit = scene.solver.max_rhs if max_rhs is None else int(max_rhs)
+    n_out = int(math.floor(T / dt + 1e-9)) + 1
+    t_out = np.minimum(np.arange(n_out) * dt, T)
+    if t_out[-1] < T - 1e-12 * T:
+        t_out = np.append(t_out, T)
+    y0 = system.initial_state()
+    r_floor = scene.roll.core_radius - scene.paper.caliper  # one layer below the core
+    bar = _Progress(T, scene.name) if progress else None
+    wall0 = time.perf_counter()
+    names = system.state_names
+
+    def fail(msg: str, t: float, y: np.ndarray) -> SimulationError:
+        state = dict(zip(names, map(float, y), strict=True))
+        where = ", ".join(f"{n}={v:.6g}" for n, v in state.items())
+        return SimulationError(f"{msg} at t = {t:.6g} s (state: {where})", time=t, state=state)
+
+    rhs = system.rhs
+
+    def fun(t: float, y: np.ndarray) -> np.ndarray:
+        if system.nfev >= limit:
+            raise fail(f"more than {limit} right-hand side evaluations (max_rhs guard); the "
+                       f"problem is stiffer than method {meth!r} can handle: try "
+                       "method='Radau' or 'LSODA', or a looser rtol", t, y)
+        if system.nfev % 2000 == 0:
+            if bar is not None:
+                bar.update(t)
+            if max_wall is not None and time.perf_counter() - wall0 > max_wall:
+                raise fail(f"wall-clock guard of {max_wall:g} s exceeded", t, y)
+        if y[4] < r_floor:
+            raise fail(f"radius {y[4]:.6g} m fell more than one caliper below the core "
+                       f"radius {scene.roll.core_radius:g} m (the roll turned backwards and "
+                       "unwound)", t, y)
+        return rhs(t, y)
+
+    breaks = sorted({b for b in system.drive.breakpoints if 0.0 < b < T} | {T})
+    use_events = events and system.contact is not None and meth != "RK4"
+    R = system.drum_radius
+
+    def gap(t: float, y: np.ndarray) -> float:  # δ = R + r − z; > 0 in contact
+        return R + y[4] - y[0]
+
+    gap.terminal = True  # type: ignore[attr-defined]
+    Ys = np.empty((len(y0), len(t_out)))
+    filled = 0
+    t0, y = 0.0, y0
+    n_events = 0
+    expect = 0.0
+    events_lost: float | None = None
+    options: dict[str, Any] = {"rtol": rtol, "atol": atol}
+    if max_step is not None:
+        options["max_step"] = max_step
+    try:
+        for tb in breaks:
+            while t0 < tb:
+                mask = (t_out >= t0) & (t_out <= tb)
+                if filled:  # points already written (the start of a restarted segment)
+                    mask[:filled] = False
+                t_eval = t_out[mask]
+                if meth == "RK4":
+                    h = max_step or 1e-3
+                    Yseg, y, _ = _rk4(fun, t0, tb, y, h, t_eval)
+                    Ys[:, filled:filled + len(t_eval)] = Yseg
+                    filled += len(t_eval)
+                    t0 = tb
+                    continue
+                ev = None
+                if use_events:
+                    if expect == 0.0:  # first segment: look for leaving the current side
+                        expect = -1.0 if gap(t0, y) > 0.0 else 1.0
+                    gap.direction = expect  # type: ignore[attr-defined]
+                    ev = [gap]
+                extra = not (len(t_eval) and t_eval[-1] == tb)
+                te = np.append(t_eval, tb) if extra else t_eval
+                try:
+                    sol = solve_ivp(fun, (t0, tb), y, method=meth, t_eval=te, events=ev,
+                                    **options)
+                except ValueError as exc:
+                    # scipy's root bracketing fails when a method's interpolant disagrees
+                    # with its step ends (seen with LSODA): finish without event location
+                    if ev is None or "different signs" not in str(exc):
+                        raise
+                    use_events, events_lost = False, t0
+                    continue
+                if sol.status < 0:
+                    raise fail(f"integrator {meth} failed: {sol.message}; try a stiff method "
+                               "(Radau, BDF) or a looser/tighter rtol", sol.t[-1] if len(sol.t)
+                               else t0, sol.y[:, -1] if sol.y.size else y)
+                cols = np.asarray(sol.y, dtype=float).reshape(len(y0), -1)
+                if sol.status == 0 and extra:
+                    cols = cols[:, :-1]
+                k = cols.shape[1]
+                Ys[:, filled:filled + k] = cols
+                filled += k
+                if sol.status == 1:  # contact event: restart exactly there
+                    n_events += 1
+                    t_ev, y_ev = float(sol.t_events[0][0]), sol.y_events[0][0]
+                    expect = -expect  # lift-off is followed by touch-down and vice versa
+                    t0, y = t_ev, y_ev
+                else:
+                    t0, y = tb, sol.y[:, -1]
+    finally:
+        if bar is not None:
+            bar.close()
+    if filled != len(t_out):
+        raise SimulationError(f"internal error: {filled} of {len(t_out)} output samples")
+    wall = time.perf_counter() - wall0
+    nfev = system.nfev
+    channels = system.channels(t_out, Ys)
+    bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
+    if bad:
+        raise SimulationError(f"non-finite values in result channels {bad}")
+    meta = {"scene": scene.name, "source": scene.source, "method": meth, "rtol": rtol,
+            "atol": atol, "rhs_evaluations": nfev, "wall_time": wall, "events": n_events,
+            "event_location_stopped_at": events_lost,
+            "t_end": T, "effects": list(scene.effects.enabled()),
+            "drum_radius": scene.drum.radius}
+    return Result(channels, meta)
+

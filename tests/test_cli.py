@@ -1,0 +1,69 @@
+"""The command line: free spin closed form through the full CLI path, errors, atomicity."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import winder
+from winder.cli import main
+
+
+def test_free_spin_matches_closed_form_through_cli(tmp_path, models_dir, capsys) -> None:
+    out = tmp_path / "free.csv"
+    assert main(["run", str(models_dir / "free_spin.toml"), "--out", str(out)]) == 0
+    with open(out) as fh:
+        header = fh.readline().strip().split(",")
+    assert tuple(header[:len(winder.CHANNELS)]) == winder.CHANNELS
+    res = winder.load_result(out)
+    r, w, t, J = res["radius"], res["roll_speed"], res.t, res["inertia"]
+    rc, h, L, rho, Jc, w0 = 0.075, 160e-6, 2.0, 800.0, 0.12, 200.0
+    J0 = Jc
+    k = 0.5 * rho * math.pi * L
+    t_closed = 2 * math.pi / (h * J0 * w0) * ((Jc - k * rc**4) * (r - rc) + k * (r**5 - rc**5) / 5)
+    assert r[-1] > 2.5 * rc  # a real growth: J grows by > 30×
+    assert np.max(np.abs(t_closed - t)) / t[-1] < 1e-8
+    assert np.max(np.abs(J * w - J0 * w0)) / (J0 * w0) < 1e-8
+
+
+def _run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "winder", *args], capture_output=True,
+                          text=True, timeout=120)
+
+
+def test_bad_scene_exits_nonzero_with_one_line(tmp_path: Path, models_dir: Path) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text((models_dir / "free_spin.toml").read_text().replace(
+        "caliper = 160e-6", "caliper = -1.0"))
+    out = tmp_path / "res.csv"
+    proc = _run("run", str(bad), "--out", str(out))
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "[paper] caliper" in lines[0] and str(bad) in lines[0]
+    assert not out.exists()
+
+
+def test_failed_run_leaves_no_partial_file(tmp_path: Path, models_dir: Path) -> None:
+    out = tmp_path / "res.csv"
+    out.write_text("previous\n")
+    # a tiny RHS budget trips the guard in the middle of the run
+    scene = tmp_path / "guarded.toml"
+    scene.write_text((models_dir / "free_spin.toml").read_text().replace(
+        "[solver]", "[solver]\nmax_rhs = 50"))
+    proc = _run("run", str(scene), "--out", str(out))
+    assert proc.returncode == 2 and "max_rhs" in proc.stderr
+    assert out.read_text() == "previous\n"  # untouched
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".res")] == []
+
+
+def test_npz_roundtrip(tmp_path: Path, models_dir: Path) -> None:
+    res = winder.simulate(winder.load_scene(models_dir / "free_spin.toml"), t_end=5.0)
+    back = winder.load_result(res.to_npz(tmp_path / "r.npz"))
+    assert list(back) == list(res)
+    for name in res:
+        np.testing.assert_array_equal(back[name], res[name])
+    assert back.meta["method"] == res.meta["method"]
