@@ -28,6 +28,7 @@ demo: $(STAMP) chromium
 	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
+	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
 	@echo "demo outputs in $(OUT)/"
 
 test: $(STAMP) chromium

@@ -230,6 +230,6 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
             "atol": atol, "rhs_evaluations": nfev, "wall_time": wall, "events": n_events,
             "event_location_stopped_at": events_lost,
             "t_end": T, "effects": list(scene.effects.enabled()),
-            "drum_radius": scene.drum.radius}
+            "drum_radius": scene.drum.radius, "scene_dict": scene.to_dict()}
     return Result(channels, meta)
 

@@ -46,6 +46,53 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _load_for_view(path: str):
+    from ._result import load_result
+    from ._scene import load_scene, scene_from_dict
+    from ._simulate import simulate
+
+    p = Path(path)
+    if p.suffix.lower() == ".toml":
+        scene = load_scene(p)
+        print(f"simulating {p} for the view ...", file=sys.stderr)
+        return scene, simulate(scene, progress=sys.stderr.isatty())
+    result = load_result(p)
+    if "scene_dict" not in result.meta:
+        raise WinderError(f"{p}: this result carries no scene (write it as .npz with "
+                          "'winder run'), or pass the scene file instead")
+    scene = scene_from_dict(result.meta["scene_dict"], source=str(result.meta.get("source", p)))
+    return scene, result
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    from winder.viewer import WinderGraph, export_html, snapshots
+
+    scene, result = _load_for_view(args.source)
+    graph = WinderGraph(scene)
+    if args.html:
+        path = export_html(graph, result, args.html, playback=args.playback)
+        print(f"animation ({args.playback:g} s playback) written to {path}")
+    if args.snapshots:
+        for path in snapshots(graph, result, args.snapshots, every=args.every):
+            print(f"  snapshot {path}")
+    if not args.html and not args.snapshots:
+        import meshcat
+
+        from winder.viewer import animate, plan_animation
+
+        vis = meshcat.Visualizer()
+        graph.build(vis)
+        animate(vis, graph, result, plan_animation(result, playback=args.playback))
+        print(f"live view at {vis.url()}  (Ctrl-C to stop)")
+        try:
+            import time
+            while True:
+                time.sleep(1.0)
+        except KeyboardInterrupt:
+            return 0
+    return 0
+
+
 def _build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="winder", description="Paper winder simulation.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -61,6 +108,15 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                      help="progress bar on stderr (default: when stderr is a terminal)")
     run.set_defaults(func=_cmd_run)
+    view = sub.add_parser("view", help="meshcat view of a result (.npz) or scene (.toml)")
+    view.add_argument("source", help="result file (.npz from 'winder run') or scene (.toml)")
+    view.add_argument("--html", help="write a standalone HTML animation (no network)")
+    view.add_argument("--snapshots", help="directory for PNG snapshots (headless Chromium)")
+    view.add_argument("--every", type=_positive, default=100.0,
+                      help="snapshot interval [s] (default 100)")
+    view.add_argument("--playback", type=_positive, default=30.0,
+                      help="playback length of the whole run [s] (default 30)")
+    view.set_defaults(func=_cmd_view)
     for register in _EXTRA:
         register(sub)
     return parser
