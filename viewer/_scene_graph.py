@@ -83,9 +83,9 @@ class WinderGraph:
         """Look along the cross-machine axis (world ``y``) at the nip region."""
         s = self.scene
         top = s.drum.radius + 2.0 * 0.9  # roll top at full size (r ≈ 0.84 m)
-        d = distance or 3.8
+        d = distance or 4.4
         # the camera node is in three.js coordinates (y up): world (x, y, z) → (x, z, −y)
-        vis["/Cameras/default"].set_transform(_translation([0.0, 0.0, 0.5 * top - 0.2]))
+        vis["/Cameras/default"].set_transform(_translation([0.0, 0.0, 0.5 * top]))
         vis["/Cameras/default/rotated/<object>"].set_property("position", [0.0, 0.0, d])
 
     # ---- poses ----------------------------------------------------------------------

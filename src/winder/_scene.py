@@ -101,7 +101,9 @@ class Drum:
 @dataclass(frozen=True)
 class Roll:
     """``[roll]``: core_radius [m], core_mass [kg], core_inertia [kg·m²], width [m],
-    initial_radius [m] (default: core_radius), initial_speed [rad/s], com_offset [m]."""
+    initial_radius [m] (default: core_radius), initial_speed [rad/s], com_offset [m];
+    winder's own key initial_height [m]: ``z`` at ``t = 0`` (default: static equilibrium on
+    the contact, spec §6), e.g. to drop the roll onto the drum."""
 
     core_radius: float
     core_mass: float
@@ -110,6 +112,7 @@ class Roll:
     initial_radius: float
     initial_speed: float = 0.0
     com_offset: float = 0.0
+    initial_height: float | None = None
 
 
 @dataclass(frozen=True)
@@ -192,7 +195,10 @@ class Scene:
         for f in fields(self):
             if f.name == "source":
                 continue
-            out[f.name] = dataclasses.asdict(getattr(self, f.name))
+            table = dataclasses.asdict(getattr(self, f.name))
+            if f.name == "drum":
+                table["drive"] = {k: v for k, v in table["drive"].items() if v is not None}
+            out[f.name] = {k: v for k, v in table.items() if v is not None}
         return out
 
 
@@ -210,7 +216,8 @@ _SPEC: dict[str, dict[str, tuple]] = {
     "roll": {"core_radius": ("num", True, _POS), "core_mass": ("num", True, _POS),
              "core_inertia": ("num", True, _POS), "width": ("num", True, _POS),
              "initial_radius": ("num", False, _POS), "initial_speed": ("num", False, None),
-             "com_offset": ("num", False, _NONNEG)},
+             "com_offset": ("num", False, _NONNEG),
+             "initial_height": ("num", False, None)},
     "paper": {"density": ("num", True, _NONNEG), "caliper": ("num", True, _POS)},
     "contact": {"law": ("str", False, None), "stiffness": ("num", False, _POS),
                 "damping": ("num", False, _NONNEG), "exponent": ("num", False, (1.0, False)),

@@ -86,7 +86,9 @@ class WinderSystem:
         roll = self.scene.roll
         r, w = roll.initial_radius, roll.initial_speed
         m = self.law.mass(r)
-        if self.contact is not None:
+        if roll.initial_height is not None:
+            z = roll.initial_height
+        elif self.contact is not None:
             z = self.contact.initial_height(m, r, self.h_over_2pi * w, self.g)
         else:
             z = self.drum_radius + r

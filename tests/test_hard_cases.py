@@ -1,0 +1,112 @@
+"""Hard cases: each completes with finite results and a balance that holds, or stops with
+a clear winder exception naming time and state — never NaN, never a hang."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import winder
+
+
+def _finite(res: winder.Result) -> None:
+    for name in res:
+        assert np.all(np.isfinite(res[name])), name
+
+
+def _smooth(paper_scene, **changes) -> winder.Scene:
+    roll = {"com_offset": 0.0, **changes.pop("roll", {})}
+    return paper_scene.replace(roll=roll, **changes)
+
+
+def test_very_stiff_nip(paper_scene) -> None:
+    """k = 1e10 N/m: the roll rests on the drum with F_n = m g on average."""
+    scene = _smooth(paper_scene, contact={"stiffness": 1e10, "damping": 1e5})
+    res = winder.simulate(scene, t_end=5.0, output_step=0.01)
+    _finite(res)
+    late = res.t > 1.0
+    np.testing.assert_allclose(res["normal_force"][late], res["mass"][late] * 9.81, rtol=1e-3)
+
+
+def test_tiny_slip_velocity(paper_scene) -> None:
+    """v_ref = 1e-5 m/s (stiff friction): the roll follows the drum, Ω R = ω r."""
+    scene = _smooth(paper_scene, friction={"slip_velocity": 1e-5})
+    res = winder.simulate(scene, t_end=5.0, output_step=0.01)
+    _finite(res)
+    late = res.t > 2.0
+    v = res["drum_speed"][late] * 0.5
+    assert np.max(np.abs(res["slip_velocity"][late])) < 1e-3 * np.max(v)
+
+
+def test_violent_bouncing(paper_scene) -> None:
+    """com_offset 5 mm: the roll flies; momentum balance in z over the run:
+    m ż(T) − m ż(0) ≈ ∫ (F_n − m g) dt (growth adds little here), and it lands again."""
+    scene = paper_scene.replace(roll={"com_offset": 0.005}, paper={"density": 0.0,
+                                                                   "caliper": 1e-9})
+    res = winder.simulate(scene, t_end=12.0, output_step=1e-4, rtol=1e-8, atol=1e-10)
+    _finite(res)
+    assert np.mean(res["normal_force"] == 0.0) > 0.05  # really in the air
+    m, e = 30.0, 0.005
+    # vertical momentum of the CoM: p = m (ż + e cos φ ω)
+    p = m * (res["z_dot"] + e * np.cos(res["roll_angle"]) * res["roll_speed"])
+    impulse = np.concatenate([[0.0], np.cumsum(0.5 * np.diff(res.t) * (
+        (res["normal_force"] - m * 9.81)[1:] + (res["normal_force"] - m * 9.81)[:-1]))])
+    assert np.max(np.abs(p - p[0] - impulse)) < 2e-2 * m * 9.81  # < 2 % of one second of weight
+
+
+def test_long_run_keeps_angular_momentum(models_dir) -> None:
+    """10 000 s of free spin: J ω stays constant."""
+    scene = winder.load_scene(models_dir / "free_spin.toml")
+    res = winder.simulate(scene, t_end=10_000.0, output_step=10.0, rtol=1e-10, atol=1e-12)
+    _finite(res)
+    jw = res["inertia"] * res["roll_speed"]
+    assert np.max(np.abs(jw - jw[0])) / jw[0] < 1e-7
+    assert res["radius"][-1] > 0.3
+
+
+def test_zero_caliper_is_rejected_with_the_key(tmp_path, models_dir) -> None:
+    text = (models_dir / "paper_winding.toml").read_text().replace(
+        "caliper = 160e-6", "caliper = 0.0")
+    p = tmp_path / "flat.toml"
+    p.write_text(text)
+    with pytest.raises(winder.SceneError, match=r"\[paper\] caliper: must be > 0"):
+        winder.load_scene(p)
+
+
+def test_tiny_caliper_reduces_to_constant_mass(paper_scene) -> None:
+    """caliper → 0: mass constant, and the variable-mass terms vanish (on = off)."""
+    base = _smooth(paper_scene, paper={"caliper": 1e-15})
+    on = winder.simulate(base, t_end=3.0, output_step=0.05)
+    off = winder.simulate(base.replace(effects={"variable_mass": False, "web_momentum": False}),
+                          t_end=3.0, output_step=0.05)
+    assert np.ptp(on["mass"]) < 1e-9
+    np.testing.assert_allclose(on["roll_speed"], off["roll_speed"], rtol=1e-5, atol=1e-6)
+
+
+@pytest.mark.parametrize("width", [50.0, 0.01])
+def test_huge_and_tiny_widths(paper_scene, width: float) -> None:
+    scene = _smooth(paper_scene, roll={"width": width})
+    res = winder.simulate(scene, t_end=3.0, output_step=0.01)
+    _finite(res)
+    late = res.t > 1.0
+    np.testing.assert_allclose(res["normal_force"][late], res["mass"][late] * 9.81, rtol=2e-2)
+
+
+def test_roll_dropped_onto_the_drum(paper_scene) -> None:
+    """Released 5 cm above contact: it lands (impacts) and settles on F_n = m g."""
+    scene = _smooth(paper_scene, roll={"initial_height": 0.5 + 0.075 + 0.05})
+    res = winder.simulate(scene, t_end=3.0, output_step=1e-3)
+    _finite(res)
+    t_land = res.t[np.argmax(res["normal_force"] > 0)]
+    assert t_land == pytest.approx(math.sqrt(2 * 0.05 / 9.81), abs=2e-3)  # free fall
+    assert res["normal_force"].max() > 10 * 30 * 9.81  # an impact
+    assert res["normal_force"][-1] == pytest.approx(res["mass"][-1] * 9.81, rel=1e-2)
+
+
+def test_divergence_is_reported_with_time_and_state(paper_scene) -> None:
+    """A guard trips with a winder exception that names time, state and a remedy."""
+    with pytest.raises(winder.SimulationError, match=r"max_rhs.*at t = .* s \(state: z=") as e:
+        winder.simulate(paper_scene, t_end=5.0, max_rhs=500)
+    assert e.value.time is not None and "radius" in e.value.state
