@@ -184,7 +184,6 @@ class WinderSystem:
         names = CHANNELS + EXTRA_CHANNELS
         out = {name: np.empty(len(t)) for name in names}
         out["t"][:] = t
-        data, model = self.data, self.model
         drive = self.drive
         for i, ti in enumerate(t):
             y = Y[:, i]
@@ -201,5 +200,4 @@ class WinderSystem:
                    a[ROLL_Z - 1], c.web_force, c.penetration)
             for name, value in zip(names[1:], row, strict=True):
                 out[name][i] = value
-        del data, model
         return out

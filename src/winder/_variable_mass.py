@@ -141,11 +141,15 @@ class VariableMassModel:
         out = pin.StdVec_Force()
         for f in base:
             out.append(pin.Force(f))
+        self._add_rate_forces(q, v, out)
+        return out
+
+    def _add_rate_forces(self, q: np.ndarray, v: np.ndarray, fext: pin.StdVec_Force) -> None:
+        """Add ``−Ẏ v`` in place to the force of every variable body (joint frames)."""
         if self._rates:
             pin.forwardKinematics(self.model, self.data, q, v)
             for j, Yd in self._rates.items():
-                out[j] = pin.Force(base[j].vector - Yd @ self.data.v[j].vector)
-        return out
+                fext[j] = pin.Force(fext[j].vector - Yd @ self.data.v[j].vector)
 
     def momentum_flux(self, q: np.ndarray, joint_id: int, *, mass_rate: float,
                       velocity: np.ndarray, point: np.ndarray) -> pin.Force:
@@ -179,17 +183,11 @@ class VariableMassModel:
                  fext: pin.StdVec_Force) -> np.ndarray:
         """Fast path of :meth:`aba`: adds ``−Ẏ v`` *in place* to a caller-owned ``fext``
         of the right length (not re-checked) and runs ABA. Returns ``data.ddq``."""
-        if self._rates:
-            pin.forwardKinematics(self.model, self.data, q, v)
-            for j, Yd in self._rates.items():
-                fext[j] = pin.Force(fext[j].vector - Yd @ self.data.v[j].vector)
+        self._add_rate_forces(q, v, fext)
         return pin.aba(self.model, self.data, q, v, tau, fext)
 
     def rnea_into(self, q: np.ndarray, v: np.ndarray, a: np.ndarray,
                   fext: pin.StdVec_Force) -> np.ndarray:
         """Fast path of :meth:`rnea`, like :meth:`aba_into` (``fext`` modified in place)."""
-        if self._rates:
-            pin.forwardKinematics(self.model, self.data, q, v)
-            for j, Yd in self._rates.items():
-                fext[j] = pin.Force(fext[j].vector - Yd @ self.data.v[j].vector)
+        self._add_rate_forces(q, v, fext)
         return pin.rnea(self.model, self.data, q, v, a, fext)
