@@ -16,13 +16,15 @@ from ._errors import SceneError
 
 __all__ = ["Scene", "SceneInfo", "Effects", "Drum", "Drive", "Roll", "Paper", "Contact",
            "Friction", "Solver", "load_scene", "scene_from_dict", "EFFECT_NAMES",
-           "DRIVE_KINDS", "CONTACT_LAWS", "METHODS"]
+           "DRIVE_KINDS", "CONTACT_LAWS", "METHODS", "BACKENDS"]
 
 EFFECT_NAMES = ("variable_mass", "web_momentum", "gravity", "imbalance", "contact",
                 "slip_relaxation")
 DRIVE_KINDS = ("speed_profile", "torque")
 CONTACT_LAWS = ("linear", "hunt_crossley")
-METHODS = ("auto", "RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23", "RK4")
+METHODS = ("auto", "DOPRI5", "RK4", "RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
+#: Right-hand side backends: the compiled planar equations, or Pinocchio's ABA.
+BACKENDS = ("compiled", "pinocchio")
 
 
 def _fail(source: str, table: str, key: str, message: str) -> SceneError:
@@ -148,12 +150,14 @@ class Friction:
 
 @dataclass(frozen=True)
 class Solver:
-    """``[solver]``: method (one of :data:`METHODS`), rtol, atol, max_rhs (guard)."""
+    """``[solver]``: method (one of :data:`METHODS`), rtol, atol, max_rhs (guard),
+    backend (one of :data:`BACKENDS`)."""
 
     method: str = "auto"
     rtol: float = 1e-6
     atol: float = 1e-8
     max_rhs: int = 50_000_000
+    backend: str = "compiled"
 
 
 @dataclass(frozen=True)
@@ -226,10 +230,11 @@ _SPEC: dict[str, dict[str, tuple]] = {
                  "relaxation_length": ("num", False, _POS),
                  "min_speed": ("num", False, _POS)},
     "solver": {"method": ("str", False, None), "rtol": ("num", False, _POS),
-               "atol": ("num", False, _POS), "max_rhs": ("num", False, _POS)},
+               "atol": ("num", False, _POS), "max_rhs": ("num", False, _POS),
+               "backend": ("str", False, None)},
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,
-            ("solver", "method"): METHODS}
+            ("solver", "method"): METHODS, ("solver", "backend"): BACKENDS}
 _REQUIRED_TABLES = ("scene", "drum", "roll", "paper")
 
 

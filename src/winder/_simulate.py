@@ -10,22 +10,42 @@ from typing import Any
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from . import _integrators as integ
 from ._errors import SimulationError
+from ._planar import PlanarSystem, pack, switch
 from ._result import Result
-from ._scene import METHODS, Scene
+from ._scene import BACKENDS, METHODS, Scene
 from ._system import WinderSystem
 
-__all__ = ["simulate", "DEFAULT_METHOD", "resolve_method"]
+__all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS"]
 
-#: What ``method="auto"`` picks (chosen from the work–precision study, docs/).
-DEFAULT_METHOD = "LSODA"
+#: What ``method="auto"`` picks (chosen from the work–precision study, docs/), per backend.
+DEFAULT_METHOD = {"compiled": "DOPRI5", "pinocchio": "LSODA"}
+#: Methods that run entirely compiled (planar backend only).
+COMPILED_METHODS = ("DOPRI5",)
+_CHUNK = 200_000  # evaluations per compiled call (progress, guards)
+_STEP_OVER = 1e-6  # [s] integrated without event location after a grazing contact
 
 
-def resolve_method(method: str | None, scene: Scene) -> str:
+def resolve_method(method: str | None, scene: Scene, backend: str | None = None) -> str:
     m = method or scene.solver.method
     if m not in METHODS:
         raise SimulationError(f"unknown method {m!r}; valid: {', '.join(METHODS)}")
-    return DEFAULT_METHOD if m == "auto" else m
+    b = resolve_backend(backend, scene)
+    if m == "auto":
+        return DEFAULT_METHOD[b]
+    if m in COMPILED_METHODS and b != "compiled":
+        raise SimulationError(f"method {m!r} needs backend 'compiled', got {b!r}; valid "
+                              f"methods for backend {b!r}: "
+                              + ", ".join(x for x in METHODS if x not in COMPILED_METHODS))
+    return m
+
+
+def resolve_backend(backend: str | None, scene: Scene) -> str:
+    b = backend or scene.solver.backend
+    if b not in BACKENDS:
+        raise SimulationError(f"unknown backend {b!r}; valid: {', '.join(BACKENDS)}")
+    return b
 
 
 class _Progress:
@@ -82,19 +102,63 @@ def _rk4(fun: Any, t0: float, t1: float, y0: np.ndarray, h: float,
     return out, y, nfev
 
 
+def _run_compiled(meth: str, p: np.ndarray, y0: np.ndarray, t_out: np.ndarray,
+                  Ys: np.ndarray, breaks: list[float], rtol: float, atol: float,
+                  max_step: float | None, limit: int, bar: _Progress | None,
+                  max_wall: float | None, wall0: float, fail: Any,
+                  r_floor: float) -> tuple[int, tuple[int, int]]:
+    """Integrate with a compiled method in chunks of :data:`_CHUNK` evaluations (progress,
+    guards between chunks). Returns samples written and ``(nfev, events)``."""
+    stats = np.zeros(4, dtype=np.int64)
+    y = np.array(y0, dtype=float)
+    t, h, k = 0.0, 0.0, 0
+    hmax = math.inf if max_step is None else float(max_step)
+    for tb in breaks:
+        while t < tb:
+            budget = min(_CHUNK, limit - int(stats[0]))
+            if budget <= 0:
+                raise fail(f"more than {limit} right-hand side evaluations (max_rhs guard); "
+                           "try a looser rtol or a larger max_rhs", t, y)
+            if meth == "DOPRI5":
+                status, t, h, k = integ.dopri5(t, tb, y, p, rtol, atol, h, hmax, t_out, Ys,
+                                               k, budget, stats)
+            else:  # RK4: chunks of budget/4 steps
+                step = max_step or 1e-3
+                t_next = min(tb, t + step * budget / 4)
+                if tb - t_next < 1e-9 * step:
+                    t_next = tb
+                status, t, _, k = integ.rk4(t, t_next, y, p, step, t_out, Ys, k, stats)
+            if status == integ.NON_FINITE or not np.all(np.isfinite(y)):
+                raise fail(f"the state went non-finite with method {meth!r}; try a stiff "
+                           "method (method='Radau', 'BDF' or 'LSODA') or a tighter rtol", t, y)
+            if status == integ.STEP_UNDERFLOW:
+                raise fail(f"step size underflow with method {meth!r} (the problem is too "
+                           "stiff or discontinuous for it): try method='Radau' or 'LSODA'",
+                           t, y)
+            if y[4] < r_floor:
+                raise fail(f"radius {y[4]:.6g} m fell more than one caliper below the core "
+                           "radius (the roll turned backwards and unwound)", t, y)
+            if bar is not None:
+                bar.update(t)
+            if max_wall is not None and time.perf_counter() - wall0 > max_wall:
+                raise fail(f"wall-clock guard of {max_wall:g} s exceeded", t, y)
+    return k, (int(stats[0]), int(stats[3]))
+
+
 def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = None,
              rtol: float | None = None, atol: float | None = None, progress: bool = False,
              output_step: float | None = None, events: bool = True,
              max_step: float | None = None, max_rhs: int | None = None,
-             max_wall: float | None = None) -> Result:
+             max_wall: float | None = None, backend: str | None = None) -> Result:
     """Simulate a scene and return its result channels.
 
     Parameters
     ----------
     scene: from :func:`winder.load_scene`.
     t_end: end time [s] (default: ``[scene] duration``).
-    method: one of ``auto``, RK45, DOP853, Radau, BDF, LSODA, RK23 (scipy) or RK4
-        (fixed step ``max_step``, default 1 ms); default ``[solver] method``.
+    method: one of ``auto`` (:data:`DEFAULT_METHOD`), DOPRI5 (compiled Dormand–Prince
+        with contact events), RK4 (fixed step ``max_step``, default 1 ms), or scipy's
+        RK45, DOP853, Radau, BDF, LSODA, RK23; default ``[solver] method``.
     rtol, atol: tolerances (default ``[solver]``).
     progress: print a progress bar on stderr.
     output_step: sampling of the result [s] (default ``[scene] output_step``).
@@ -102,16 +166,20 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
     max_step: largest step [s] (the step of RK4).
     max_rhs, max_wall: guards: right-hand side evaluations, wall-clock seconds; exceeding
         one raises :class:`~winder.SimulationError` naming time and state.
+    backend: ``compiled`` (planar equations in numba, default) or ``pinocchio`` (ABA
+        with the variable-mass terms); default ``[solver] backend``.
 
     Raises
     ------
     SimulationError: the integrator failed, a state went non-finite, or a guard tripped.
     """
     system = WinderSystem(scene)
+    be = resolve_backend(backend, scene)
+    planar = PlanarSystem(scene, system) if be == "compiled" else None
     T = scene.scene.duration if t_end is None else float(t_end)
     if not (math.isfinite(T) and T > 0):
         raise SimulationError(f"t_end must be finite and > 0, got {t_end!r}")
-    meth = resolve_method(method, scene)
+    meth = resolve_method(method, scene, be)
     rtol = scene.solver.rtol if rtol is None else float(rtol)
     atol = scene.solver.atol if atol is None else float(atol)
     dt = scene.scene.output_step if output_step is None else float(output_step)
@@ -131,14 +199,15 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
         where = ", ".join(f"{n}={v:.6g}" for n, v in state.items())
         return SimulationError(f"{msg} at t = {t:.6g} s (state: {where})", time=t, state=state)
 
-    rhs = system.rhs
+    counter = planar if planar is not None else system
+    rhs = counter.rhs
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
-        if system.nfev >= limit:
+        if counter.nfev >= limit:
             raise fail(f"more than {limit} right-hand side evaluations (max_rhs guard); the "
                        f"problem is stiffer than method {meth!r} can handle: try "
                        "method='Radau' or 'LSODA', or a looser rtol", t, y)
-        if system.nfev % 2000 == 0:
+        if counter.nfev % 2000 == 0:
             if bar is not None:
                 bar.update(t)
             if max_wall is not None and time.perf_counter() - wall0 > max_wall:
@@ -151,10 +220,11 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
 
     breaks = sorted({b for b in system.drive.breakpoints if 0.0 < b < T} | {T})
     use_events = events and system.contact is not None and meth != "RK4"
-    R = system.drum_radius
 
-    def gap(t: float, y: np.ndarray) -> float:  # δ = R + r − z; > 0 in contact
-        return R + y[4] - y[0]
+    p_switch = pack(scene)
+
+    def gap(t: float, y: np.ndarray) -> float:  # min(δ, F_unclamped/k); > 0: F_n > 0
+        return switch(t, y, p_switch)
 
     gap.terminal = True  # type: ignore[attr-defined]
     Ys = np.empty((len(y0), len(t_out)))
@@ -162,14 +232,16 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
     t0, y = 0.0, y0
     n_events = 0
     expect = 0.0
+    step_over_until = -math.inf
     events_lost: float | None = None
     options: dict[str, Any] = {"rtol": rtol, "atol": atol}
     if max_step is not None:
         options["max_step"] = max_step
     try:
-        for tb in breaks:
+        for tb in breaks if planar is None or meth not in ("DOPRI5", "RK4") else ():
             while t0 < tb:
-                mask = (t_out >= t0) & (t_out <= tb)
+                t_stop = tb if t0 >= step_over_until else min(tb, step_over_until)
+                mask = (t_out >= t0) & (t_out <= t_stop)
                 if filled:  # points already written (the start of a restarted segment)
                     mask[:filled] = False
                 t_eval = t_out[mask]
@@ -181,15 +253,15 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
                     t0 = tb
                     continue
                 ev = None
-                if use_events:
+                if use_events and t0 >= step_over_until:
                     if expect == 0.0:  # first segment: look for leaving the current side
                         expect = -1.0 if gap(t0, y) > 0.0 else 1.0
                     gap.direction = expect  # type: ignore[attr-defined]
                     ev = [gap]
-                extra = not (len(t_eval) and t_eval[-1] == tb)
-                te = np.append(t_eval, tb) if extra else t_eval
+                extra = not (len(t_eval) and t_eval[-1] == t_stop)
+                te = np.append(t_eval, t_stop) if extra else t_eval
                 try:
-                    sol = solve_ivp(fun, (t0, tb), y, method=meth, t_eval=te, events=ev,
+                    sol = solve_ivp(fun, (t0, t_stop), y, method=meth, t_eval=te, events=ev,
                                     **options)
                 except ValueError as exc:
                     # scipy's root bracketing fails when a method's interpolant disagrees
@@ -212,21 +284,32 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
                     n_events += 1
                     t_ev, y_ev = float(sol.t_events[0][0]), sol.y_events[0][0]
                     expect = -expect  # lift-off is followed by touch-down and vice versa
+                    if t_ev - t0 <= 1e-10 * max(1.0, abs(t0)):
+                        # grazing: the crossing is back at the restart point; step over
+                        # a short stretch without event location, then re-arm
+                        step_over_until, expect = t0 + _STEP_OVER, 0.0
                     t0, y = t_ev, y_ev
                 else:
-                    t0, y = tb, sol.y[:, -1]
+                    t0, y = t_stop, sol.y[:, -1]
+        if planar is not None and meth in ("DOPRI5", "RK4"):
+            filled, n_events = _run_compiled(meth, planar.params, y, t_out, Ys, breaks,
+                                             rtol, atol, max_step, limit, bar, max_wall,
+                                             wall0, fail, r_floor)
+            planar.nfev = n_events[0]
+            n_events = n_events[1]
     finally:
         if bar is not None:
             bar.close()
     if filled != len(t_out):
         raise SimulationError(f"internal error: {filled} of {len(t_out)} output samples")
     wall = time.perf_counter() - wall0
-    nfev = system.nfev
-    channels = system.channels(t_out, Ys)
+    nfev = counter.nfev
+    channels = counter.channels(t_out, Ys)
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
     if bad:
         raise SimulationError(f"non-finite values in result channels {bad}")
-    meta = {"scene": scene.name, "source": scene.source, "method": meth, "rtol": rtol,
+    meta = {"scene": scene.name, "source": scene.source, "method": meth, "backend": be,
+            "rtol": rtol,
             "atol": atol, "rhs_evaluations": nfev, "wall_time": wall, "events": n_events,
             "event_location_stopped_at": events_lost,
             "t_end": T, "effects": list(scene.effects.enabled()),

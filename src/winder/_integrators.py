@@ -1,0 +1,266 @@
+"""Compiled integrators of the planar backend: adaptive Dormand–Prince 5(4) with contact
+events, and classical fixed-step RK4.
+
+``dopri5`` is Hairer's DOPRI5 (same tableau, error estimate, 4th-order dense output and
+step control as ``scipy``'s RK45 and Hairer & Wanner's code) with one addition for the
+nip: the contact mode (touching or not) is *locked* during a step. When an accepted step
+ends on the other side of the switching function, the crossing is located on the step's
+dense output (Illinois method, to ~1e-12 s), the step is cut there and the integration
+restarts in the new mode. The discontinuity of the damped force at touch-down and the
+kink at lift-off therefore never fall inside a step, and the error keeps converging with
+the tolerance through bouncing.
+
+Both functions integrate ``y`` in place, write samples at output times into a caller's
+array and keep counters in ``stats = [nfev, accepted, rejected, events]``.
+Status codes: :data:`DONE`, :data:`PAUSED` (the evaluation budget of this call is spent;
+call again to resume), :data:`STEP_UNDERFLOW`, :data:`NON_FINITE`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ._planar import AUTO, FREE, IN_CONTACT, N_AUX, P_CONTACT, evaluate, mode_of, switch
+
+__all__ = ["dopri5", "rk4", "DONE", "PAUSED", "STEP_UNDERFLOW", "NON_FINITE"]
+
+DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE = 0, 1, 2, 3
+
+# Dormand–Prince 5(4) tableau
+C2, C3, C4, C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
+A21 = 1 / 5
+A31, A32 = 3 / 40, 9 / 40
+A41, A42, A43 = 44 / 45, -56 / 15, 32 / 9
+A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
+A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
+A71, A73, A74, A75, A76 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
+E1, E3, E4, E5, E6, E7 = (71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525,
+                          -1 / 40)
+D1, D3, D4 = -12715105075 / 11282082432, 87487479700 / 32700410799, -10690763975 / 1880347072
+D5, D6, D7 = 701980252875 / 199316789632, -1453857185 / 822651844, 69997945 / 29380423
+
+
+@njit(cache=True)
+def _dense(rc: np.ndarray, theta: float, out: np.ndarray) -> None:
+    th1 = 1.0 - theta
+    for i in range(out.shape[0]):
+        out[i] = rc[0, i] + theta * (rc[1, i] + th1 * (rc[2, i] + theta
+                                                       * (rc[3, i] + th1 * rc[4, i])))
+
+
+@njit(cache=True)
+def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol: float,
+           h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
+           budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
+    """Integrate ``y`` from ``t0`` to ``t1``. Samples at ``t_out[k:]`` up to ``t1`` go to
+    the columns of ``Y_out``. ``h <= 0`` picks the first step. Stops after ``budget``
+    evaluations with :data:`PAUSED`. Returns ``(status, t, h, k)``."""
+    n = y.shape[0]
+    k1, k2, k3, k4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    k5, k6, k7 = np.empty(n), np.empty(n), np.empty(n)
+    yt, y1 = np.empty(n), np.empty(n)
+    rc = np.empty((5, n))
+    aux = np.empty(N_AUX)
+    contact = p[P_CONTACT] != 0.0
+    t = t0
+    mode = mode_of(t, y, p)
+    evaluate(t, y, p, mode, k1, aux)
+    nfev = 1
+    if h <= 0.0:  # Hairer's starting step, first part
+        d0 = d1 = 0.0
+        for i in range(n):
+            sk = atol + rtol * abs(y[i])
+            d0 += (y[i] / sk) ** 2
+            d1 += (k1[i] / sk) ** 2
+        d0, d1 = math.sqrt(d0 / n), math.sqrt(d1 / n)
+        h = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+    rejected_last = False
+    status = DONE
+    while t < t1:
+        if nfev >= budget:
+            status = PAUSED
+            break
+        hh = min(h, max_step)
+        if t + hh >= t1 or t + 1.01 * hh >= t1:
+            hh = t1 - t
+        if hh < 1e-14 * max(1.0, abs(t)):
+            status = STEP_UNDERFLOW
+            break
+        for i in range(n):
+            yt[i] = y[i] + hh * A21 * k1[i]
+        evaluate(t + C2 * hh, yt, p, mode, k2, aux)
+        for i in range(n):
+            yt[i] = y[i] + hh * (A31 * k1[i] + A32 * k2[i])
+        evaluate(t + C3 * hh, yt, p, mode, k3, aux)
+        for i in range(n):
+            yt[i] = y[i] + hh * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+        evaluate(t + C4 * hh, yt, p, mode, k4, aux)
+        for i in range(n):
+            yt[i] = y[i] + hh * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+        evaluate(t + C5 * hh, yt, p, mode, k5, aux)
+        for i in range(n):
+            yt[i] = y[i] + hh * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
+                                 + A65 * k5[i])
+        evaluate(t + hh, yt, p, mode, k6, aux)
+        for i in range(n):
+            y1[i] = y[i] + hh * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i]
+                                 + A76 * k6[i])
+        evaluate(t + hh, y1, p, mode, k7, aux)
+        nfev += 6
+        err = 0.0
+        for i in range(n):
+            sk = atol + rtol * max(abs(y[i]), abs(y1[i]))
+            ei = hh * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i]
+                       + E7 * k7[i])
+            err += (ei / sk) ** 2
+        err = math.sqrt(err / n)
+        if not math.isfinite(err):
+            stats[2] += 1
+            h = 0.1 * hh
+            if h < 1e-14 * max(1.0, abs(t)):
+                status = NON_FINITE
+                break
+            rejected_last = True
+            continue
+        if err > 1.0:
+            stats[2] += 1
+            h = hh * max(0.2, 0.9 * err ** -0.2)
+            rejected_last = True
+            continue
+        # accepted: dense output coefficients
+        for i in range(n):
+            dyi = y1[i] - y[i]
+            bspl = hh * k1[i] - dyi
+            rc[0, i] = y[i]
+            rc[1, i] = dyi
+            rc[2, i] = bspl
+            rc[3, i] = dyi - hh * k7[i] - bspl
+            rc[4, i] = hh * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i]
+                             + D7 * k7[i])
+        theta_end = 1.0
+        new_mode = mode
+        if contact:
+            s1 = switch(t + hh, y1, p)
+            crossed = (mode == IN_CONTACT and s1 <= 0.0) or (mode == FREE and s1 > 0.0)
+            if crossed:
+                new_mode = IN_CONTACT if s1 > 0.0 else FREE
+                s0 = switch(t, y, p)
+                if mode == IN_CONTACT and s0 <= 0.0:
+                    s0 = 1e-300
+                elif mode == FREE and s0 > 0.0:
+                    s0 = -1e-300
+                ta, ga, tb, gb = 0.0, s0, 1.0, s1
+                side = 0
+                tol = 1e-12 * max(1.0, abs(t)) / hh
+                for _ in range(100):
+                    if tb - ta <= tol:
+                        break
+                    th = (ta * gb - tb * ga) / (gb - ga)
+                    if not (ta < th < tb):
+                        th = 0.5 * (ta + tb)
+                    _dense(rc, th, yt)
+                    g = switch(t + th * hh, yt, p)
+                    in_new = g > 0.0 if new_mode == IN_CONTACT else g <= 0.0
+                    if in_new:
+                        tb, gb = th, g
+                        if side == -1:
+                            ga *= 0.5
+                        side = -1
+                    else:
+                        ta, ga = th, g
+                        if side == 1:
+                            gb *= 0.5
+                        side = 1
+                theta_end = tb
+        t_end = t + theta_end * hh
+        # samples inside the accepted part of the step
+        while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
+            if t_out[k] > t1 + 1e-13 * max(1.0, abs(t1)):
+                break
+            _dense(rc, min(1.0, max(0.0, (t_out[k] - t) / hh)), yt)
+            for i in range(n):
+                Y_out[i, k] = yt[i]
+            k += 1
+        stats[1] += 1
+        if theta_end < 1.0:  # event: restart at the crossing in the new mode
+            _dense(rc, theta_end, y)
+            t = t_end
+            mode = new_mode
+            evaluate(t, y, p, mode, k1, aux)
+            nfev += 1
+            stats[3] += 1
+            h = hh
+            rejected_last = False
+            continue
+        for i in range(n):
+            y[i] = y1[i]
+            k1[i] = k7[i]
+        t = t + hh if t + hh < t1 else t1
+        if new_mode != mode:  # crossing at the very end of the step
+            mode = new_mode
+            evaluate(t, y, p, mode, k1, aux)
+            nfev += 1
+            stats[3] += 1
+        fac = 0.9 * max(err, 1e-10) ** -0.2
+        fac = min(fac, 1.0) if rejected_last else min(fac, 10.0)
+        h = hh * max(0.2, fac)
+        rejected_last = False
+    stats[0] += nfev
+    return status, t, h, k
+
+
+@njit(cache=True)
+def rk4(t0: float, t1: float, y: np.ndarray, p: np.ndarray, h: float, t_out: np.ndarray,
+        Y_out: np.ndarray, k: int, stats: np.ndarray) -> tuple[int, float, float, int]:
+    """Classical RK4 with steps of at most ``h`` evenly dividing ``[t0, t1]`` (the clamped
+    nip law, no event location: for real-time stepping). Samples by cubic Hermite
+    interpolation. Returns ``(status, t, h, k)``."""
+    n = y.shape[0]
+    steps = max(1, int(math.ceil((t1 - t0) / h - 1e-9)))
+    hh = (t1 - t0) / steps
+    k1, k2, k3, k4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    yt, y1 = np.empty(n), np.empty(n)
+    aux = np.empty(N_AUX)
+    evaluate(t0, y, p, AUTO, k1, aux)
+    nfev = 1
+    t = t0
+    status = DONE
+    for j in range(steps):
+        for i in range(n):
+            yt[i] = y[i] + 0.5 * hh * k1[i]
+        evaluate(t + 0.5 * hh, yt, p, AUTO, k2, aux)
+        for i in range(n):
+            yt[i] = y[i] + 0.5 * hh * k2[i]
+        evaluate(t + 0.5 * hh, yt, p, AUTO, k3, aux)
+        for i in range(n):
+            yt[i] = y[i] + hh * k3[i]
+        evaluate(t + hh, yt, p, AUTO, k4, aux)
+        for i in range(n):
+            y1[i] = y[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+        tn = t0 + (j + 1) * hh
+        evaluate(tn, y1, p, AUTO, k2, aux)  # f at the step end (next k1)
+        nfev += 4
+        ok = True
+        for i in range(n):
+            if not math.isfinite(y1[i]):
+                ok = False
+        if not ok:
+            status = NON_FINITE
+            break
+        while k < t_out.shape[0] and t_out[k] <= tn + 1e-13 * max(1.0, abs(tn)):
+            s = (t_out[k] - t) / hh
+            h00, h10 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s
+            h01, h11 = -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2
+            for i in range(n):
+                Y_out[i, k] = h00 * y[i] + h10 * hh * k1[i] + h01 * y1[i] + h11 * hh * k2[i]
+            k += 1
+        for i in range(n):
+            y[i] = y1[i]
+            k1[i] = k2[i]
+        t = tn
+    stats[0] += nfev
+    stats[1] += steps
+    return status, t, hh, k
