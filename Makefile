@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.winder-installed
 OUT    ?= out
 
-.PHONY: demo test test-slow bench lint chromium clean
+.PHONY: demo test test-slow bench fmu lint chromium clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -39,7 +39,14 @@ test-slow: $(STAMP) chromium
 	$(PY) -m pytest -q -m slow
 
 bench: $(STAMP)
+	$(PY) benchmarks/rhs_speed.py
 	$(PY) benchmarks/work_precision.py
+	$(PY) benchmarks/fmu_realtime.py
+
+# The FMU and the closed-loop PI example (FMPy host).
+fmu: $(STAMP)
+	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/winder.fmu
+	$(PY) examples/speed_control_fmu.py --out $(OUT)
 
 lint: $(STAMP)
 	$(PY) -m ruff check src viewer tests examples benchmarks

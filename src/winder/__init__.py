@@ -8,6 +8,7 @@ from ._mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
 from ._result import Result, load_result
 from ._scene import Scene, load_scene, scene_from_dict
 from ._simulate import DEFAULT_METHOD, simulate
+from ._stepper import Stepper
 from ._system import CHANNELS, EXTRA_CHANNELS, WinderSystem
 from ._variable_mass import VariableMassModel
 from .effects import EFFECTS, Effect
@@ -20,6 +21,7 @@ __all__ = [
     "Effect",
     "Result",
     "Scene",
+    "Stepper",
     "WinderSystem",
     "load_result",
     "load_scene",

@@ -111,7 +111,7 @@ def _run_compiled(meth: str, p: np.ndarray, y0: np.ndarray, t_out: np.ndarray,
     guards between chunks). Returns samples written and ``(nfev, events)``."""
     stats = np.zeros(4, dtype=np.int64)
     y = np.array(y0, dtype=float)
-    t, h, k = 0.0, 0.0, 0
+    t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
     for tb in breaks:
         while t < tb:
@@ -149,7 +149,8 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
              rtol: float | None = None, atol: float | None = None, progress: bool = False,
              output_step: float | None = None, events: bool = True,
              max_step: float | None = None, max_rhs: int | None = None,
-             max_wall: float | None = None, backend: str | None = None) -> Result:
+             max_wall: float | None = None, backend: str | None = None,
+             t_start: float = 0.0, initial_state: np.ndarray | None = None) -> Result:
     """Simulate a scene and return its result channels.
 
     Parameters
@@ -168,6 +169,8 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
         one raises :class:`~winder.SimulationError` naming time and state.
     backend: ``compiled`` (planar equations in numba, default) or ``pinocchio`` (ABA
         with the variable-mass terms); default ``[solver] backend``.
+    t_start, initial_state: start the run at ``t_start`` [s] from a full state vector
+        (order of ``WinderSystem.state_names``) instead of spec §6's initial state.
 
     Raises
     ------
@@ -184,11 +187,21 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
     atol = scene.solver.atol if atol is None else float(atol)
     dt = scene.scene.output_step if output_step is None else float(output_step)
     limit = scene.solver.max_rhs if max_rhs is None else int(max_rhs)
-    n_out = int(math.floor(T / dt + 1e-9)) + 1
-    t_out = np.minimum(np.arange(n_out) * dt, T)
+    t_s = float(t_start)
+    if not (math.isfinite(t_s) and 0.0 <= t_s < T):
+        raise SimulationError(f"t_start must be finite, >= 0 and < t_end = {T:g}, got "
+                              f"{t_start!r}")
+    n_out = int(math.floor((T - t_s) / dt + 1e-9)) + 1
+    t_out = np.minimum(t_s + np.arange(n_out) * dt, T)
     if t_out[-1] < T - 1e-12 * T:
         t_out = np.append(t_out, T)
-    y0 = system.initial_state()
+    if initial_state is None:
+        y0 = system.initial_state()
+    else:
+        y0 = np.array(initial_state, dtype=float)
+        if y0.shape != (system.n_states,) or not np.all(np.isfinite(y0)):
+            raise SimulationError(f"initial_state must be {system.n_states} finite values "
+                                  f"({', '.join(system.state_names)}), got {initial_state!r}")
     r_floor = scene.roll.core_radius - scene.paper.caliper  # one layer below the core
     bar = _Progress(T, scene.name) if progress else None
     wall0 = time.perf_counter()
@@ -218,7 +231,7 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
                        "unwound)", t, y)
         return rhs(t, y)
 
-    breaks = sorted({b for b in system.drive.breakpoints if 0.0 < b < T} | {T})
+    breaks = sorted({b for b in system.drive.breakpoints if t_s < b < T} | {T})
     use_events = events and system.contact is not None and meth != "RK4"
 
     p_switch = pack(scene)
@@ -229,7 +242,7 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
     gap.terminal = True  # type: ignore[attr-defined]
     Ys = np.empty((len(y0), len(t_out)))
     filled = 0
-    t0, y = 0.0, y0
+    t0, y = t_s, y0
     n_events = 0
     expect = 0.0
     step_over_until = -math.inf
@@ -312,7 +325,7 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
             "rtol": rtol,
             "atol": atol, "rhs_evaluations": nfev, "wall_time": wall, "events": n_events,
             "event_location_stopped_at": events_lost,
-            "t_end": T, "effects": list(scene.effects.enabled()),
+            "t_start": t_s, "t_end": T, "effects": list(scene.effects.enabled()),
             "drum_radius": scene.drum.radius, "scene_dict": scene.to_dict()}
     return Result(channels, meta)
 
