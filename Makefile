@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.winder-installed
 OUT    ?= out
 
-.PHONY: demo test test-slow bench fmu lint chromium clean
+.PHONY: demo test test-slow bench fmu docs-figures lint chromium clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -29,6 +29,7 @@ demo: $(STAMP) chromium
 	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
 	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
+	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
 	@echo "demo outputs in $(OUT)/"
 
 test: $(STAMP) chromium
@@ -42,6 +43,10 @@ bench: $(STAMP)
 	$(PY) benchmarks/rhs_speed.py
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_realtime.py
+
+# The README's resonance map (committed under docs/).
+docs-figures: $(STAMP)
+	$(PY) -m winder modes models/paper_winding.toml --plot docs/resonance_map.png --csv docs/modes.csv
 
 # The FMU and the closed-loop PI example (FMPy host).
 fmu: $(STAMP)

@@ -3,7 +3,8 @@
 Problems: the smooth paper scene (first 120 s and the full 700 s), free spin (closed
 form) and 0.5 s of the bouncing phase of the paper scene (from t = 25 s). Methods: the
 compiled DOPRI5 and fixed-step RK4, and scipy's RK45, DOP853, Radau, BDF and LSODA on
-the compiled right-hand side, plus LSODA on the Pinocchio backend. Errors are the largest
+the compiled right-hand side, plus LSODA on the Pinocchio backend and BDF/Radau with the
+Pinocchio-derivative Jacobian (instead of their finite differences). Errors are the largest
 deviation over the output grid, scaled by the channel's largest magnitude, against a
 DOP853 solution at rtol 1e-12 (the closed form for free spin; the compiled DOPRI5 at
 1e-12 where scipy's DOP853 cannot get through the bouncing or would take minutes).
@@ -27,9 +28,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 import winder
-from winder._planar import PlanarSystem
 from winder._result import atomic_write
 from winder._system import WinderSystem
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import rhs_speed  # noqa: E402  (the sibling benchmark)
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
@@ -53,11 +56,13 @@ class Problem:
     reference_method: str = "DOP853"
 
     def run(self, method: str, rtol: float, *, backend: str = "compiled",
-            max_step: float | None = None, max_wall: float | None = None) -> winder.Result:
+            max_step: float | None = None, max_wall: float | None = None,
+            jacobian: str = "fd") -> winder.Result:
         return winder.simulate(self.scene, t_end=self.t_end, method=method, rtol=rtol,
                                atol=rtol * 1e-2, output_step=self.output_step,
                                backend=backend, max_step=max_step, max_wall=max_wall,
-                               t_start=self.t_start, initial_state=self.y0)
+                               t_start=self.t_start, initial_state=self.y0,
+                               jacobian=jacobian)
 
 
 def free_spin_closed_form(scene: winder.Scene, t: np.ndarray) -> dict[str, np.ndarray]:
@@ -139,16 +144,20 @@ def study(problems: list[Problem], *, max_wall: float, quick: bool,
         runs += [("RK4", "compiled", None, h) for h in (RK4_STEPS[1::2] if quick else RK4_STEPS)]
         if "700" not in prob.name:
             runs += [("LSODA", "pinocchio", tol, None) for tol in tols[:4]]
+            runs += [(m, "jacobian", tol, None) for m in ("BDF", "Radau") for tol in tols]
         given_up: set[tuple[str, str]] = set()
         for method, backend, tol, h in runs:
-            label = method if backend == "compiled" else f"{method} (Pinocchio)"
+            label = {"compiled": method, "pinocchio": f"{method} (Pinocchio RHS)",
+                     "jacobian": f"{method} (Pinocchio Jacobian)"}[backend]
             if (label, prob.name) in given_up:
                 continue
             row: dict[str, Any] = {"problem": prob.name, "method": label,
                                    "rtol": tol, "step": h}
             try:
-                res = prob.run(method, tol if tol is not None else 1e-6, backend=backend,
-                               max_step=h, max_wall=max_wall)
+                res = prob.run(method, tol if tol is not None else 1e-6,
+                               backend="pinocchio" if backend == "pinocchio" else "compiled",
+                               max_step=h, max_wall=max_wall,
+                               jacobian="pinocchio" if backend == "jacobian" else "fd")
             except winder.SimulationError as exc:
                 msg = str(exc)
                 row["status"] = "wall limit" if "wall-clock" in msg else "failed"
@@ -195,22 +204,9 @@ def default_check(rows: list[dict[str, Any]], problem: str) -> str:
 def headline() -> dict[str, Any]:
     """µs per RHS (both backends) and the 700 s paper cycle at rtol 1e-6."""
     scene = winder.load_scene(MODELS / "paper_winding.toml")
-    system = WinderSystem(scene)
-    planar = PlanarSystem(scene, system)
-    y = system.initial_state()
-    y[3] = 50.0
-    out: dict[str, Any] = {}
-    for name, f, n in (("rhs_us_compiled", planar.rhs, 200_000),
-                       ("rhs_us_pinocchio", system.rhs, 20_000)):
-        for _ in range(1000):
-            f(1.0, y)
-        best = math.inf
-        for _ in range(5):
-            t0 = time.perf_counter()
-            for _ in range(n):
-                f(1.0, y)
-            best = min(best, (time.perf_counter() - t0) / n * 1e6)
-        out[name] = best
+    speeds = rhs_speed.main()
+    out: dict[str, Any] = {"rhs_us_compiled": speeds["compiled"],
+                           "rhs_us_pinocchio": speeds["pinocchio"]}
     res = winder.simulate(scene)  # auto, [solver] rtol 1e-6
     out["cycle_wall"] = res.meta["wall_time"]
     out["cycle_nfev"] = res.meta["rhs_evaluations"]

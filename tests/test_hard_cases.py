@@ -110,3 +110,19 @@ def test_divergence_is_reported_with_time_and_state(paper_scene) -> None:
     with pytest.raises(winder.SimulationError, match=r"max_rhs.*at t = .* s \(state: z=") as e:
         winder.simulate(paper_scene, t_end=5.0, max_rhs=500)
     assert e.value.time is not None and "radius" in e.value.state
+
+
+def test_scipy_integrator_failure_is_a_clear_error(paper_scene) -> None:
+    """DOP853 at rtol 1e-12 cannot step over the touch-down jump of the damped nip force
+    in the bouncing phase: a SimulationError naming the method, time and state (this
+    used to crash with an AttributeError when no sample had been written)."""
+    start = winder.simulate(paper_scene, t_end=25.0, method="DOPRI5", rtol=1e-10,
+                            atol=1e-12, output_step=25.0)
+    y25 = [start[k][-1] for k in ("z", "roll_angle", "z_dot", "roll_speed", "radius",
+                                  "friction_force")]
+    with pytest.raises(winder.SimulationError, match="integrator DOP853 failed") as info:
+        winder.simulate(paper_scene, t_start=25.0, initial_state=y25, t_end=25.5,
+                        method="DOP853", rtol=1e-12, atol=1e-14, output_step=0.5)
+    assert 25.0 <= info.value.time < 25.5
+    assert set(info.value.state) == {"z", "roll_angle", "z_dot", "roll_speed", "radius",
+                                     "friction_force"}

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import random_states
 
 import winder
 from winder import _integrators as integ
@@ -30,19 +31,6 @@ def _variant(paper_scene: winder.Scene, name: str | None) -> winder.Scene:
     return paper_scene.replace(effects={name: False})
 
 
-def _random_states(system: WinderSystem, rng: np.random.Generator, n: int):
-    y0 = system.initial_state()
-    for _ in range(n):
-        y = y0.copy()
-        y[0] += rng.uniform(-2e-4, 5e-5)  # in and out of contact
-        y[1] = rng.uniform(-math.pi, math.pi)
-        y[2] = rng.normal(0, 0.05)
-        y[3] = rng.uniform(-10, 300)
-        y[4] = rng.uniform(0.075, 0.85)
-        y[5:] = rng.normal(0, 200, len(y) - 5)
-        yield rng.uniform(0, 60), y
-
-
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_compiled_rhs_equals_pinocchio(paper_scene, variant) -> None:
     scene = _variant(paper_scene, variant)
@@ -51,7 +39,7 @@ def test_compiled_rhs_equals_pinocchio(paper_scene, variant) -> None:
     if variant == "torque":
         system.set_drum_torque(-75.0)
         planar.set_drum_torque(-75.0)
-    for t, y in _random_states(system, np.random.default_rng(11), 30):
+    for t, y in random_states(system, np.random.default_rng(11), 30):
         ref = system.rhs(t, y)
         np.testing.assert_allclose(planar.rhs(t, y), ref, rtol=1e-12,
                                    atol=1e-12 * (1 + np.max(np.abs(ref))))
@@ -63,7 +51,7 @@ def test_compiled_channels_equal_pinocchio(paper_scene, variant) -> None:
     scene = _variant(paper_scene, variant)
     system = WinderSystem(scene)
     planar = PlanarSystem(scene, system)
-    states = list(_random_states(system, np.random.default_rng(12), 25))
+    states = list(random_states(system, np.random.default_rng(12), 25))
     t = np.array([s[0] for s in states])
     Y = np.stack([s[1] for s in states], axis=1)
     ref, got = system.channels(t, Y), planar.channels(t, Y)

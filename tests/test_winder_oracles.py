@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import random_states
 
 import winder
 from winder._system import WinderSystem
@@ -48,18 +49,7 @@ def _planar_accel(scene: winder.Scene, sys_: WinderSystem, t: float, y: np.ndarr
 def test_pinocchio_equals_planar_equations(paper_scene, toggle) -> None:
     scene = paper_scene if toggle is None else paper_scene.replace(effects={toggle: False})
     sys_ = WinderSystem(scene)
-    rng = np.random.default_rng(3)
-    y0 = sys_.initial_state()
-    for _ in range(20):
-        y = y0.copy()
-        y[0] += rng.uniform(-2e-4, 5e-5)         # in and out of contact
-        y[1] = rng.uniform(-math.pi, math.pi)
-        y[2] = rng.normal(0, 0.05)
-        y[3] = rng.uniform(-10, 300)
-        y[4] = rng.uniform(0.075, 0.85)
-        if len(y) > 5:
-            y[5] = rng.normal(0, 200)
-        t = rng.uniform(0, 60)
+    for t, y in random_states(sys_, np.random.default_rng(3), 20):
         dy = sys_.rhs(t, y)
         acc, _ = _planar_accel(scene, sys_, t, y)
         np.testing.assert_allclose(dy[2:4], acc, rtol=1e-11, atol=1e-9)

@@ -4,7 +4,10 @@ Public API (everything else is private and may change):
 """
 
 from ._errors import ModelError, SceneError, SimulationError, WinderError
+from ._fmu import build_fmu
+from ._linearise import jacobian
 from ._mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
+from ._modes import Mode, ModeMap, mode_map, modes_at
 from ._result import Result, load_result
 from ._scene import Scene, load_scene, scene_from_dict
 from ._simulate import DEFAULT_METHOD, simulate
@@ -19,12 +22,18 @@ __all__ = [
     "EFFECTS",
     "EXTRA_CHANNELS",
     "Effect",
+    "Mode",
+    "ModeMap",
     "Result",
     "Scene",
     "Stepper",
     "WinderSystem",
+    "build_fmu",
+    "jacobian",
     "load_result",
     "load_scene",
+    "mode_map",
+    "modes_at",
     "scene_from_dict",
     "simulate",
     "FunctionMassLaw",

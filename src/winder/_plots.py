@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 from ._result import Result, atomic_write  # noqa: E402
 from ._scene import Scene  # noqa: E402
 
-__all__ = ["paper_figures"]
+__all__ = ["paper_figures", "campbell_figure", "normal_force_envelope"]
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
@@ -137,3 +137,56 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
         a.grid(True, alpha=0.3)
     paths.append(_save(fig, out / f"{name}_fig8_normal_force.png"))
     return paths
+
+
+def normal_force_envelope(result: Result, window: float = 0.5
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(radius, min, max, half peak-to-peak)`` of the normal force over windows of
+    ``window`` [s]."""
+    t, fn, r = result.t, result["normal_force"], result["radius"]
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else window
+    w = max(1, int(round(window / dt)))
+    n = len(t) // w
+    fn, r = fn[:n * w].reshape(n, w), r[:n * w].reshape(n, w)
+    lo, hi = fn.min(axis=1), fn.max(axis=1)
+    return r.mean(axis=1), lo, hi, (hi - lo) / 2
+
+
+def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
+                    title: str = "") -> Path:
+    """Resonance map (bounce and slip modes, 1×/2×/3× rotation lines, critical radii)
+    over the radius; with ``result``, the simulated normal-force envelope below on the
+    same radius axis."""
+    mm = mode_map
+    rows = 2 if result is not None else 1
+    fig, axes = plt.subplots(rows, 1, figsize=(8, 4.2 * rows), sharex=True, squeeze=False)
+    ax = axes[0, 0]
+    ax.plot(mm.radius, mm.bounce_frequency, "C0", lw=2, label="bounce mode (damped)")
+    ax.plot(mm.radius, mm.slip_frequency, "C2", lw=1.2,
+            label="slip/torsion mode |λ|/2π (overdamped)")
+    for k, style in ((1, "k-"), (2, "k--"), (3, "k:")):
+        ax.plot(mm.radius, k * mm.rotation_1x, style, lw=1,
+                label=f"{k}× roll rotation at {mm.web_speed:g} m/s")
+        for rc in mm.critical_radii(k):
+            ax.axvline(rc, color="C3", lw=0.8, alpha=0.7)
+            ax.annotate(f"{k}×: r = {rc:.3f} m", (rc, ax.get_ylim()[1] * 0.02 + 1),
+                        rotation=90, fontsize=8, color="C3", va="bottom")
+    top = float(np.nanmax(mm.bounce_frequency)) * 1.1
+    ax.set_ylim(0, top)
+    ax.set_ylabel("frequency [Hz]")
+    ax.legend(fontsize=8, loc="upper right")
+    ax.grid(alpha=0.3)
+    ax.set_title(title or "Resonance map (Campbell chart)")
+    if result is not None:
+        r, lo, hi, _ = normal_force_envelope(result)
+        b = axes[1, 0]
+        b.fill_between(r, lo / 1e3, hi / 1e3, color="C1", alpha=0.5, lw=0)
+        b.plot(r, hi / 1e3, "C1", lw=0.6)
+        for k in (1, 2, 3):
+            for rc in mm.critical_radii(k):
+                b.axvline(rc, color="C3", lw=0.8, alpha=0.7)
+        b.set_ylabel("normal force envelope [kN]")
+        b.grid(alpha=0.3)
+        b.set_title("simulated nip normal force (min-max over 0.5 s)", fontsize=10)
+    axes[-1, 0].set_xlabel("roll radius r [m]")
+    return _save(fig, Path(path))

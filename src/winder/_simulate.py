@@ -150,7 +150,8 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
              output_step: float | None = None, events: bool = True,
              max_step: float | None = None, max_rhs: int | None = None,
              max_wall: float | None = None, backend: str | None = None,
-             t_start: float = 0.0, initial_state: np.ndarray | None = None) -> Result:
+             t_start: float = 0.0, initial_state: np.ndarray | None = None,
+             jacobian: str = "fd") -> Result:
     """Simulate a scene and return its result channels.
 
     Parameters
@@ -171,6 +172,8 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
         with the variable-mass terms); default ``[solver] backend``.
     t_start, initial_state: start the run at ``t_start`` [s] from a full state vector
         (order of ``WinderSystem.state_names``) instead of spec §6's initial state.
+    jacobian: for Radau, BDF and LSODA: ``fd`` (the integrator's finite differences) or
+        ``pinocchio`` (ABA derivatives and the chain rule, :mod:`winder._linearise`).
 
     Raises
     ------
@@ -248,6 +251,13 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
     step_over_until = -math.inf
     events_lost: float | None = None
     options: dict[str, Any] = {"rtol": rtol, "atol": atol}
+    if jacobian not in ("fd", "pinocchio"):
+        raise SimulationError(f"unknown jacobian {jacobian!r}; valid: fd, pinocchio")
+    if jacobian == "pinocchio" and meth in ("Radau", "BDF", "LSODA"):
+        from ._linearise import jacobian as _jac
+
+        jac_system = WinderSystem(scene)
+        options["jac"] = lambda t, y: _jac(jac_system, t, y)
     if max_step is not None:
         options["max_step"] = max_step
     try:
@@ -284,9 +294,10 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
                     use_events, events_lost = False, t0
                     continue
                 if sol.status < 0:
+                    ys = np.asarray(sol.y, dtype=float).reshape(len(y0), -1)
+                    t_bad, y_bad = (float(sol.t[-1]), ys[:, -1]) if ys.shape[1] else (t0, y)
                     raise fail(f"integrator {meth} failed: {sol.message}; try a stiff method "
-                               "(Radau, BDF) or a looser/tighter rtol", sol.t[-1] if len(sol.t)
-                               else t0, sol.y[:, -1] if sol.y.size else y)
+                               "(Radau, BDF) or a looser/tighter rtol", t_bad, y_bad)
                 cols = np.asarray(sol.y, dtype=float).reshape(len(y0), -1)
                 if sol.status == 0 and extra:
                     cols = cols[:, :-1]

@@ -139,6 +139,44 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_modes(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ._modes import mode_map
+    from ._result import atomic_write
+    from ._scene import load_scene
+
+    scene = load_scene(args.scene)
+    mm = mode_map(scene, web_speed=args.web_speed, n=args.points)
+    print(f"{scene.name}: modes at {len(mm.radius)} radii, {mm.radius[0]:.3f}-"
+          f"{mm.radius[-1]:.3f} m, web speed {mm.web_speed:g} m/s")
+    print(f"  bounce mode {mm.bounce_frequency[0]:.1f} -> {mm.bounce_frequency[-1]:.1f} Hz, "
+          f"damping ratio {mm.bounce_damping[0]:.3f} -> {mm.bounce_damping[-1]:.3f}")
+    for k in (1, 2, 3):
+        crit = mm.critical_radii(k)
+        print(f"  {k}x rotation meets the bounce mode at r = "
+              + (", ".join(f"{c:.4f} m" for c in crit) if crit else "(no crossing)"))
+    if args.csv:
+        cols = mm.as_columns()
+        header = ",".join(cols)
+        table = np.column_stack(list(cols.values()))
+        atomic_write(args.csv, lambda p: np.savetxt(p, table, delimiter=",", header=header,
+                                                    comments="", fmt="%.10g"))
+        print(f"  table written to {args.csv}")
+    if args.plot:
+        from ._plots import campbell_figure
+        from ._simulate import simulate
+
+        result = None
+        if args.simulate:
+            print("  simulating the scene for the normal-force envelope ...", file=sys.stderr)
+            result = simulate(scene, progress=sys.stderr.isatty())
+        path = campbell_figure(mm, args.plot, result=result,
+                               title=f"Resonance map of {scene.name}")
+        print(f"  figure written to {path}")
+    return 0
+
+
 def _build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="winder", description="Paper winder simulation.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -170,6 +208,17 @@ def _build_parser() -> argparse.ArgumentParser:
     fmu.add_argument("--check", action=argparse.BooleanOptionalAction, default=True,
                      help="load the built FMU with FMPy and step it (default on)")
     fmu.set_defaults(func=_cmd_fmu)
+    modes = sub.add_parser("modes", help="nip modes against roll radius (resonance map)")
+    modes.add_argument("scene", help="scene file (TOML)")
+    modes.add_argument("--plot", nargs="?", const="campbell.png",
+                       help="write the Campbell chart (PNG; default name campbell.png)")
+    modes.add_argument("--csv", help="write frequencies, damping and critical speeds (CSV)")
+    modes.add_argument("--web-speed", type=_positive,
+                       help="operating web speed [m/s] (default: the scene's)")
+    modes.add_argument("--points", type=int, default=150, help="radii (default 150)")
+    modes.add_argument("--simulate", action=argparse.BooleanOptionalAction, default=True,
+                       help="add the simulated normal-force envelope to the plot")
+    modes.set_defaults(func=_cmd_modes)
     for register in _EXTRA:
         register(sub)
     return parser
