@@ -126,3 +126,24 @@ def test_scipy_integrator_failure_is_a_clear_error(paper_scene) -> None:
     assert 25.0 <= info.value.time < 25.5
     assert set(info.value.state) == {"z", "roll_angle", "z_dot", "roll_speed", "radius",
                                      "friction_force"}
+
+
+def test_initial_radius_equal_to_core(paper_scene) -> None:
+    """r₀ = r_c exactly: static equilibrium F_n = m g at t = 0 and the wound length
+    identity r = r_c + h φ/2π (one caliper per turn) hold from the first layer."""
+    scene = paper_scene.replace(roll={"initial_radius": paper_scene.roll.core_radius})
+    res = winder.simulate(scene, t_end=5.0, output_step=0.01)
+    _finite(res)
+    # to the round-off floor of F_n = k (R + r − z): k·z·ε ≈ 2e7·0.575·2.2e-16 ≈ 3e-9 N
+    assert res["normal_force"][0] == pytest.approx(res["mass"][0] * 9.81, abs=1e-8)
+    r_expected = 0.075 + scene.paper.caliper * res["roll_angle"] / (2 * math.pi)
+    np.testing.assert_allclose(res["radius"], r_expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize("method", ["DOPRI5", "LSODA"])
+def test_evaluation_guard_stops_with_time_and_state(paper_scene, method) -> None:
+    """A run that would need more evaluations than max_rhs stops with a SimulationError
+    naming the guard, time and state instead of running on."""
+    with pytest.raises(winder.SimulationError, match="max_rhs") as info:
+        winder.simulate(paper_scene, t_end=30.0, method=method, max_rhs=5_000)
+    assert 0.0 <= info.value.time < 30.0 and "radius" in info.value.state
