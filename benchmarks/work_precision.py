@@ -15,6 +15,7 @@ Run:  make bench      (or  python benchmarks/work_precision.py [--quick])
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import platform
@@ -196,8 +197,8 @@ def default_check(rows: list[dict[str, Any]], problem: str) -> str:
         return "auto not measured"
     a = auto[0]
     best = min((r for r in ok if r["error"] <= a["error"]), key=lambda r: r["wall"])
-    return (f"auto = {a['method']} at rtol 1e-6: {a['wall']:.3f} s, error {a['error']:.1e}; "
-            f"fastest at that accuracy: {best['method']} {best['wall']:.3f} s "
+    return (f"auto = {a['method']} at rtol 1e-6: {a['wall']:.3g} s, error {a['error']:.1e}; "
+            f"fastest at that accuracy: {best['method']} {best['wall']:.3g} s "
             f"(ratio {a['wall'] / best['wall']:.2f})")
 
 
@@ -207,13 +208,13 @@ def headline() -> dict[str, Any]:
     speeds = rhs_speed.main()
     out: dict[str, Any] = {"rhs_us_compiled": speeds["compiled"],
                            "rhs_us_pinocchio": speeds["pinocchio"]}
+    winder.simulate(scene, t_end=1.0)  # compile and warm up
+    t0 = time.perf_counter()
     res = winder.simulate(scene)  # auto, [solver] rtol 1e-6
+    out["cycle_total"] = time.perf_counter() - t0  # with output channels (70 001 samples)
     out["cycle_wall"] = res.meta["wall_time"]
     out["cycle_nfev"] = res.meta["rhs_evaluations"]
     out["cycle_events"] = res.meta["events"]
-    t0 = time.perf_counter()
-    winder.simulate(scene)
-    out["cycle_total"] = time.perf_counter() - t0  # with output channels (70 001 samples)
     out["rtf"] = 700.0 / out["cycle_total"]
     return out
 
@@ -240,7 +241,7 @@ def write_markdown(rows: list[dict[str, Any]], problems: list[Problem], head: di
         lines += [f"## {prob.name}", "", prob.note + ".", "",
                   "Best method per accuracy level (fastest run with error at most the level):", ""]
         for level, label, wall in best_per_level(rows, prob.name):
-            lines.append(f"- error ≤ {level:.0e}: {label}, {wall:.3f} s")
+            lines.append(f"- error ≤ {level:.0e}: {label}, {wall:.3g} s")
         lines += ["", default_check(rows, prob.name) + ".", "",
                   "| method | rtol / step | status | wall [s] | RHS evals | events | error | "
                   "radius | roll speed | z | normal force |",
@@ -255,7 +256,7 @@ def write_markdown(rows: list[dict[str, Any]], problems: list[Problem], head: di
                 continue
             cells = [f"{r.get('err_' + c, math.nan):.1e}" if 'err_' + c in r else "–"
                      for c in CHANNELS]
-            lines.append(f"| {r['method']} | {setting} | ok | {r['wall']:.3f} | {r['nfev']:,} | "
+            lines.append(f"| {r['method']} | {setting} | ok | {r['wall']:.3g} | {r['nfev']:,} | "
                          f"{r['events']} | {r['error']:.1e} | " + " | ".join(cells) + " |")
         lines.append("")
     text = "\n".join(lines)
@@ -267,11 +268,13 @@ def plot(rows: list[dict[str, Any]], problems: list[Problem], path: Path) -> Non
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(problems), figsize=(5.2 * len(problems), 4.6))
-    axes = np.atleast_1d(axes)
+    cols = 2 if len(problems) > 2 else len(problems)
+    nrows = math.ceil(len(problems) / cols)
+    fig, axes = plt.subplots(nrows, cols, figsize=(6.0 * cols, 4.6 * nrows), squeeze=False)
+    axes = axes.ravel()
     methods = sorted({r["method"] for r in rows})
     colours = dict(zip(methods, plt.cm.tab10(np.linspace(0, 1, 10)), strict=False))
-    for ax, prob in zip(axes, problems, strict=True):
+    for ax, prob in zip(axes, problems, strict=False):
         for m in methods:
             pts = [(r["wall"], max(r["error"], 1e-16)) for r in rows
                    if r["problem"] == prob.name and r["method"] == m and r["status"] == "ok"]
@@ -281,10 +284,15 @@ def plot(rows: list[dict[str, Any]], problems: list[Problem], path: Path) -> Non
         ax.set_title(prob.name, fontsize=10)
         ax.set_xlabel("wall time [s]")
         ax.grid(True, which="both", alpha=0.3)
-    axes[0].set_ylabel("scaled max error [-]")
-    axes[-1].legend(fontsize=8)
+    for ax in axes[::cols]:
+        ax.set_ylabel("scaled max error [-]")
+    handles = {}
+    for ax in axes:
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            handles.setdefault(lab, h)
+    fig.legend(handles.values(), handles.keys(), loc="lower center", ncol=6, fontsize=8)
     fig.suptitle("winder work–precision (error against wall time, one line per method)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
     plt.close(fig)
 
@@ -295,13 +303,26 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--max-wall", type=float, default=30.0,
                     help="give up a method's tighter tolerances after a run this long [s]")
     ap.add_argument("--out", type=Path, default=DOCS, help="output folder (default docs/)")
+    ap.add_argument("--replot", action="store_true",
+                    help="rewrite the table and plot from the saved work_precision.json")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
-    problems = build_problems(args.quick)
-    rows = study(problems, max_wall=args.max_wall, quick=args.quick)
-    head = headline()
-    cpu = platform.processor() or platform.machine()
-    head["machine"] = f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
+    saved = args.out / "work_precision.json"
+    if args.replot:
+        data = json.loads(saved.read_text(encoding="utf-8"))
+        rows, head = data["rows"], data["head"]
+        problems = [Problem(p["name"], None, 0.0, 0.0, note=p["note"])  # type: ignore[arg-type]
+                    for p in data["problems"]]
+    else:
+        problems = build_problems(args.quick)
+        rows = study(problems, max_wall=args.max_wall, quick=args.quick)
+        head = headline()
+        cpu = platform.processor() or platform.machine()
+        head["machine"] = f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
+        text = json.dumps({"rows": rows, "head": head,
+                           "problems": [{"name": p.name, "note": p.note} for p in problems]},
+                          indent=1)
+        atomic_write(saved, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     write_markdown(rows, problems, head, args.out / "work_precision.md")
     plot(rows, problems, args.out / "work_precision.png")
     print(f"wrote {args.out / 'work_precision.md'} and {args.out / 'work_precision.png'}")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -20,7 +21,7 @@ from ._system import WinderSystem
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS"]
 
 #: What ``method="auto"`` picks (chosen from the work–precision study, docs/), per backend.
-DEFAULT_METHOD = {"compiled": "DOPRI5", "pinocchio": "LSODA"}
+DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
 #: Methods that run entirely compiled (planar backend only).
 COMPILED_METHODS = ("DOPRI5",)
 _CHUNK = 200_000  # evaluations per compiled call (progress, guards)
