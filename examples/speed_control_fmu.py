@@ -83,12 +83,14 @@ def main(argv: list[str] | None = None) -> int:
         fmu.doStep(currentCommunicationPoint=t, communicationStepSize=args.step)
         t = (i + 1) * args.step
         if i % 5000 == 0:
-            sys.stderr.write(f"\rt = {t:7.1f} s  radius {vals[3]:.3f} m")
+            end = "\r" if sys.stderr.isatty() else "\n"
+            sys.stderr.write(f"t = {t:7.1f} s  radius {vals[3]:.3f} m{end}")
     wall = time.perf_counter() - wall0
     fmu.terminate()
     fmu.freeInstance()
     shutil.rmtree(unzip, ignore_errors=True)
-    sys.stderr.write("\n")
+    if sys.stderr.isatty():
+        sys.stderr.write("\n")
 
     T, tau = log[:, 0], log[:, 1]
     cols = dict(zip(names, log[:, 2:].T, strict=True))

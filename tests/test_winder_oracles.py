@@ -147,3 +147,14 @@ def test_energy_conserved_without_dissipation(paper_scene) -> None:
          + m * g * (z + e * np.sin(phi)) + 0.5 * k * delta**2)
     assert np.any(res["normal_force"] == 0.0)  # it really lifts off
     assert np.max(np.abs(E - E[0])) / abs(E[0]) < 1e-8
+
+
+def test_progress_in_a_log_is_line_per_report(paper_scene, capsys) -> None:
+    """Oracle: when stderr is not a terminal, progress is whole lines (no carriage
+    returns that would pile up in a CI log) and the last one reports 100 %."""
+    winder.simulate(paper_scene, t_end=2.0, progress=True)
+    err = capsys.readouterr().err
+    assert "\r" not in err
+    lines = [line for line in err.splitlines() if "%" in line]
+    assert lines and "100.0%" in lines[-1]
+    assert "t =     2.00 s" in lines[-1]

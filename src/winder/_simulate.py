@@ -50,27 +50,31 @@ def resolve_backend(backend: str | None, scene: Scene) -> str:
 
 
 class _Progress:
-    """A one-line progress bar on stderr (updated at most every 0.2 s)."""
+    """Progress on stderr: a one-line bar redrawn at most every 0.2 s on a terminal;
+    one line every 5 s when stderr is a log file or pipe (no carriage returns there)."""
 
     def __init__(self, t_end: float, label: str) -> None:
         self.t_end, self.label = t_end, label
         self.start = self.last = time.perf_counter()
+        self.tty = sys.stderr.isatty()
 
     def update(self, t: float) -> None:
         now = time.perf_counter()
-        if now - self.last < 0.2:
+        if now - self.last < (0.2 if self.tty else 5.0):
             return
         self.last = now
         frac = min(max(t / self.t_end, 0.0), 1.0)
         bar = "#" * int(30 * frac)
-        sys.stderr.write(f"\r{self.label} [{bar:<30}] {100 * frac:5.1f}%  t = {t:8.2f} s"
-                         f"  {now - self.start:6.1f} s wall")
+        line = (f"{self.label} [{bar:<30}] {100 * frac:5.1f}%  t = {t:8.2f} s"
+                f"  {now - self.start:6.1f} s wall")
+        sys.stderr.write(f"\r{line}" if self.tty else f"{line}\n")
         sys.stderr.flush()
 
     def close(self) -> None:
-        self.last = 0.0
+        self.last = -1e9
         self.update(self.t_end)
-        sys.stderr.write("\n")
+        if self.tty:
+            sys.stderr.write("\n")
 
 
 def _rk4(fun: Any, t0: float, t1: float, y0: np.ndarray, h: float,
