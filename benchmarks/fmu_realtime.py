@@ -7,7 +7,6 @@
 from __future__ import annotations
 
 import argparse
-import shutil
 import sys
 import tempfile
 import time
@@ -21,28 +20,19 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def fmu_run(fmu_file: Path, t_end: float, step: float) -> float:
-    import fmpy
-    from fmpy.fmi2 import FMU2Slave
+    from winder._fmpy_host import loaded_fmu, start_fmu
 
-    md = fmpy.read_model_description(str(fmu_file))
-    refs = {v.name: v.valueReference for v in md.modelVariables}
-    unzip = fmpy.extract(str(fmu_file))
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip,
-                    modelIdentifier=md.coSimulation.modelIdentifier, instanceName="rt")
-    fmu.instantiate()
-    fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
-    fmu.exitInitializationMode()
-    out = [refs[k] for k in winder.CHANNELS[1:]]
-    n = int(round(t_end / step))
-    t0 = time.perf_counter()
-    for i in range(n):  # a host reads every output each step
-        fmu.doStep(currentCommunicationPoint=i * step, communicationStepSize=step)
-        fmu.getReal(out)
-    wall = time.perf_counter() - t0
-    fmu.terminate()
-    fmu.freeInstance()
-    shutil.rmtree(unzip, ignore_errors=True)
+    with loaded_fmu(fmu_file, instance_name="rt") as (fmu, refs, _):
+        start_fmu(fmu, refs, logging=False)
+        out = [refs[k] for k in winder.CHANNELS[1:]]
+        n = int(round(t_end / step))
+        t0 = time.perf_counter()
+        for i in range(n):  # a host reads every output each step
+            fmu.doStep(currentCommunicationPoint=i * step, communicationStepSize=step)
+            fmu.getReal(out)
+        wall = time.perf_counter() - t0
+        fmu.terminate()
+        fmu.freeInstance()
     return wall
 
 

@@ -9,38 +9,17 @@ from __future__ import annotations
 
 import gc
 import json
-import shutil
 import sys
 from pathlib import Path
 
 import fmpy
 import numpy as np
-from fmpy.fmi2 import FMU2Slave
+
+from winder._fmpy_host import loaded_fmu, start_fmu
 
 
 def rss_mb() -> float:
     return int(Path("/proc/self/statm").read_text().split()[1]) * 4096 / 1e6
-
-
-def _open(path: str):
-    md = fmpy.read_model_description(path)
-    unzip = fmpy.extract(path)
-    refs = {v.name: v.valueReference for v in md.modelVariables}
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip,
-                    modelIdentifier=md.coSimulation.modelIdentifier, instanceName="host")
-    return fmu, refs, unzip
-
-
-def _start(fmu, refs, **params) -> None:
-    fmu.instantiate(loggingOn=True)
-    fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
-    for name, value in params.items():
-        if isinstance(value, bool):
-            fmu.setBoolean([refs[name]], [value])
-        else:
-            fmu.setReal([refs[name]], [value])
-    fmu.exitInitializationMode()
 
 
 def case_compare(path: str) -> dict:
@@ -52,62 +31,59 @@ def case_compare(path: str) -> dict:
 def case_torque(path: str) -> dict:
     import winder
 
-    fmu, refs, unzip = _open(path)
-    _start(fmu, refs, speed_profile=False, com_offset=0.002)
-    scene = winder.load_scene(Path(unzip) / "resources" / "scene.toml")
-    scene = scene.replace(roll={"com_offset": 0.002},
-                          drum={"drive": {"kind": "torque", "web_speed": 0.0}})
-    sim = winder.Stepper(scene)
-    out = ["drum_speed", "roll_speed", "normal_force", "drum_torque"]
-    worst = 0.0
-    for i in range(500):
-        tau = 400.0 * np.sin(0.01 * i) + 100.0
-        fmu.setReal([refs["drum_torque_command"]], [tau])
-        fmu.doStep(currentCommunicationPoint=i * 0.01, communicationStepSize=0.01)
-        sim.set_input("drum_torque", tau)
-        sim.step(0.01)
-        got = np.array(fmu.getReal([refs[k] for k in out]))
-        want = np.array([sim.output(k) for k in out])
-        worst = max(worst, float(np.max(np.abs(got - want) / (1.0 + np.abs(want)))))
-    v_ref = fmu.getReal([refs["web_speed_reference"]])[0]
-    fmu.terminate()
-    fmu.freeInstance()
-    shutil.rmtree(unzip, ignore_errors=True)
+    with loaded_fmu(path, instance_name="host") as (fmu, refs, unzip):
+        start_fmu(fmu, refs, speed_profile=False, com_offset=0.002)
+        scene = winder.load_scene(unzip / "resources" / "scene.toml")
+        scene = scene.replace(roll={"com_offset": 0.002},
+                              drum={"drive": {"kind": "torque", "web_speed": 0.0}})
+        sim = winder.Stepper(scene)
+        out = ["drum_speed", "roll_speed", "normal_force", "drum_torque"]
+        worst = 0.0
+        for i in range(500):
+            tau = 400.0 * np.sin(0.01 * i) + 100.0
+            fmu.setReal([refs["drum_torque_command"]], [tau])
+            fmu.doStep(currentCommunicationPoint=i * 0.01, communicationStepSize=0.01)
+            sim.set_input("drum_torque", tau)
+            sim.step(0.01)
+            got = np.array(fmu.getReal([refs[k] for k in out]))
+            want = np.array([sim.output(k) for k in out])
+            worst = max(worst, float(np.max(np.abs(got - want) / (1.0 + np.abs(want)))))
+        v_ref = fmu.getReal([refs["web_speed_reference"]])[0]
+        fmu.terminate()
+        fmu.freeInstance()
     return {"worst": worst, "drum_speed": sim.output("drum_speed"), "t": sim.t,
             "web_speed_reference": v_ref}
 
 
 def case_bad_input(path: str) -> dict:
-    fmu, refs, unzip = _open(path)
-    _start(fmu, refs, speed_profile=False)
-    fmu.setReal([refs["drum_torque_command"]], [float("inf")])
-    try:
-        fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
-        message = None
-    except Exception as exc:  # FMPy raises on fmi2Error
-        message = str(exc)
-    fmu.freeInstance()
-    shutil.rmtree(unzip, ignore_errors=True)
+    with loaded_fmu(path, instance_name="host") as (fmu, refs, _):
+        start_fmu(fmu, refs, speed_profile=False)
+        fmu.setReal([refs["drum_torque_command"]], [float("inf")])
+        try:
+            fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
+            message = None
+        except Exception as exc:  # FMPy raises on fmi2Error
+            message = str(exc)
+        fmu.freeInstance()
     return {"error": message}
 
 
 def case_cycles_instantiate(path: str, n: int = 220) -> dict:
     from winder._fmu_slave import WinderSlave
 
-    fmu, refs, unzip = _open(path)
     mem, radius = [], []
-    for i in range(n):
-        _start(fmu, refs)
-        for k in range(5):
-            fmu.doStep(currentCommunicationPoint=k * 1e-3, communicationStepSize=1e-3)
-        radius.append(fmu.getReal([refs["radius"]])[0])
-        fmu.terminate()
-        fmu.freeInstance()
-        if i in (19, n - 1):
-            gc.collect()
-            mem.append(rss_mb())
-    alive = sum(isinstance(o, WinderSlave) for o in gc.get_objects())
-    shutil.rmtree(unzip, ignore_errors=True)
+    with loaded_fmu(path, instance_name="host") as (fmu, refs, _):
+        for i in range(n):
+            start_fmu(fmu, refs)
+            for k in range(5):
+                fmu.doStep(currentCommunicationPoint=k * 1e-3, communicationStepSize=1e-3)
+            radius.append(fmu.getReal([refs["radius"]])[0])
+            fmu.terminate()
+            fmu.freeInstance()
+            if i in (19, n - 1):
+                gc.collect()
+                mem.append(rss_mb())
+        alive = sum(isinstance(o, WinderSlave) for o in gc.get_objects())
     return {"cycles": n, "mem": mem, "alive": alive, "radius": radius}
 
 

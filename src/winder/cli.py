@@ -97,33 +97,22 @@ def _check_fmu(path: Path) -> str:
     """Load the FMU in FMPy in this process and run ten 1 ms steps; a one-line report."""
     try:
         import fmpy
-        from fmpy.fmi2 import FMU2Slave
     except ImportError:
         return "not run-checked: FMPy is not installed (pip install 'winder[fmu]')"
-    try:
-        md = fmpy.read_model_description(str(path))
-    except Exception as exc:  # fmpy's ValidationError lists the problems
-        raise WinderError(f"{path}: invalid model description: {exc}") from exc
-    unzip = fmpy.extract(str(path))
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip,
-                    modelIdentifier=md.coSimulation.modelIdentifier, instanceName="check")
-    try:
-        fmu.instantiate(loggingOn=True)
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
-        for i in range(10):
-            fmu.doStep(currentCommunicationPoint=i * 1e-3, communicationStepSize=1e-3)
-        ref = {v.name: v.valueReference for v in md.modelVariables}
-        radius = fmu.getReal([ref["radius"]])[0]
-        fmu.terminate()
-    except Exception as exc:  # FMPy raises plain exceptions with the FMI status
-        raise WinderError(f"{path} was built but does not run in this Python "
-                          f"({sys.executable}): {exc}") from exc
-    finally:
-        fmu.freeInstance()
-        import shutil
-        shutil.rmtree(unzip, ignore_errors=True)
+    from ._fmpy_host import loaded_fmu, start_fmu
+
+    with loaded_fmu(path, instance_name="check") as (fmu, refs, _):
+        try:
+            start_fmu(fmu, refs)
+            for i in range(10):
+                fmu.doStep(currentCommunicationPoint=i * 1e-3, communicationStepSize=1e-3)
+            radius = fmu.getReal([refs["radius"]])[0]
+            fmu.terminate()
+        except Exception as exc:  # FMPy raises plain exceptions with the FMI status
+            raise WinderError(f"{path} was built but does not run in this Python "
+                              f"({sys.executable}): {exc}") from exc
+        finally:
+            fmu.freeInstance()
     return f"run-checked with FMPy {fmpy.__version__}: 10 steps of 1 ms, radius {radius:.6g} m"
 
 

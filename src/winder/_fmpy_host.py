@@ -1,0 +1,51 @@
+"""The host side of a winder FMU in FMPy: loading and starting it, written once for the
+CLI's run-check, the FMU tests and the real-time benchmark (needs ``winder[fmu]``)."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import fmpy
+from fmpy.fmi2 import FMU2Slave
+
+from ._fmu import FmuError
+
+__all__ = ["loaded_fmu", "start_fmu"]
+
+
+@contextmanager
+def loaded_fmu(path: str | Path, *, instance_name: str = "winder"
+               ) -> Iterator[tuple[FMU2Slave, dict[str, int], Path]]:
+    """FMPy's ``FMU2Slave`` of an extracted copy of ``path``, the value references by
+    variable name, and the extraction folder (removed on exit). The caller instantiates
+    (:func:`start_fmu`) and frees the instance (``freeInstance``), as often as it likes."""
+    try:
+        md = fmpy.read_model_description(str(path))
+    except Exception as exc:  # fmpy's ValidationError lists the problems
+        raise FmuError(f"{path}: invalid model description: {exc}") from exc
+    unzip = fmpy.extract(str(path))
+    try:
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip,
+                        modelIdentifier=md.coSimulation.modelIdentifier,
+                        instanceName=instance_name)
+        yield fmu, {v.name: v.valueReference for v in md.modelVariables}, Path(unzip)
+    finally:
+        shutil.rmtree(unzip, ignore_errors=True)
+
+
+def start_fmu(fmu: FMU2Slave, refs: dict[str, int], *, logging: bool = True,
+              **parameters: float | bool) -> None:
+    """Instantiate at ``t = 0`` and set ``parameters`` (by FMU variable name; booleans
+    with ``setBoolean``) during initialisation."""
+    fmu.instantiate(loggingOn=logging)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    for name, value in parameters.items():
+        if isinstance(value, bool):
+            fmu.setBoolean([refs[name]], [value])
+        else:
+            fmu.setReal([refs[name]], [float(value)])
+    fmu.exitInitializationMode()
