@@ -6,6 +6,8 @@ import os
 import shutil
 import subprocess
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import meshcat
@@ -24,43 +26,38 @@ CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu",
                   "--enable-unsafe-swiftshader", "--use-angle=swiftshader")
 
 
-def _visualizer() -> meshcat.Visualizer:
+@contextmanager
+def _built(graph: WinderGraph) -> Iterator[meshcat.Visualizer]:
+    """A meshcat server with ``graph`` built in it; the server subprocess is stopped on
+    exit (0.3.2's ViewerWindow has no close())."""
     try:
-        return meshcat.Visualizer()
+        vis = meshcat.Visualizer()
     except Exception as exc:  # the zmq server subprocess could not start
         raise WinderError(f"could not start the meshcat server: {exc}") from exc
-
-
-def _close(vis: meshcat.Visualizer) -> None:
-    """Stop the meshcat server subprocess (0.3.2's ViewerWindow has no close())."""
-    proc = getattr(vis.window, "server_proc", None)
-    if proc is not None:
-        proc.kill()
-        proc.wait(timeout=10)
+    try:
+        graph.build(vis)
+        yield vis
+    finally:
+        proc = getattr(vis.window, "server_proc", None)
+        if proc is not None:
+            proc.kill()
+            proc.wait(timeout=10)
 
 
 def export_html(graph: WinderGraph, result: Result, path: str | Path, *,
                 playback: float = 30.0, fps: int = 30) -> Path:
     """Write a standalone HTML file (three.js embedded, no network) that plays ``result``."""
-    vis = _visualizer()
-    try:
-        graph.build(vis)
+    with _built(graph) as vis:
         animate(vis, graph, result, plan_animation(result, playback=playback, fps=fps))
         html = vis.static_html()
-    finally:
-        _close(vis)
     return atomic_write(path, lambda tmp: tmp.write_text(html, encoding="utf-8"))
 
 
 def snapshot_html(graph: WinderGraph, state: dict[str, float]) -> str:
     """Static HTML of the winder at one state (keys drum_angle, z, roll_angle, radius)."""
-    vis = _visualizer()
-    try:
-        graph.build(vis)
+    with _built(graph) as vis:
         graph.show(vis, **state)
         return vis.static_html()
-    finally:
-        _close(vis)
 
 
 def find_chromium() -> str | None:
@@ -104,14 +101,14 @@ def snapshots(graph: WinderGraph, result: Result, out_dir: str | Path, *, every:
     t = result.t
     paths = []
     times = np.arange(0.0, t[-1] + 1e-9, every)
-    with tempfile.TemporaryDirectory(prefix="winder-snap-") as tmp:
-        for ti in times:
+    with tempfile.TemporaryDirectory(prefix="winder-snap-") as tmp, _built(graph) as vis:
+        for ti in times:  # one meshcat server, re-posed for each page
             def at(name: str, ti: float = ti) -> float:
                 return float(np.interp(ti, t, result[name]))
-            state = {"drum_angle": at("drum_angle") if "drum_angle" in result else 0.0,
-                     "z": at("z"), "roll_angle": at("roll_angle"), "radius": at("radius")}
+            graph.show(vis, drum_angle=at("drum_angle") if "drum_angle" in result else 0.0,
+                       z=at("z"), roll_angle=at("roll_angle"), radius=at("radius"))
             page = Path(tmp) / f"t{ti:g}.html"
-            page.write_text(snapshot_html(graph, state), encoding="utf-8")
+            page.write_text(vis.static_html(), encoding="utf-8")
             paths.append(screenshot(page, out / f"snapshot_t{int(round(ti)):04d}s.png",
                                     size=size, wait_ms=1500))
     return paths

@@ -14,9 +14,8 @@ import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
 
-from winder._model import DRUM, ROLL
+from winder._model import DRUM, ROLL, WinderModel
 from winder._scene import Scene
-from winder._system import WinderSystem
 
 __all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN"]
 
@@ -40,8 +39,7 @@ class WinderGraph:
     root: str = "winder"
 
     def __post_init__(self) -> None:
-        self.system = WinderSystem(self.scene)
-        self.model = self.system.model
+        self.model = WinderModel(self.scene).model
         self.data = self.model.createData()
 
     # ---- objects --------------------------------------------------------------------
@@ -71,10 +69,9 @@ class WinderGraph:
         floor_z = -R - 0.35
         root["floor"].set_object(g.Box([4.0, 2.0 * L, 0.05]), lam(color=COLOURS["floor"]))
         root["floor"].set_transform(_translation([0.0, 0.0, floor_z]))
-        for side, y in (("far", 0.62 * L),):
-            root["frame"][side].set_object(g.Box([0.25, 0.08, -floor_z]),
-                                           lam(color=COLOURS["frame"]))
-            root["frame"][side].set_transform(_translation([0.0, y, floor_z / 2]))
+        root["frame"]["far"].set_object(g.Box([0.25, 0.08, -floor_z]),
+                                        lam(color=COLOURS["frame"]))
+        root["frame"]["far"].set_transform(_translation([0.0, 0.62 * L, floor_z / 2]))
         vis["/Grid"].set_property("visible", False)
         vis["/Axes"].set_property("visible", False)
         self.set_camera(vis)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 
+import numpy as np
+
 from ._scene import Scene
 
 __all__ = ["Drive", "SpeedProfile", "TorqueDrive", "make_drive"]
@@ -47,9 +49,10 @@ class SpeedProfile(Drive):
         theta0 = 0.5 * self.a * self.t_ramp**2 / self.R
         return theta0 + self.v * (t - self.t_ramp) / self.R, self.v / self.R, 0.0
 
-    def web_speed(self, t: float) -> float:
-        """Web speed ``min(a_w t, v_w)`` [m/s]."""
-        return min(self.a * t, self.v) if self.a > 0 else self.v
+    def web_speed(self, t: np.ndarray | float) -> np.ndarray:
+        """Web speed ``min(a_w t, v_w)`` [m/s] at the time(s) ``t`` [s]."""
+        t = np.asarray(t, dtype=float)
+        return np.minimum(self.a * t, self.v) if self.a > 0 else np.full(t.shape, self.v)
 
     @property
     def breakpoints(self) -> tuple[float, ...]:

@@ -10,6 +10,7 @@ from typing import Any
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
+from ._drive import SpeedProfile
 from ._errors import WinderError
 from ._fmu import FMU_PARAMETERS, scene_with_parameters
 from ._scene import load_scene
@@ -18,6 +19,7 @@ from ._stepper import OUTPUTS, Stepper
 __all__ = ["WinderSlave"]
 
 _PINNED: list[dict[str, Any]] = []
+
 
 class WinderSlave(Fmi2Slave):
     """Co-simulation slave: parameters, input ``drum_torque_command``, all channels as
@@ -68,7 +70,8 @@ class WinderSlave(Fmi2Slave):
         values = {name: getattr(self, name) for name in FMU_PARAMETERS}
         scene = scene_with_parameters(self._scene, values, speed_profile=bool(self.speed_profile))
         self._stepper = Stepper(scene, rtol=float(self.rtol))
-        self._profile = (float(self.web_acceleration), float(self.profile_web_speed))
+        self._profile = SpeedProfile(scene.drum.radius, float(self.web_acceleration),
+                                     float(self.profile_web_speed))
         self._publish()
 
     def _publish(self) -> None:
@@ -76,8 +79,7 @@ class WinderSlave(Fmi2Slave):
         assert st is not None
         for name, value in st.outputs().items():
             setattr(self, name, value)
-        a, v = self._profile
-        self.web_speed_reference = min(a * st.t, v) if a > 0 else v
+        self.web_speed_reference = float(self._profile.web_speed(st.t))
 
     def exit_initialization_mode(self) -> None:
         self._build()  # parameters may have been set during initialisation

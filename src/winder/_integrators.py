@@ -84,7 +84,7 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
             status = PAUSED
             break
         hh = min(h, max_step)
-        if t + hh >= t1 or t + 1.01 * hh >= t1:
+        if t + 1.01 * hh >= t1:
             hh = t1 - t
         if hh < 1e-14 * max(1.0, abs(t)):
             status = STEP_UNDERFLOW

@@ -70,9 +70,9 @@ def jacobian(system: WinderSystem, t: float, y: np.ndarray) -> np.ndarray:
         th = math.tanh(c.slip_velocity / vref)
         g_fss = mu * th * g_fn + mu * c.normal_force * (1.0 - th * th) / vref * g_vs
         if fx_on.slip_relaxation:
-            i_ft = next(eff.index for eff in system.effects if eff.states)
-            g_ft = e[i_ft].copy()
             relax = next(eff for eff in system.effects if eff.states)
+            i_ft = relax.index
+            g_ft = e[i_ft].copy()
             rate = (abs(c.Omega * R) + relax.v_min) / relax.sigma
             ft_row = (i_ft, rate * (g_fss - e[i_ft]))
             if free:

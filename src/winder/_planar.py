@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from ._errors import SimulationError
+from ._drive import SpeedProfile
 from ._scene import Scene
 
 if TYPE_CHECKING:
@@ -213,7 +213,6 @@ class PlanarSystem:
         self.n_states = system.n_states
         self.nfev = 0
         self._aux = np.empty(N_AUX)
-        self._speed_profile = scene.drum.drive.kind == "speed_profile"
 
     def set_drum_torque(self, torque: float) -> None:
         """Input torque of a free drum [N·m] (see :meth:`WinderSystem.set_drum_torque`)."""
@@ -226,9 +225,7 @@ class PlanarSystem:
         dy = np.empty(self.n_states)
         evaluate(t, y, self.params, AUTO, dy, self._aux)
         if not math.isfinite(dy[2] + dy[3]):
-            raise SimulationError(self.system.describe_blowup(t, y, dy), time=t,
-                                  state=dict(zip(self.system.state_names, map(float, y),
-                                                 strict=True)))
+            raise self.system.blowup_error(t, y, dy)
         return dy
 
     def channels(self, t: np.ndarray, Y: np.ndarray) -> dict[str, np.ndarray]:
@@ -237,10 +234,9 @@ class PlanarSystem:
         aux = np.empty((N_AUX, len(t)))
         channels_into(t, np.ascontiguousarray(Y, dtype=float), self.params, aux)
         a = dict(zip(AUX_NAMES, aux, strict=True))
-        d = self.scene.drum.drive
-        if self._speed_profile:
-            web = np.minimum(d.web_acceleration * t, d.web_speed) \
-                if d.web_acceleration > 0 else np.full(len(t), d.web_speed)
+        drive = self.system.drive
+        if isinstance(drive, SpeedProfile):
+            web = drive.web_speed(t)
         else:
             web = a["drum_speed"] * self.scene.drum.radius
         return {"t": t.copy(), "drum_speed": a["drum_speed"], "drum_torque": a["drum_torque"],

@@ -32,7 +32,7 @@ def _fail(source: str, table: str, key: str, message: str) -> SceneError:
 
 
 def _check_number(source: str, table: str, key: str, value: Any, *, lo: float | None = None,
-                  lo_open: bool = False, hi: float | None = None) -> float:
+                  lo_open: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise _fail(source, table, key, f"expected a number, got {value!r} "
                                          f"({type(value).__name__})")
@@ -42,13 +42,10 @@ def _check_number(source: str, table: str, key: str, value: Any, *, lo: float | 
     if lo is not None and (value <= lo if lo_open else value < lo):
         raise _fail(source, table, key, f"must be {'>' if lo_open else '>='} {lo:g}, "
                                          f"got {value!r}")
-    if hi is not None and value > hi:
-        raise _fail(source, table, key, f"must be <= {hi:g}, got {value!r}")
     return value
 
 
-# Declarative table schemas: key -> (kind, required, default, lower bound, open bound).
-# kind: "num", "bool", "str"; choices for "str" in _CHOICES.
+# Lower bounds (value, open) of the table schemas in _SPEC.
 _POS, _NONNEG = (0.0, True), (0.0, False)
 
 
@@ -209,7 +206,8 @@ class Scene:
 # ---- parsing --------------------------------------------------------------------------
 
 _SPEC: dict[str, dict[str, tuple]] = {
-    # key: (kind, required, bound)   bound = (lo, open) or None
+    # key: (kind, required, bound); kind "num", "bool" or "str" (choices in _CHOICES);
+    # bound = (lo, open) or None
     "scene": {"name": ("str", False, None), "duration": ("num", True, _POS),
               "output_step": ("num", False, _POS), "gravity": ("num", False, _NONNEG)},
     "effects": {n: ("bool", False, None) for n in EFFECT_NAMES},

@@ -107,11 +107,47 @@ def _rk4(fun: Any, t0: float, t1: float, y0: np.ndarray, h: float,
     return out, y, nfev
 
 
+class _Guards:
+    """The run's guards, shared by the scipy and the compiled paths: evaluation budget,
+    wall clock and radius floor (one caliper below the core: the roll unwound); they also
+    drive the progress bar. Each failure names the time and the state."""
+
+    def __init__(self, scene: Scene, names: tuple[str, ...], meth: str, *, limit: int,
+                 max_wall: float | None, bar: _Progress | None) -> None:
+        self.names, self.meth = names, meth
+        self.limit, self.max_wall, self.bar = limit, max_wall, bar
+        self.core_radius = scene.roll.core_radius
+        self.r_floor = scene.roll.core_radius - scene.paper.caliper
+        self.wall0 = time.perf_counter()
+
+    def error(self, msg: str, t: float, y: np.ndarray) -> SimulationError:
+        state = dict(zip(self.names, map(float, y), strict=True))
+        where = ", ".join(f"{n}={v:.6g}" for n, v in state.items())
+        return SimulationError(f"{msg} at t = {t:.6g} s (state: {where})", time=t, state=state)
+
+    def over_budget(self, t: float, y: np.ndarray) -> SimulationError:
+        return self.error(f"more than {self.limit} right-hand side evaluations (max_rhs "
+                          f"guard); the problem is stiffer than method {self.meth!r} can "
+                          "handle: try method='Radau' or 'LSODA', a looser rtol or a larger "
+                          "max_rhs", t, y)
+
+    def tick(self, t: float, y: np.ndarray) -> None:
+        """Progress and the wall-clock guard (call now and then, not every evaluation)."""
+        if self.bar is not None:
+            self.bar.update(t)
+        if self.max_wall is not None and time.perf_counter() - self.wall0 > self.max_wall:
+            raise self.error(f"wall-clock guard of {self.max_wall:g} s exceeded", t, y)
+
+    def check_radius(self, t: float, y: np.ndarray) -> None:
+        if y[4] < self.r_floor:
+            raise self.error(f"radius {y[4]:.6g} m fell more than one caliper below the core "
+                             f"radius {self.core_radius:g} m (the roll turned backwards and "
+                             "unwound)", t, y)
+
+
 def _run_compiled(meth: str, p: np.ndarray, y0: np.ndarray, t_out: np.ndarray,
                   Ys: np.ndarray, breaks: list[float], rtol: float, atol: float,
-                  max_step: float | None, limit: int, bar: _Progress | None,
-                  max_wall: float | None, wall0: float, fail: Any,
-                  r_floor: float) -> tuple[int, tuple[int, int]]:
+                  max_step: float | None, guards: _Guards) -> tuple[int, tuple[int, int]]:
     """Integrate with a compiled method in chunks of :data:`_CHUNK` evaluations (progress,
     guards between chunks). Returns samples written and ``(nfev, events)``."""
     stats = np.zeros(4, dtype=np.int64)
@@ -120,10 +156,9 @@ def _run_compiled(meth: str, p: np.ndarray, y0: np.ndarray, t_out: np.ndarray,
     hmax = math.inf if max_step is None else float(max_step)
     for tb in breaks:
         while t < tb:
-            budget = min(_CHUNK, limit - int(stats[0]))
+            budget = min(_CHUNK, guards.limit - int(stats[0]))
             if budget <= 0:
-                raise fail(f"more than {limit} right-hand side evaluations (max_rhs guard); "
-                           "try a looser rtol or a larger max_rhs", t, y)
+                raise guards.over_budget(t, y)
             if meth == "DOPRI5":
                 status, t, h, k = integ.dopri5(t, tb, y, p, rtol, atol, h, hmax, t_out, Ys,
                                                k, budget, stats)
@@ -134,19 +169,15 @@ def _run_compiled(meth: str, p: np.ndarray, y0: np.ndarray, t_out: np.ndarray,
                     t_next = tb
                 status, t, _, k = integ.rk4(t, t_next, y, p, step, t_out, Ys, k, stats)
             if status == integ.NON_FINITE or not np.all(np.isfinite(y)):
-                raise fail(f"the state went non-finite with method {meth!r}; try a stiff "
-                           "method (method='Radau', 'BDF' or 'LSODA') or a tighter rtol", t, y)
+                raise guards.error(f"the state went non-finite with method {meth!r}; try a "
+                                   "stiff method (method='Radau', 'BDF' or 'LSODA') or a "
+                                   "tighter rtol", t, y)
             if status == integ.STEP_UNDERFLOW:
-                raise fail(f"step size underflow with method {meth!r} (the problem is too "
-                           "stiff or discontinuous for it): try method='Radau' or 'LSODA'",
-                           t, y)
-            if y[4] < r_floor:
-                raise fail(f"radius {y[4]:.6g} m fell more than one caliper below the core "
-                           "radius (the roll turned backwards and unwound)", t, y)
-            if bar is not None:
-                bar.update(t)
-            if max_wall is not None and time.perf_counter() - wall0 > max_wall:
-                raise fail(f"wall-clock guard of {max_wall:g} s exceeded", t, y)
+                raise guards.error(f"step size underflow with method {meth!r} (the problem "
+                                   "is too stiff or discontinuous for it): try "
+                                   "method='Radau' or 'LSODA'", t, y)
+            guards.check_radius(t, y)
+            guards.tick(t, y)
     return k, (int(stats[0]), int(stats[3]))
 
 
@@ -210,39 +241,23 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
         if y0.shape != (system.n_states,) or not np.all(np.isfinite(y0)):
             raise SimulationError(f"initial_state must be {system.n_states} finite values "
                                   f"({', '.join(system.state_names)}), got {initial_state!r}")
-    r_floor = scene.roll.core_radius - scene.paper.caliper  # one layer below the core
     bar = _Progress(T, scene.name) if progress else None
-    wall0 = time.perf_counter()
-    names = system.state_names
-
-    def fail(msg: str, t: float, y: np.ndarray) -> SimulationError:
-        state = dict(zip(names, map(float, y), strict=True))
-        where = ", ".join(f"{n}={v:.6g}" for n, v in state.items())
-        return SimulationError(f"{msg} at t = {t:.6g} s (state: {where})", time=t, state=state)
-
+    guards = _Guards(scene, system.state_names, meth, limit=limit, max_wall=max_wall, bar=bar)
     counter = planar if planar is not None else system
     rhs = counter.rhs
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
         if counter.nfev >= limit:
-            raise fail(f"more than {limit} right-hand side evaluations (max_rhs guard); the "
-                       f"problem is stiffer than method {meth!r} can handle: try "
-                       "method='Radau' or 'LSODA', or a looser rtol", t, y)
+            raise guards.over_budget(t, y)
         if counter.nfev % 2000 == 0:
-            if bar is not None:
-                bar.update(t)
-            if max_wall is not None and time.perf_counter() - wall0 > max_wall:
-                raise fail(f"wall-clock guard of {max_wall:g} s exceeded", t, y)
-        if y[4] < r_floor:
-            raise fail(f"radius {y[4]:.6g} m fell more than one caliper below the core "
-                       f"radius {scene.roll.core_radius:g} m (the roll turned backwards and "
-                       "unwound)", t, y)
+            guards.tick(t, y)
+        guards.check_radius(t, y)
         return rhs(t, y)
 
     breaks = sorted({b for b in system.drive.breakpoints if t_s < b < T} | {T})
     use_events = events and system.contact is not None and meth != "RK4"
-
-    p_switch = pack(scene)
+    compiled_run = planar is not None and meth in (*COMPILED_METHODS, "RK4")
+    p_switch = planar.params if planar is not None else pack(scene)
 
     def gap(t: float, y: np.ndarray) -> float:  # min(δ, F_unclamped/k); > 0: F_n > 0
         return switch(t, y, p_switch)
@@ -266,7 +281,7 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
     if max_step is not None:
         options["max_step"] = max_step
     try:
-        for tb in breaks if planar is None or meth not in ("DOPRI5", "RK4") else ():
+        for tb in () if compiled_run else breaks:
             while t0 < tb:
                 t_stop = tb if t0 >= step_over_until else min(tb, step_over_until)
                 mask = (t_out >= t0) & (t_out <= t_stop)
@@ -301,8 +316,9 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
                 if sol.status < 0:
                     ys = np.asarray(sol.y, dtype=float).reshape(len(y0), -1)
                     t_bad, y_bad = (float(sol.t[-1]), ys[:, -1]) if ys.shape[1] else (t0, y)
-                    raise fail(f"integrator {meth} failed: {sol.message}; try a stiff method "
-                               "(Radau, BDF) or a looser/tighter rtol", t_bad, y_bad)
+                    raise guards.error(f"integrator {meth} failed: {sol.message}; try a stiff "
+                                       "method (Radau, BDF) or a looser/tighter rtol", t_bad,
+                                       y_bad)
                 cols = np.asarray(sol.y, dtype=float).reshape(len(y0), -1)
                 if sol.status == 0 and extra:
                     cols = cols[:, :-1]
@@ -320,27 +336,24 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
                     t0, y = t_ev, y_ev
                 else:
                     t0, y = t_stop, sol.y[:, -1]
-        if planar is not None and meth in ("DOPRI5", "RK4"):
-            filled, n_events = _run_compiled(meth, planar.params, y, t_out, Ys, breaks,
-                                             rtol, atol, max_step, limit, bar, max_wall,
-                                             wall0, fail, r_floor)
-            planar.nfev = n_events[0]
-            n_events = n_events[1]
+        if compiled_run:
+            filled, (planar.nfev, n_events) = _run_compiled(meth, planar.params, y, t_out,
+                                                            Ys, breaks, rtol, atol, max_step,
+                                                            guards)
     finally:
         if bar is not None:
             bar.close()
     if filled != len(t_out):
         raise SimulationError(f"internal error: {filled} of {len(t_out)} output samples")
-    wall = time.perf_counter() - wall0
+    wall = time.perf_counter() - guards.wall0
     nfev = counter.nfev
     channels = counter.channels(t_out, Ys)
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
     if bad:
         raise SimulationError(f"non-finite values in result channels {bad}")
     meta = {"scene": scene.name, "source": scene.source, "method": meth, "backend": be,
-            "rtol": rtol,
-            "atol": atol, "rhs_evaluations": nfev, "wall_time": wall, "events": n_events,
-            "event_location_stopped_at": events_lost,
+            "rtol": rtol, "atol": atol, "rhs_evaluations": nfev, "wall_time": wall,
+            "events": n_events, "event_location_stopped_at": events_lost,
             "t_start": t_s, "t_end": T, "effects": list(scene.effects.enabled()),
             "drum_radius": scene.drum.radius, "scene_dict": scene.to_dict()}
     return Result(channels, meta)

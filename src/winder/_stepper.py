@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _integrators as integ
 from ._errors import SimulationError
-from ._planar import P_TAU, PlanarSystem
+from ._planar import PlanarSystem
 from ._scene import Scene
 from ._system import CHANNELS, EXTRA_CHANNELS, WinderSystem
 
@@ -73,10 +73,7 @@ class Stepper:
         v = float(value)
         if not math.isfinite(v):
             raise SimulationError(f"input {name} must be finite, got {value!r}")
-        if not self.free_drum:
-            raise SimulationError("drum_torque is an input only with [drum.drive] kind = "
-                                  "'torque'; this scene prescribes the drum speed")
-        self._planar.params[P_TAU] = v
+        self._planar.set_drum_torque(v)
         self._outputs = None
 
     def step(self, dt: float) -> None:

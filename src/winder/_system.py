@@ -163,19 +163,21 @@ class WinderSystem:
         if self._free_drum:
             dy[5], dy[6] = c.Omega, a[DRUM - 1]
         if not math.isfinite(dy[2] + dy[3]):
-            raise SimulationError(self.describe_blowup(t, y, dy), time=t,
-                                  state=dict(zip(self.state_names, map(float, y),
-                                                 strict=True)))
+            raise self.blowup_error(t, y, dy)
         return dy
 
-    def describe_blowup(self, t: float, y: np.ndarray, dy: np.ndarray) -> str:
+    def blowup_error(self, t: float, y: np.ndarray, dy: np.ndarray) -> SimulationError:
+        """The error for a non-finite derivative: which states, which effects, the state."""
         bad = [n for n, v, d in zip(self.state_names, y, dy, strict=False)
                if not (math.isfinite(v) and math.isfinite(d))]
         effects = ", ".join(e.name for e in self.effects) or "none"
-        return (f"non-finite state or derivative at t = {t:.6g} s in {bad or 'accelerations'} "
-                f"(active effects: {effects}); the state was "
-                + ", ".join(f"{n}={v:.6g}" for n, v in zip(self.state_names, y, strict=True))
-                + ". Try a stiff method (method='Radau' or 'BDF') or a tighter rtol.")
+        state = dict(zip(self.state_names, map(float, y), strict=True))
+        return SimulationError(
+            f"non-finite state or derivative at t = {t:.6g} s in {bad or 'accelerations'} "
+            f"(active effects: {effects}); the state was "
+            + ", ".join(f"{n}={v:.6g}" for n, v in state.items())
+            + ". Try a stiff method (method='Radau' or 'BDF') or a tighter rtol.",
+            time=t, state=state)
 
     # ---- outputs --------------------------------------------------------------------
     def channels(self, t: np.ndarray, Y: np.ndarray) -> dict[str, np.ndarray]:
@@ -195,7 +197,7 @@ class WinderSystem:
             row = (c.Omega, tau[DRUM - 1], c.omega, a[ROLL - 1], c.phi, c.r, c.mass, c.inertia,
                    c.mass_rate, c.inertia_rate, c.z, c.z_dot, c.normal_force,
                    c.friction_force, c.slip_velocity, c.theta,
-                   drive.web_speed(ti) if isinstance(drive, SpeedProfile)
+                   float(drive.web_speed(ti)) if isinstance(drive, SpeedProfile)
                    else c.Omega * self.drum_radius,
                    a[ROLL_Z - 1], c.web_force, c.penetration)
             for name, value in zip(names[1:], row, strict=True):

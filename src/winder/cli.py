@@ -1,4 +1,4 @@
-"""Command-line interface: ``winder run|view|bench|fmu|modes`` (also ``python -m winder``)."""
+"""Command-line interface: ``winder run|view|fmu|modes`` (also ``python -m winder``)."""
 
 from __future__ import annotations
 
@@ -208,13 +208,7 @@ def _build_parser() -> argparse.ArgumentParser:
     modes.add_argument("--simulate", action=argparse.BooleanOptionalAction, default=True,
                        help="add the simulated normal-force envelope to the plot")
     modes.set_defaults(func=_cmd_modes)
-    for register in _EXTRA:
-        register(sub)
     return parser
-
-
-#: Further sub-commands register themselves here: ``f(subparsers)``.
-_EXTRA: list = []
 
 
 def main(argv: Sequence[str] | None = None) -> int:
