@@ -3,7 +3,15 @@
 Public API (everything else is private and may change):
 """
 
-from ._errors import ModelError, SceneError, SimulationError, WinderError
+from ._errors import (
+    ArgumentError,
+    ArgumentTypeError,
+    BudgetExceeded,
+    ModelError,
+    SceneError,
+    SimulationError,
+    WinderError,
+)
 from ._fmu import build_fmu
 from ._linearise import jacobian
 from ._mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
@@ -17,6 +25,9 @@ from ._variable_mass import VariableMassModel
 from .effects import EFFECTS, Effect
 
 __all__ = [
+    "ArgumentError",
+    "ArgumentTypeError",
+    "BudgetExceeded",
     "CHANNELS",
     "DEFAULT_METHOD",
     "EFFECTS",

@@ -15,6 +15,15 @@ class ModelError(WinderError, ValueError):
     """A model, body or force argument is inconsistent with the Pinocchio model."""
 
 
+class ArgumentError(WinderError, ValueError):
+    """A bad argument to a winder function or command: the message names the argument, the
+    value given and what is valid. (A wrong *type* raises :class:`ArgumentTypeError`.)"""
+
+
+class ArgumentTypeError(WinderError, TypeError):
+    """An argument of the wrong type: the message names the argument and the types accepted."""
+
+
 class SimulationError(WinderError, RuntimeError):
     """The integration failed, diverged or exceeded its guards.
 
@@ -31,3 +40,18 @@ class SimulationError(WinderError, RuntimeError):
         super().__init__(message)
         self.time = time
         self.state = dict(state or {})
+
+
+class BudgetExceeded(SimulationError):
+    """A run hit its evaluation or wall-clock budget (``max_rhs``, ``max_wall``).
+
+    The run ended cleanly: the message names the budget, the time reached, the last step
+    size and the state; :attr:`partial` holds the result up to :attr:`time` (or ``None``
+    where no sample was reached), and :attr:`step` the last step size [s]."""
+
+    def __init__(self, message: str, *, time: float | None = None,
+                 state: dict[str, float] | None = None, step: float | None = None,
+                 partial: object | None = None) -> None:
+        super().__init__(message, time=time, state=state)
+        self.step = step
+        self.partial = partial
