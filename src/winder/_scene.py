@@ -7,12 +7,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from ._errors import SceneError
+from ._errors import ArgumentError, ArgumentTypeError, SceneError
 
 __all__ = ["Scene", "SceneInfo", "Effects", "Drum", "Drive", "Roll", "Paper", "Contact",
            "Friction", "Solver", "load_scene", "scene_from_dict", "EFFECT_NAMES",
@@ -27,22 +29,52 @@ METHODS = ("auto", "DOPRI5", "RK4", "RK45", "DOP853", "Radau", "BDF", "LSODA", "
 BACKENDS = ("compiled", "pinocchio")
 
 
+#: Most output samples a scene may ask for (``duration / output_step``); each sample holds
+#: some twenty channels of 8 bytes.
+MAX_SAMPLES = 10_000_000
+#: Longest scene name [characters].
+MAX_NAME = 200
+
+
+def show(value: Any, limit: int = 60) -> str:
+    """``repr(value)`` cut to about ``limit`` characters (messages stay one line)."""
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    size = f"{len(value)} characters" if isinstance(value, str | bytes) else \
+        f"{len(text)} characters as text"
+    return f"{text[:limit - 20]}... ({size})"
+
+
 def _fail(source: str, table: str, key: str, message: str) -> SceneError:
-    return SceneError(f"{source}: [{table}] {key}: {message}")
+    return SceneError(f"{source}: [{table}] {show(key, 40)[1:-1]}: {message}")
 
 
 def _check_number(source: str, table: str, key: str, value: Any, *, lo: float | None = None,
-                  lo_open: bool = False) -> float:
+                  lo_open: bool = False, hi: float | None = None) -> float:
+    """A finite number in ``[lo, hi]`` (``(lo, hi]`` when ``lo_open``); with ``lo`` None
+    the bound ``hi`` applies to ``|value|``."""
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise _fail(source, table, key, f"expected a number, got {value!r} "
+        raise _fail(source, table, key, f"expected a number, got {show(value)} "
                                          f"({type(value).__name__})")
-    value = float(value)
-    if not math.isfinite(value):
-        raise _fail(source, table, key, f"must be finite, got {value!r}")
-    if lo is not None and (value <= lo if lo_open else value < lo):
-        raise _fail(source, table, key, f"must be {'>' if lo_open else '>='} {lo:g}, "
-                                         f"got {value!r}")
-    return value
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond the float range
+        number = math.copysign(math.inf, value)
+    if not math.isfinite(number):
+        raise _fail(source, table, key, f"must be finite, got {show(value)}")
+    if (lo is not None and (number <= lo if lo_open else number < lo)) or \
+            (hi is not None and (number if lo is not None else abs(number)) > hi):
+        raise _fail(source, table, key, f"must be {_range_text(lo, lo_open, hi)}, got "
+                                         f"{show(value)}")
+    return number
+
+
+def _range_text(lo: float | None, lo_open: bool, hi: float | None) -> str:
+    if lo is None:
+        return "any finite number" if hi is None else f"|value| <= {hi:g}"
+    text = f"{'>' if lo_open else '>='} {lo:g}"
+    return text if hi is None else f"{text} and <= {hi:g}"
 
 
 # Lower bounds (value, open) of the table schemas in _SPEC.
@@ -51,7 +83,9 @@ _POS, _NONNEG = (0.0, True), (0.0, False)
 
 @dataclass(frozen=True)
 class SceneInfo:
-    """``[scene]``: name, duration [s], output_step [s], gravity [m/s²]."""
+    """``[scene]``: name (1 to 200 printable characters), duration (0, 1e6] [s],
+    output_step (0, duration] [s] with at most :data:`MAX_SAMPLES` samples, gravity
+    [0, 1000] [m/s²]."""
 
     name: str = "scene"
     duration: float = 10.0
@@ -78,8 +112,9 @@ class Effects:
 @dataclass(frozen=True)
 class Drive:
     """``[drum.drive]``: ``speed_profile`` (web speed ramps at ``web_acceleration``
-    [m/s²] to ``web_speed`` [m/s]) or ``torque`` (drum free, driven by an input torque
-    ``torque`` [N·m]; ``web_speed`` then is the initial web speed)."""
+    [0, 1000] [m/s²] to ``web_speed`` [0, 1000] [m/s]) or ``torque`` (drum free, driven by
+    an input torque ``torque``, ``|torque| <= 1e8`` [N·m]; ``web_speed`` then is the
+    initial web speed)."""
 
     kind: str = "speed_profile"
     web_acceleration: float = 0.0
@@ -89,7 +124,8 @@ class Drive:
 
 @dataclass(frozen=True)
 class Drum:
-    """``[drum]``: radius [m], inertia (polar) [kg·m²], mass [kg]."""
+    """``[drum]``: radius (0, 10] [m], inertia (polar) (0, 1e7] [kg·m²], mass (0, 1e6]
+    [kg]."""
 
     radius: float
     inertia: float
@@ -99,10 +135,14 @@ class Drum:
 
 @dataclass(frozen=True)
 class Roll:
-    """``[roll]``: core_radius [m], core_mass [kg], core_inertia [kg·m²], width [m],
-    initial_radius [m] (default: core_radius), initial_speed [rad/s], com_offset [m];
-    winder's own key initial_height [m]: ``z`` at ``t = 0`` (default: static equilibrium on
-    the contact, spec §6), e.g. to drop the roll onto the drum."""
+    """``[roll]``: core_radius (0, 10] [m], core_mass (0, 1e6] [kg], core_inertia
+    (0, 1e7] [kg·m²], width (0, 100] [m], initial_radius [core_radius, 10] [m] (default:
+    core_radius), initial_speed ``|ω| <= 1e5`` [rad/s], com_offset ``e`` [m] with
+    ``0 <= e <`` :func:`max_com_offset` (inside the core, and the core's inertia about
+    its centre of mass stays positive); winder's own key initial_height
+    (drum radius, 1000] [m]: ``z`` at ``t = 0`` (default: static equilibrium on the
+    contact, spec §6), e.g. to drop the roll onto the drum; the roll axis must lie above
+    the drum's surface."""
 
     core_radius: float
     core_mass: float
@@ -116,7 +156,8 @@ class Roll:
 
 @dataclass(frozen=True)
 class Paper:
-    """``[paper]``: density [kg/m³], caliper [m] (thickness added per revolution)."""
+    """``[paper]``: density [0, 1e5] [kg/m³], caliper (0, 0.1] [m] (thickness added per
+    revolution)."""
 
     density: float
     caliper: float
@@ -124,8 +165,9 @@ class Paper:
 
 @dataclass(frozen=True)
 class Contact:
-    """``[contact]``: law (``linear`` | ``hunt_crossley``), stiffness [N/m or N/m^p],
-    damping [N·s/m] (linear), exponent ``p`` [-] and hc_damping ``α`` [s/m] (Hunt–Crossley)."""
+    """``[contact]``: law (``linear`` | ``hunt_crossley``), stiffness (0, 1e18] [N/m or
+    N/m^p], damping [0, 1e12] [N·s/m] (linear), exponent ``p`` [1, 3] [-] and hc_damping
+    ``α`` [0, 1e4] [s/m] (Hunt–Crossley)."""
 
     law: str = "linear"
     stiffness: float = 1e7
@@ -136,8 +178,8 @@ class Contact:
 
 @dataclass(frozen=True)
 class Friction:
-    """``[friction]``: mu [-], slip_velocity ``v_ref`` [m/s], relaxation_length ``σ`` [m],
-    min_speed ``v_min`` [m/s]."""
+    """``[friction]``: mu [0, 10] [-], slip_velocity ``v_ref`` (0, 1000] [m/s],
+    relaxation_length ``σ`` (0, 1000] [m], min_speed ``v_min`` (0, 1000] [m/s]."""
 
     mu: float = 0.3
     slip_velocity: float = 0.05
@@ -147,14 +189,16 @@ class Friction:
 
 @dataclass(frozen=True)
 class Solver:
-    """``[solver]``: method (one of :data:`METHODS`), rtol, atol, max_rhs (guard),
-    backend (one of :data:`BACKENDS`)."""
+    """``[solver]``: method (one of :data:`METHODS`), rtol (0, 0.1] [-], atol (0, 1]
+    [state units], max_rhs (guard: an integer 1 … 1e12 of right-hand side evaluations),
+    backend (one of :data:`BACKENDS`), max_wall (guard: wall-clock seconds, > 0) [s]."""
 
     method: str = "auto"
     rtol: float = 1e-6
     atol: float = 1e-8
     max_rhs: int = 50_000_000
     backend: str = "compiled"
+    max_wall: float = 600.0
 
 
 @dataclass(frozen=True)
@@ -175,18 +219,37 @@ class Scene:
     def name(self) -> str:
         return self.scene.name
 
-    def replace(self, **changes: dict[str, Any]) -> Scene:
+    def replace(self, **changes: Mapping[str, Any]) -> Scene:
         """A copy with some tables' keys changed: ``scene.replace(roll={"com_offset": 0})``.
 
-        The result is validated like a file."""
+        Each keyword is a table (``drum={"drive": {...}}`` reaches ``[drum.drive]``) and
+        its value a mapping of that table's keys to new values. The result is validated
+        like a file (:class:`SceneError` naming the key).
+
+        Raises
+        ------
+        ArgumentError: a keyword that is not a table of the scene.
+        ArgumentTypeError: a table given as something other than a mapping of keys.
+        """
         data = self.to_dict()
         for table, values in changes.items():
             if table not in data:
-                raise SceneError(f"{self.source}: no table [{table}]; valid: "
-                                 f"{', '.join(sorted(data))}")
+                raise ArgumentError(f"Scene.replace: {table} is not a table of the scene; "
+                                    f"valid tables: {', '.join(data)}")
+            if not isinstance(values, Mapping):
+                raise ArgumentTypeError(
+                    f"Scene.replace: {table} must be a mapping of [{table}] keys to values, "
+                    f"e.g. {table}={{{next(iter(data[table]))!r}: ...}}; got {show(values)} "
+                    f"({type(values).__name__})")
+            values = dict(values)
             if table == "drum" and "drive" in values:
-                data["drum"]["drive"].update(values["drive"])
-                values = {k: v for k, v in values.items() if k != "drive"}
+                drive = values.pop("drive")
+                if not isinstance(drive, Mapping):
+                    raise ArgumentTypeError(
+                        f"Scene.replace: drum['drive'] must be a mapping of [drum.drive] keys "
+                        f"to values, e.g. drum={{'drive': {{'web_speed': 5.0}}}}; got "
+                        f"{show(drive)} ({type(drive).__name__})")
+                data["drum"]["drive"].update(drive)
             data[table].update(values)
         return scene_from_dict(data, source=self.source)
 
@@ -229,53 +292,95 @@ _SPEC: dict[str, dict[str, tuple]] = {
                  "min_speed": ("num", False, _POS)},
     "solver": {"method": ("str", False, None), "rtol": ("num", False, _POS),
                "atol": ("num", False, _POS), "max_rhs": ("num", False, _POS),
-               "backend": ("str", False, None)},
+               "backend": ("str", False, None), "max_wall": ("num", False, _POS)},
+}
+#: Upper bounds of the numeric keys (far beyond any real winder, well inside the float
+#: range so that masses, inertias and forces cannot overflow); units as in the tables'
+#: docstrings. Keys without a lower bound are bounded in magnitude.
+_MAX: dict[tuple[str, str], float] = {
+    ("scene", "duration"): 1e6, ("scene", "gravity"): 1e3,
+    ("drum", "radius"): 10.0, ("drum", "inertia"): 1e7, ("drum", "mass"): 1e6,
+    ("drum.drive", "web_acceleration"): 1e3, ("drum.drive", "web_speed"): 1e3,
+    ("drum.drive", "torque"): 1e8,
+    ("roll", "core_radius"): 10.0, ("roll", "core_mass"): 1e6, ("roll", "core_inertia"): 1e7,
+    ("roll", "width"): 100.0, ("roll", "initial_radius"): 10.0,
+    ("roll", "initial_speed"): 1e5, ("roll", "com_offset"): 10.0,
+    ("roll", "initial_height"): 1e3,
+    ("paper", "density"): 1e5, ("paper", "caliper"): 0.1,
+    ("contact", "stiffness"): 1e18, ("contact", "damping"): 1e12,
+    ("contact", "exponent"): 3.0, ("contact", "hc_damping"): 1e4,
+    ("friction", "mu"): 10.0, ("friction", "slip_velocity"): 1e3,
+    ("friction", "relaxation_length"): 1e3, ("friction", "min_speed"): 1e3,
+    ("solver", "rtol"): 0.1, ("solver", "atol"): 1.0, ("solver", "max_rhs"): 1e12,
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,
             ("solver", "method"): METHODS, ("solver", "backend"): BACKENDS}
 _REQUIRED_TABLES = ("scene", "drum", "roll", "paper")
 
 
+def _check_name(source: str, value: str) -> str:
+    if not value or len(value) > MAX_NAME or not value.isprintable():
+        raise _fail(source, "scene", "name", f"{show(value)} is not a plain name; valid: 1 to "
+                                              f"{MAX_NAME} printable characters")
+    return value
+
+
 def _parse_table(source: str, table: str, raw: Any) -> dict[str, Any]:
     spec = _SPEC[table]
     if not isinstance(raw, dict):
-        raise SceneError(f"{source}: [{table}] must be a table, got {type(raw).__name__}")
+        raise SceneError(f"{source}: [{table}] must be a table of keys, got {show(raw)} "
+                         f"({type(raw).__name__})")
     out: dict[str, Any] = {}
     for key, value in raw.items():
         if table == "drum" and key == "drive":
             continue
         if key not in spec:
-            raise _fail(source, table, key, f"unknown key; valid keys: {', '.join(spec)}")
+            raise _fail(source, table, str(key), f"unknown key; valid keys: {', '.join(spec)}")
         kind, _, bound = spec[key]
         if kind == "bool":
             if not isinstance(value, bool):
-                raise _fail(source, table, key, f"expected true or false, got {value!r}")
+                raise _fail(source, table, key, f"expected true or false, got {show(value)}")
             out[key] = value
         elif kind == "str":
             if not isinstance(value, str):
-                raise _fail(source, table, key, f"expected a string, got {value!r}")
+                raise _fail(source, table, key, f"expected a string, got {show(value)} "
+                                                 f"({type(value).__name__})")
             choices = _CHOICES.get((table, key))
             if choices and value not in choices:
-                raise _fail(source, table, key, f"{value!r} is not one of: "
+                raise _fail(source, table, key, f"{show(value)} is not one of: "
                                                  f"{', '.join(repr(c) for c in choices)}")
-            out[key] = value
+            out[key] = _check_name(source, value) if (table, key) == ("scene", "name") \
+                else value
         else:
             lo, lo_open = bound if bound else (None, False)
-            out[key] = _check_number(source, table, key, value, lo=lo, lo_open=lo_open)
+            out[key] = _check_number(source, table, key, value, lo=lo, lo_open=lo_open,
+                                     hi=_MAX.get((table, key)))
     for key, (_, required, _) in spec.items():
         if required and key not in out:
             raise _fail(source, table, key, "missing required key")
     return out
 
 
+def max_com_offset(core_radius: float, core_mass: float, core_inertia: float) -> float:
+    """Bound ``e_max`` [m] of a roll's centre-of-mass offset, ``0 <= e < e_max``.
+
+    The centre of mass lies inside the core (``e < r_c``) and the core's inertia about it,
+    ``J_core − m_core e²``, is positive (``e < √(J_core/m_core)``). Then the roll's inertia
+    about its centre of mass ``J(r) − m(r) e²`` stays positive at every radius: the paper
+    adds ``b(r)(½(r² + r_c²) − e²) > 0`` with ``b`` its mass."""
+    return min(core_radius, math.sqrt(core_inertia / core_mass))
+
+
 def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
     """Validate nested dictionaries (as read from TOML) and build a :class:`Scene`."""
     if not isinstance(data, dict):
-        raise SceneError(f"{source}: a scene is a set of TOML tables")
+        raise SceneError(f"{source}: a scene is a set of TOML tables, got {show(data)} "
+                         f"({type(data).__name__})")
+    valid = ", ".join(t for t in _SPEC if t != "drum.drive")
     for table in data:
         if table not in _SPEC or table == "drum.drive":
-            valid = ", ".join(t for t in _SPEC if t != "drum.drive")
-            raise SceneError(f"{source}: [{table}]: unknown table; valid tables: {valid}")
+            raise SceneError(f"{source}: [{show(table, 40)[1:-1]}]: unknown table; valid "
+                             f"tables: {valid}")
     for table in _REQUIRED_TABLES:
         if table not in data:
             raise SceneError(f"{source}: [{table}]: missing required table")
@@ -292,17 +397,42 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
     if info.output_step > info.duration:
         raise _fail(source, "scene", "output_step",
                     f"{info.output_step!r} is longer than duration {info.duration!r}")
+    samples = info.duration / info.output_step
+    if samples > MAX_SAMPLES:
+        raise _fail(source, "scene", "output_step",
+                    f"{info.output_step!r} s over duration {info.duration!r} s gives "
+                    f"{samples:.3g} samples; valid: at most {MAX_SAMPLES:.0e} samples "
+                    f"(output_step >= {info.duration / MAX_SAMPLES:.3g} s)")
     roll_kw = dict(t["roll"])
     roll_kw.setdefault("initial_radius", roll_kw["core_radius"])
     roll = Roll(**roll_kw)
     if roll.initial_radius < roll.core_radius:
         raise _fail(source, "roll", "initial_radius",
-                    f"{roll.initial_radius!r} m is below core_radius {roll.core_radius!r} m")
+                    f"{roll.initial_radius!r} m is below core_radius {roll.core_radius!r} m; "
+                    f"valid: >= core_radius")
+    e_max = max_com_offset(roll.core_radius, roll.core_mass, roll.core_inertia)
+    if not roll.com_offset < e_max:
+        raise _fail(source, "roll", "com_offset",
+                    f"{roll.com_offset!r} m puts the centre of mass outside the core or "
+                    f"makes the core's inertia about it, core_inertia − core_mass "
+                    f"com_offset², non-positive (core_radius {roll.core_radius!r} m, "
+                    f"core_inertia {roll.core_inertia!r} kg·m², core_mass "
+                    f"{roll.core_mass!r} kg); valid: com_offset < min(core_radius, "
+                    f"√(core_inertia/core_mass)) = {e_max:.6g} m")
+    radius = t["drum"]["radius"]
+    if roll.initial_height is not None and not roll.initial_height > radius:
+        raise _fail(source, "roll", "initial_height",
+                    f"{roll.initial_height!r} m puts the roll axis inside the drum or below "
+                    f"it; valid: > {radius!r} m (the drum radius, [drum] radius) and <= "
+                    f"{_MAX[('roll', 'initial_height')]:g} m")
     if drive["kind"] == "speed_profile" and "web_speed" not in drive:
         raise _fail(source, "drum.drive", "web_speed", "missing required key "
                     "(kind = 'speed_profile')")
     solver_kw = dict(t["solver"])
     if "max_rhs" in solver_kw:
+        if solver_kw["max_rhs"] != int(solver_kw["max_rhs"]):
+            raise _fail(source, "solver", "max_rhs", f"{solver_kw['max_rhs']!r} is not a whole "
+                        "number of evaluations; valid: an integer 1 … 1e12")
         solver_kw["max_rhs"] = int(solver_kw["max_rhs"])
     if effects.slip_relaxation and not effects.contact:
         raise SceneError(f"{source}: [effects] slip_relaxation: true requires contact = true "
@@ -310,28 +440,106 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
     contact = Contact(**t["contact"])
     if effects.contact and "contact" not in data:
         raise SceneError(f"{source}: [contact]: missing required table (effects.contact is on)")
-    return Scene(scene=info, effects=effects,
-                 drum=Drum(**t["drum"], drive=Drive(**drive)), roll=roll,
-                 paper=Paper(**t["paper"]), contact=contact, friction=Friction(**t["friction"]),
-                 solver=Solver(**solver_kw), source=source)
+    scene = Scene(scene=info, effects=effects,
+                  drum=Drum(**t["drum"], drive=Drive(**drive)), roll=roll,
+                  paper=Paper(**t["paper"]), contact=contact,
+                  friction=Friction(**t["friction"]), solver=Solver(**solver_kw),
+                  source=source)
+    _check_rest_on_nip(scene)
+    return scene
 
 
-def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file (TOML, spec section 7).
+def _check_rest_on_nip(scene: Scene) -> None:
+    """Spec §6 starts the roll at rest on the nip (``F_n = m g``): the nip must carry the
+    roll's weight with a compression below the roll's radius, else the roll axis would
+    start inside the drum."""
+    if not scene.effects.contact or scene.roll.initial_height is not None:
+        return
+    from ._mass_law import PaperRollLaw
+    from .effects.contact import make_contact_law
+
+    roll = scene.roll
+    r = roll.initial_radius
+    weight = PaperRollLaw(roll.core_radius, roll.core_mass, roll.core_inertia, roll.width,
+                          scene.paper.density).mass(r) \
+        * (scene.scene.gravity if scene.effects.gravity else 0.0)
+    r_dot = scene.paper.caliper / (2 * math.pi) * roll.initial_speed
+    try:
+        delta = make_contact_law(scene).static_penetration(weight, r_dot)
+    except ValueError:
+        delta = math.inf
+    if not delta < r:
+        c = scene.contact
+        raise _fail(scene.source, "contact", "stiffness",
+                    f"{c.stiffness!r} ({c.law}) is too soft for the roll's weight "
+                    f"{weight:.4g} N: at rest the nip would be compressed by {delta:.3g} m, "
+                    f"more than the roll's radius {r!r} m, with the roll axis inside the "
+                    "drum (the weight comes from [roll] core_mass, initial_radius, width, "
+                    "[paper] density and [scene] gravity); valid: a stiffer nip or a "
+                    "lighter roll, so that the compression stays below the roll's radius")
+
+
+#: Largest scene file read [bytes] (scenes are a few kB; this stops a device or a huge
+#: file given by mistake from being read into memory).
+MAX_SCENE_BYTES = 1 << 20
+
+
+def _scene_text(p: Path) -> str:
+    """The text of a scene file, or a :class:`SceneError` saying why it is not one."""
+    try:
+        with p.open("rb") as fh:
+            raw = fh.read(MAX_SCENE_BYTES + 1)
+    except IsADirectoryError:
+        raise SceneError(f"{p}: is a directory, not a scene file (give a .toml file)") from None
+    except OSError as exc:
+        raise SceneError(f"{p}: cannot read scene file: {exc.strerror or exc}") from None
+    if len(raw) > MAX_SCENE_BYTES:
+        raise SceneError(f"{p}: larger than {MAX_SCENE_BYTES} bytes: not a scene file "
+                         "(a scene is a small TOML text file)")
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise SceneError(f"{p}: UTF-16 text; a scene file must be UTF-8 (save it as UTF-8)")
+    if raw.startswith(b"PK\x03\x04"):
+        raise SceneError(f"{p}: a zip archive (a .npz result?), not a TOML scene file")
+    if b"\x00" in raw:
+        raise SceneError(f"{p}: a binary file (NUL byte at offset {raw.index(0)}), not a "
+                         "TOML scene file")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise SceneError(f"{p}: not UTF-8 text: byte 0x{raw[exc.start]:02x} at line {line} "
+                         f"(offset {exc.start}); a scene file must be UTF-8 (save it as "
+                         "UTF-8)") from None
+
+
+def load_scene(path: str | os.PathLike[str]) -> Scene:
+    """Read and validate a scene file (TOML, UTF-8, spec section 7).
 
     Raises
     ------
     SceneError
-        If the file is missing, not TOML, or any key is unknown, missing, of the wrong
-        type, non-finite or out of range (the message names the key and the file).
+        If the file is missing, a directory, not UTF-8 text, not TOML, or any key is
+        unknown, missing, of the wrong type, non-finite or out of range (the message names
+        the key and the file).
+    ArgumentTypeError
+        If ``path`` is not a string or path.
     """
+    if not isinstance(path, str | os.PathLike):
+        raise ArgumentTypeError(f"load_scene: path must be a str or os.PathLike naming a "
+                                f"scene file, got {show(path)} ({type(path).__name__})")
+    name = os.fspath(path)
+    if not isinstance(name, str):
+        raise ArgumentTypeError(f"load_scene: path must name the file as text, got "
+                                f"{show(name)} ({type(name).__name__})")
+    if "\x00" in name:
+        raise SceneError(f"{show(name)}: a file name cannot contain a NUL byte")
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SceneError(f"{p}: cannot read scene file: {exc.strerror or exc}") from None
+    text = _scene_text(p)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{p}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise SceneError(f"{p}: not a scene: arrays or tables nested too deeply for TOML "
+                         "parsing (a scene is a few flat tables)") from None
     return scene_from_dict(data, source=str(p))
