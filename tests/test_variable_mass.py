@@ -61,18 +61,94 @@ def test_rnea_inverts_aba_with_rates(model: pin.Model) -> None:
     assert np.linalg.norm(a - plain) > 1e-3
 
 
-def test_fext_length_is_checked() -> None:
+def test_bad_arguments_name_the_argument() -> None:
+    """Wrong values raise ArgumentError, wrong types ArgumentTypeError, each naming the
+    argument and what is valid."""
     model = pin.buildSampleModelManipulator()
     vm = VariableMassModel(model)
-    q, v = pin.neutral(model), np.zeros(model.nv)
-    with pytest.raises(winder.ModelError, match="one pin.Force per joint"):
-        vm.aba(q, v, np.zeros(model.nv), [pin.Force.Zero()] * 2)
-    with pytest.raises(winder.ModelError, match=r"fext\[1\]"):
-        vm.rnea(q, v, np.zeros(model.nv), [pin.Force.Zero(), 3.0] + [pin.Force.Zero()] * 5)
-    with pytest.raises(winder.ModelError, match="valid: 1="):
+    q, v, z = pin.neutral(model), np.zeros(model.nv), np.zeros(model.nv)
+    E, T = winder.ArgumentError, winder.ArgumentTypeError
+    with pytest.raises(T, match="model must be a pinocchio.Model, got None"):
+        VariableMassModel(None)
+    with pytest.raises(E, match="one pin.Force per joint"):
+        vm.aba(q, v, z, [pin.Force.Zero()] * 2)
+    with pytest.raises(T, match=r"fext\[1\] is a float"):
+        vm.rnea(q, v, z, [pin.Force.Zero(), 3.0] + [pin.Force.Zero()] * 5)
+    with pytest.raises(E, match=r"joint_id 7 is not a moving joint.*valid: 1="):
         vm.set_body(model.njoints, rate=np.zeros((6, 6)))
-    with pytest.raises(winder.ModelError, match="symmetric"):
+    with pytest.raises(E, match=r"joint_id -1 is not a moving joint"):
+        vm.rate(-1)
+    for bad in (1.5, "1", True):
+        with pytest.raises(T, match="joint_id must be an integer"):
+            vm.set_body(bad, rate=np.zeros((6, 6)))
+    with pytest.raises(E, match=r"rate must be symmetric.*up to 1"):
         vm.set_body(1, rate=np.triu(np.ones((6, 6))))
+    with pytest.raises(E, match=r"rate has non-finite entries at \[\[0, 0\]\]"):
+        vm.set_body(1, rate=np.diag([np.nan, 1, 1, 1, 1, 1]))
+    with pytest.raises(E, match=r"got shape \(3, 3\)"):
+        vm.set_body(1, rate=np.eye(3))
+    with pytest.raises(T, match="rate must be a pin.Inertia or a symmetric 6x6 array"):
+        vm.set_body(1, rate="fast")
+    with pytest.raises(T, match="inertia must be a pin.Inertia, got 3.0"):
+        vm.set_body(1, inertia=3.0)
+    with pytest.raises(E, match=rf"q must have shape \({model.nq},\)"):
+        vm.aba(q[:-1], v, z)
+    with pytest.raises(E, match="tau has non-finite entries"):
+        vm.aba(q, v, np.full(model.nv, np.inf))
+    with pytest.raises(E, match="a must have shape"):
+        vm.rnea(q, v, np.zeros(2))
+    with pytest.raises(E, match=r"momentum_flux: mass_rate must be finite, got nan"):
+        vm.momentum_flux(q, 1, mass_rate=math.nan, velocity=np.zeros(3), point=np.zeros(3))
+    with pytest.raises(E, match=r"velocity must have shape \(3,\)"):
+        vm.momentum_flux(q, 1, mass_rate=1.0, velocity=np.zeros(2), point=np.zeros(3))
+
+
+@pytest.mark.parametrize("method", ["mass", "polar_inertia", "mass_derivative",
+                                    "polar_inertia_derivative", "properties", "inertia",
+                                    "rate"])
+@pytest.mark.parametrize("r", [-5.0, 0.0, 0.07, math.nan, math.inf, -math.inf])
+def test_paper_roll_law_refuses_radii_off_the_roll(method: str, r: float) -> None:
+    """The laws hold for r >= r_c: any other radius names ``r``, its value and the range."""
+    args = (r, 1.0) if method == "rate" else (r,)
+    with pytest.raises(winder.ArgumentError, match=rf"PaperRollLaw\.\w+: r = {r!r} is out of "
+                                                    r"range; valid: a finite radius r >= "
+                                                    r"core_radius = 0.075 m"):
+        getattr(ROLL, method)(*args)
+    with pytest.raises(winder.ArgumentTypeError, match=r"r expected a number, got '0.3'"):
+        getattr(ROLL, method)(*(("0.3", 1.0) if method == "rate" else ("0.3",)))
+
+
+def test_paper_roll_law_at_the_core_and_overflow() -> None:
+    """At r = r_c the law gives the core exactly; a radius whose inertia overflows and a
+    non-finite rate are refused."""
+    assert ROLL.mass(0.075) == 30.0 and ROLL.polar_inertia(0.075) == 0.12
+    with pytest.raises(winder.ArgumentError, match=r"r = 1e\+100 m: the roll's inertia "
+                                                    "overflows"):
+        ROLL.inertia(1e100)
+    with pytest.raises(winder.ArgumentError, match=r"rate: s_dot must be finite, got inf"):
+        ROLL.rate(0.3, math.inf)
+
+
+@pytest.mark.parametrize("field, value, match", [
+    ("core_radius", 0.0, r"core_radius must be > 0 m, got 0.0"),
+    ("core_mass", -30.0, r"core_mass must be > 0 kg, got -30.0"),
+    ("core_inertia", math.nan, r"core_inertia must be finite, got nan"),
+    ("width", math.inf, r"width must be finite, got inf"),
+    ("density", -1.0, r"density must be >= 0 kg/m³, got -1.0"),
+    ("com_offset", -1e-3, r"com_offset must be >= 0 m, got -0.001"),
+    ("com_offset", 0.07, r"com_offset = 0.07 m is out of range; valid: >= 0 and < "
+                         r"min\(core_radius, √\(core_inertia/core_mass\)\) = 0.0632456 m"),
+    ("com_offset", 1.0, r"com_offset = 1.0 m is out of range"),
+])
+def test_paper_roll_law_arguments(field: str, value: float, match: str) -> None:
+    kw = {"core_radius": 0.075, "core_mass": 30.0, "core_inertia": 0.12, "width": 2.0,
+          "density": 800.0, "com_offset": 0.0, field: value}
+    with pytest.raises(winder.ArgumentError, match=rf"PaperRollLaw: {match}"):
+        PaperRollLaw(**kw)
+    kw[field] = "a"
+    with pytest.raises(winder.ArgumentTypeError, match=rf"PaperRollLaw: {field} expected a "
+                                                        "number, got 'a'"):
+        PaperRollLaw(**kw)
 
 
 def test_set_body_writes_the_users_model() -> None:
@@ -263,7 +339,8 @@ def test_rate_matches_finite_differences(law: winder.MassLaw, s: float) -> None:
 
 
 def test_rate_given_as_inertia_attributes() -> None:
-    """An indefinite Ẏ built from attributes (the pitfall in DEVELOPERS.md) is accepted."""
+    """An indefinite Ẏ built from attributes is accepted: a rate is not an inertia, so
+    its rotational part need not be positive (Pinocchio's Inertia does not check it)."""
     model = _roll_model()
     vm = VariableMassModel(model)
     Yd = pin.Inertia.Zero()

@@ -81,7 +81,7 @@ def jacobian(system: WinderSystem, t: float, y: np.ndarray) -> np.ndarray:
         else:
             g_ft = g_fss
     if fx_on.web_momentum:
-        K = system.law.mass_derivative(1.0) * h2pi  # ṁ = K r ω
+        K = system.law.scalars(1.0)[2] * h2pi  # ṁ = K r ω (dm/dr at r = 1 m)
         g_mr = K * (r * e[3] + w * e[4])
         if fx_on.contact:
             g_web = c.Omega * R * g_mr + (c.mass_rate * R * e[i_om] if free else 0.0)

@@ -17,7 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ._errors import ModelError
+from ._args import number
+from ._errors import ArgumentError, ModelError
+from ._scene import max_com_offset
 
 __all__ = ["MassLaw", "MassProperties", "FunctionMassLaw", "PaperRollLaw", "skew",
            "spatial_inertia_matrix"]
@@ -102,7 +104,8 @@ class MassLaw(ABC):
         return self.properties(s).spatial()
 
     def rate(self, s: float, s_dot: float) -> np.ndarray:
-        """Rate inertia ``Ẏ = dY/ds · ṡ`` as a 6×6 matrix."""
+        """Rate inertia ``Ẏ = dY/ds · ṡ`` as a 6×6 matrix (``ṡ`` finite)."""
+        s_dot = number(f"{type(self).__name__}.rate", "s_dot", s_dot)
         return self.properties(s).spatial_derivative() * s_dot
 
 
@@ -135,8 +138,16 @@ class PaperRollLaw(MassLaw):
 
     Parameters
     ----------
-    core_radius: ``r_c`` [m]; core_mass: [kg]; core_inertia: ``J_core`` [kg·m²];
-    width: ``L`` [m]; density: ``ρ`` [kg/m³]; com_offset: ``e`` [m].
+    core_radius: ``r_c`` > 0 [m]; core_mass: > 0 [kg]; core_inertia: ``J_core`` > 0
+    [kg·m²]; width: ``L`` > 0 [m]; density: ``ρ`` >= 0 [kg/m³]; com_offset: ``e`` [m],
+    ``0 <= e < min(r_c, √(J_core/m_core))`` (:func:`winder._scene.max_com_offset`: the
+    centre of mass inside the core, the inertia about it positive). All finite.
+
+    The laws are defined for ``r >= r_c`` (finite): :meth:`mass`, :meth:`polar_inertia`,
+    their derivatives, :meth:`properties`, :meth:`inertia` and :meth:`rate` raise
+    :class:`~winder.ArgumentError` for any other ``r``. The fast paths :meth:`scalars`,
+    :meth:`write_inertia` and :meth:`rate_into` do not check (an integrator's trial states
+    may probe a little below the core, where the polynomials continue smoothly).
     """
 
     core_radius: float
@@ -147,48 +158,74 @@ class PaperRollLaw(MassLaw):
     com_offset: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("core_radius", "core_mass", "core_inertia", "width"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ModelError(f"PaperRollLaw.{name} must be finite and > 0, got {value!r}")
-        if not (math.isfinite(self.density) and self.density >= 0.0):
-            raise ModelError(f"PaperRollLaw.density must be finite and >= 0, got {self.density!r}")
-        if not math.isfinite(self.com_offset):
-            raise ModelError(f"PaperRollLaw.com_offset must be finite, got {self.com_offset!r}")
+        where = "PaperRollLaw"
+        for name, unit in (("core_radius", "m"), ("core_mass", "kg"),
+                           ("core_inertia", "kg·m²"), ("width", "m")):
+            object.__setattr__(self, name, number(where, name, getattr(self, name), lo=0.0,
+                                                  lo_open=True, unit=unit))
+        object.__setattr__(self, "density", number(where, "density", self.density, lo=0.0,
+                                                   unit="kg/m³"))
+        e_max = max_com_offset(self.core_radius, self.core_mass, self.core_inertia)
+        e = number(where, "com_offset", self.com_offset, lo=0.0, unit="m")
+        if not e < e_max:
+            raise ArgumentError(f"{where}: com_offset = {e!r} m is out of range; valid: >= 0 "
+                                f"and < min(core_radius, √(core_inertia/core_mass)) = "
+                                f"{e_max:.6g} m (the centre of mass inside the core, the "
+                                "inertia about it positive)")
+        object.__setattr__(self, "com_offset", e)
+
+    def _radius(self, where: str, r: float) -> float:
+        """``r`` checked: finite and ``>= r_c``."""
+        return number(f"PaperRollLaw.{where}", "r", r, lo=self.core_radius, unit="m",
+                      valid=f"a finite radius r >= core_radius = {self.core_radius:g} m")
 
     # scalar laws (fast path used by the winder) ---------------------------------------
+    def scalars(self, r: float) -> tuple[float, float, float, float]:
+        """Fast path, unchecked: ``(m, J, dm/dr, dJ/dr)`` at ``r`` [kg, kg·m², kg/m,
+        kg·m]."""
+        k = math.pi * self.density * self.width
+        rc2, r2 = self.core_radius**2, r * r
+        return (self.core_mass + k * (r2 - rc2),
+                self.core_inertia + 0.5 * k * (r2 * r2 - rc2 * rc2),
+                2.0 * k * r, 2.0 * k * r2 * r)
+
     def mass(self, r: float) -> float:
         """``m(r)`` [kg]."""
-        return self.core_mass + self.density * math.pi * self.width * (r * r - self.core_radius**2)
+        return self.scalars(self._radius("mass", r))[0]
 
     def polar_inertia(self, r: float) -> float:
         """``J(r)`` about the roll axis [kg·m²]."""
-        k = 0.5 * self.density * math.pi * self.width
-        return self.core_inertia + k * (r**4 - self.core_radius**4)
+        return self.scalars(self._radius("polar_inertia", r))[1]
 
     def mass_derivative(self, r: float) -> float:
         """``dm/dr`` [kg/m]."""
-        return 2.0 * math.pi * self.density * self.width * r
+        return self.scalars(self._radius("mass_derivative", r))[2]
 
     def polar_inertia_derivative(self, r: float) -> float:
         """``dJ/dr`` [kg·m]."""
-        return 2.0 * math.pi * self.density * self.width * r**3
+        return self.scalars(self._radius("polar_inertia_derivative", r))[3]
 
     def write_inertia(self, r: float, Y: pin.Inertia) -> None:
-        """Fast path: overwrite mass and rotational inertia of ``Y`` (lever ``(e,0,0)``
-        must already be set) with ``Y(r)``."""
-        m, J = self.mass(r), self.polar_inertia(r)
+        """Fast path, unchecked: overwrite mass and rotational inertia of ``Y`` (lever
+        ``(e,0,0)`` must already be set) with ``Y(r)``."""
+        m, J, _, _ = self.scalars(r)
+        Y.mass = m
+        Y.inertia = np.diag(self._about_com(m, J))
+
+    def _about_com(self, m: float, J: float) -> tuple[float, float, float]:
+        """Diagonal of the rotational inertia about the centre of mass [kg·m²] from ``m``
+        and ``J`` (linear in both: the same map takes ``(dm/dr, dJ/dr)`` to its
+        derivative)."""
         It = 0.5 * J + m * self.width**2 / 12.0
         me2 = m * self.com_offset**2
-        Y.mass = m
-        Y.inertia = np.diag((It, J - me2, It - me2))
+        return It, J - me2, It - me2
 
     def rate_into(self, r: float, r_dot: float, out: np.ndarray) -> None:
-        """Fast path: write ``Ẏ = dY/dr · ṙ`` into the 6×6 array ``out`` (only the
-        structurally non-zero entries are written; the others must be zero)."""
-        dm = self.mass_derivative(r) * r_dot
-        dJ = self.polar_inertia_derivative(r) * r_dot
-        dIt = 0.5 * dJ + dm * self.width**2 / 12.0
+        """Fast path, unchecked: write ``Ẏ = dY/dr · ṙ`` into the 6×6 array ``out`` (only
+        the structurally non-zero entries are written; the others must be zero)."""
+        _, _, dm, dJ = self.scalars(r)
+        dm, dJ = dm * r_dot, dJ * r_dot
+        dIt = self._about_com(dm, dJ)[0]  # transverse, about the roll axis
         dme = dm * self.com_offset
         out[0, 0] = out[1, 1] = out[2, 2] = dm
         out[1, 5] = out[5, 1] = dme
@@ -197,15 +234,12 @@ class PaperRollLaw(MassLaw):
         out[4, 4] = dJ
 
     def properties(self, r: float) -> MassProperties:
-        m, dm = self.mass(r), self.mass_derivative(r)
-        J, dJ = self.polar_inertia(r), self.polar_inertia_derivative(r)
-        if not m > 0.0:
-            raise ModelError(f"paper roll mass {m!r} kg is not positive at r = {r!r} m")
-        e = self.com_offset
-        L2 = self.width**2 / 12.0
-        It, dIt = 0.5 * J + m * L2, 0.5 * dJ + dm * L2
-        me2, dme2 = m * e * e, dm * e * e
-        inertia = np.diag([It, J - me2, It - me2])
-        dinertia = np.diag([dIt, dJ - dme2, dIt - dme2])
-        com = np.array([e, 0.0, 0.0])
+        m, J, dm, dJ = self.scalars(self._radius("properties", r))
+        inertia = np.diag(self._about_com(m, J))
+        dinertia = np.diag(self._about_com(dm, dJ))
+        if not (np.all(np.isfinite(inertia)) and np.all(np.isfinite(dinertia))):
+            raise ArgumentError(f"PaperRollLaw.properties: r = {r!r} m: the roll's inertia "
+                                f"overflows (mass {m:.3g} kg); valid: a radius whose mass "
+                                "properties are finite numbers")
+        com = np.array([self.com_offset, 0.0, 0.0])
         return MassProperties(m, com, inertia, dm, np.zeros(3), dinertia)

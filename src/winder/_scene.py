@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from ._args import check_real, show
 from ._errors import ArgumentError, ArgumentTypeError, SceneError
 
 __all__ = ["Scene", "SceneInfo", "Effects", "Drum", "Drive", "Roll", "Paper", "Contact",
@@ -36,16 +37,6 @@ MAX_SAMPLES = 10_000_000
 MAX_NAME = 200
 
 
-def show(value: Any, limit: int = 60) -> str:
-    """``repr(value)`` cut to about ``limit`` characters (messages stay one line)."""
-    text = repr(value)
-    if len(text) <= limit:
-        return text
-    size = f"{len(value)} characters" if isinstance(value, str | bytes) else \
-        f"{len(text)} characters as text"
-    return f"{text[:limit - 20]}... ({size})"
-
-
 def _fail(source: str, table: str, key: str, message: str) -> SceneError:
     return SceneError(f"{source}: [{table}] {show(key, 40)[1:-1]}: {message}")
 
@@ -54,27 +45,10 @@ def _check_number(source: str, table: str, key: str, value: Any, *, lo: float | 
                   lo_open: bool = False, hi: float | None = None) -> float:
     """A finite number in ``[lo, hi]`` (``(lo, hi]`` when ``lo_open``); with ``lo`` None
     the bound ``hi`` applies to ``|value|``."""
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise _fail(source, table, key, f"expected a number, got {show(value)} "
-                                         f"({type(value).__name__})")
-    try:
-        number = float(value)
-    except OverflowError:  # an integer beyond the float range
-        number = math.copysign(math.inf, value)
-    if not math.isfinite(number):
-        raise _fail(source, table, key, f"must be finite, got {show(value)}")
-    if (lo is not None and (number <= lo if lo_open else number < lo)) or \
-            (hi is not None and (number if lo is not None else abs(number)) > hi):
-        raise _fail(source, table, key, f"must be {_range_text(lo, lo_open, hi)}, got "
-                                         f"{show(value)}")
+    number, problem, _ = check_real(value, lo=lo, lo_open=lo_open, hi=hi)
+    if problem is not None:
+        raise _fail(source, table, key, problem)
     return number
-
-
-def _range_text(lo: float | None, lo_open: bool, hi: float | None) -> str:
-    if lo is None:
-        return "any finite number" if hi is None else f"|value| <= {hi:g}"
-    text = f"{'>' if lo_open else '>='} {lo:g}"
-    return text if hi is None else f"{text} and <= {hi:g}"
 
 
 # Lower bounds (value, open) of the table schemas in _SPEC.

@@ -119,9 +119,9 @@ class WinderSystem:
         c.Omega_dot = math.nan if omd is None else omd
         law, r = self.law, c.r
         c.r_dot = rdot = self.h_over_2pi * c.omega
-        c.mass, c.inertia = law.mass(r), law.polar_inertia(r)
-        c.mass_rate = law.mass_derivative(r) * rdot
-        c.inertia_rate = law.polar_inertia_derivative(r) * rdot
+        c.mass, c.inertia, dm_dr, dJ_dr = law.scalars(r)  # unchecked: trial states may dip
+        c.mass_rate = dm_dr * rdot
+        c.inertia_rate = dJ_dr * rdot
         c.drum_radius = self.drum_radius
         c.slip_velocity = c.Omega * self.drum_radius - c.omega * r
         c.reset_forces()

@@ -11,27 +11,40 @@ momentum carried by arriving or leaving mass is added with :meth:`momentum_flux`
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Sequence
 
 import numpy as np
 import pinocchio as pin
 
-from ._errors import ModelError
+from ._args import number, show
+from ._errors import ArgumentError, ArgumentTypeError
 
 __all__ = ["VariableMassModel"]
 
 
 def _as_rate_matrix(rate: pin.Inertia | np.ndarray) -> np.ndarray:
+    where = "VariableMassModel.set_body"
     if isinstance(rate, pin.Inertia):
-        return np.array(rate.matrix(), dtype=float)
-    arr = np.array(rate, dtype=float)
+        arr = np.array(rate.matrix(), dtype=float)
+    else:
+        try:
+            arr = np.array(rate, dtype=float)
+        except (TypeError, ValueError):
+            raise ArgumentTypeError(f"{where}: rate must be a pin.Inertia or a symmetric 6x6 "
+                                    f"array of numbers, got {show(rate)} "
+                                    f"({type(rate).__name__})") from None
     if arr.shape != (6, 6):
-        raise ModelError(f"rate must be a pin.Inertia or a 6x6 array, got shape {arr.shape}")
+        raise ArgumentError(f"{where}: rate must be a pin.Inertia or a symmetric 6x6 array, "
+                            f"got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
-        raise ModelError("rate contains non-finite entries")
-    if not np.allclose(arr, arr.T, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(arr).max())):
-        raise ModelError("rate must be symmetric (it is the time derivative of a spatial "
-                         "inertia matrix)")
+        raise ArgumentError(f"{where}: rate has non-finite entries at "
+                            f"{np.argwhere(~np.isfinite(arr)).tolist()[:4]}; valid: finite "
+                            "numbers")
+    asym = np.abs(arr - arr.T).max()
+    if not asym <= 1e-12 * max(1.0, np.abs(arr).max()):
+        raise ArgumentError(f"{where}: rate must be symmetric (it is the time derivative of a "
+                            f"spatial inertia matrix), got |rate - rate.T| up to {asym:.3g}")
     return arr
 
 
@@ -48,6 +61,9 @@ class VariableMassModel:
     """
 
     def __init__(self, model: pin.Model) -> None:
+        if not isinstance(model, pin.Model):
+            raise ArgumentTypeError(f"VariableMassModel: model must be a pinocchio.Model, got "
+                                    f"{show(model)} ({type(model).__name__})")
         self.model = model
         self.data = model.createData()
         self._rates: dict[int, np.ndarray] = {}
@@ -60,11 +76,15 @@ class VariableMassModel:
 
     # bodies ----------------------------------------------------------------------------
     def _check_joint(self, joint_id: int) -> int:
+        names = ", ".join(f"{i}={self.model.names[i]}" for i in range(1, self.model.njoints))
+        if isinstance(joint_id, bool) or not isinstance(joint_id, numbers.Integral):
+            raise ArgumentTypeError(f"joint_id must be an integer joint index, got "
+                                    f"{show(joint_id)} ({type(joint_id).__name__}); valid: "
+                                    f"{names}")
         j = int(joint_id)
         if not 1 <= j < self.model.njoints:
-            names = ", ".join(f"{i}={self.model.names[i]}" for i in range(1, self.model.njoints))
-            raise ModelError(f"joint_id {joint_id!r} is not a moving joint of the model; "
-                             f"valid: {names}")
+            raise ArgumentError(f"joint_id {joint_id!r} is not a moving joint of the model; "
+                                f"valid: {names or 'none (the model has no moving joint)'}")
         return j
 
     def set_body(self, joint_id: int, *, inertia: pin.Inertia | None = None,
@@ -86,7 +106,9 @@ class VariableMassModel:
         j = self._check_joint(joint_id)
         if inertia is not None:
             if not isinstance(inertia, pin.Inertia):
-                raise ModelError(f"inertia must be a pin.Inertia, got {type(inertia).__name__}")
+                raise ArgumentTypeError(f"VariableMassModel.set_body: inertia must be a "
+                                        f"pin.Inertia, got {show(inertia)} "
+                                        f"({type(inertia).__name__})")
             self.model.inertias[j] = inertia
         if rate is None:
             self._rates.pop(j, None)
@@ -125,19 +147,36 @@ class VariableMassModel:
         try:
             count = len(fext)
         except TypeError:
-            raise ModelError("fext must be a list of pin.Force, one per joint") from None
+            raise ArgumentTypeError(f"fext must be a list of pin.Force, one per joint, got "
+                                    f"{show(fext)} ({type(fext).__name__})") from None
         if count != n:
-            raise ModelError(f"fext has {count} forces but the model has {n} joints "
-                             f"(one pin.Force per joint, the universe included)")
+            raise ArgumentError(f"fext has {count} forces but the model has {n} joints "
+                                f"(one pin.Force per joint, the universe included)")
         for i, f in enumerate(fext):
             if not isinstance(f, pin.Force):
-                raise ModelError(f"fext[{i}] is a {type(f).__name__}, expected pin.Force")
+                raise ArgumentTypeError(f"fext[{i}] is a {type(f).__name__}, expected "
+                                        "pin.Force")
         return fext
 
+    def _check_vector(self, name: str, value: np.ndarray, size: int) -> np.ndarray:
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise ArgumentTypeError(f"{name} must be an array of {size} numbers, got "
+                                    f"{show(value)} ({type(value).__name__})") from None
+        if arr.shape != (size,):
+            raise ArgumentError(f"{name} must have shape ({size},) for this model, got shape "
+                                f"{arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            raise ArgumentError(f"{name} has non-finite entries {show(arr.tolist())}; valid: "
+                                "finite numbers")
+        return arr
     def variable_mass_forces(self, q: np.ndarray, v: np.ndarray,
                              fext: Sequence[pin.Force] | None = None) -> pin.StdVec_Force:
         """``fext`` plus ``−Ẏ v`` on every variable body (joint frames), as a new list."""
         base = self._check_fext(fext)
+        q = self._check_vector("q", q, self.model.nq)
+        v = self._check_vector("v", v, self.model.nv)
         out = pin.StdVec_Force()
         for f in base:
             out.append(pin.Force(f))
@@ -161,21 +200,28 @@ class VariableMassModel:
         of the leaving mass (a rocket: body velocity minus the exhaust speed).
         """
         j = self._check_joint(joint_id)
+        q = self._check_vector("q", q, self.model.nq)
+        mass_rate = number("VariableMassModel.momentum_flux", "mass_rate", mass_rate,
+                           unit="kg/s")
+        velocity = self._check_vector("velocity", velocity, 3)
+        point = self._check_vector("point", point, 3)
         pin.forwardKinematics(self.model, self.data, q)
-        lin = mass_rate * np.asarray(velocity, float)
-        f_world = pin.Force(lin, np.cross(np.asarray(point, float), lin))
+        lin = mass_rate * velocity
+        f_world = pin.Force(lin, np.cross(point, lin))
         return self.data.oMi[j].actInv(f_world)
 
     # dynamics --------------------------------------------------------------------------
     def aba(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray,
             fext: Sequence[pin.Force] | None = None) -> np.ndarray:
         """Forward dynamics ``a`` with the ``−Ẏ v`` terms; ``fext`` in joint frames."""
+        tau = self._check_vector("tau", tau, self.model.nv)
         forces = self.variable_mass_forces(q, v, fext)
         return pin.aba(self.model, self.data, q, v, tau, forces).copy()
 
     def rnea(self, q: np.ndarray, v: np.ndarray, a: np.ndarray,
              fext: Sequence[pin.Force] | None = None) -> np.ndarray:
         """Inverse dynamics ``τ`` consistent with :meth:`aba`; ``fext`` in joint frames."""
+        a = self._check_vector("a", a, self.model.nv)
         forces = self.variable_mass_forces(q, v, fext)
         return pin.rnea(self.model, self.data, q, v, a, forces).copy()
 

@@ -1,0 +1,80 @@
+"""Argument checks of the Python API: a bad argument raises :class:`~winder.ArgumentError`
+(a wrong value) or :class:`~winder.ArgumentTypeError` (a wrong type) naming the function,
+the argument, the value given and what is valid."""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+from ._errors import ArgumentError, ArgumentTypeError
+
+__all__ = ["show", "range_text", "check_real", "number", "integer"]
+
+
+def show(value: Any, limit: int = 60) -> str:
+    """``repr(value)`` cut to about ``limit`` characters (messages stay one line)."""
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    size = f"{len(value)} characters" if isinstance(value, str | bytes) else \
+        f"{len(text)} characters as text"
+    return f"{text[:limit - 20]}... ({size})"
+
+
+def range_text(lo: float | None, lo_open: bool = False, hi: float | None = None,
+               unit: str = "") -> str:
+    """``> 0 and <= 10 m`` and the like; with ``lo`` None, ``hi`` bounds ``|value|``."""
+    u = f" {unit}" if unit else ""
+    if lo is None:
+        return "any finite number" if hi is None else f"|value| <= {hi:g}{u}"
+    text = f"{'>' if lo_open else '>='} {lo:g}{u}"
+    return text if hi is None else f"{text} and <= {hi:g}{u}"
+
+
+def check_real(value: Any, *, lo: float | None = None, lo_open: bool = False,
+               hi: float | None = None, unit: str = "") -> tuple[float, str | None, bool]:
+    """``(x, problem, wrong_type)``: ``value`` as a float and, if it is not a finite real
+    number in ``[lo, hi]`` (``(lo, hi]`` when ``lo_open``; ``|value| <= hi`` when ``lo`` is
+    None), what is wrong with it (``"must be finite, got nan"``) and whether its type is."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return math.nan, f"expected a number, got {show(value)} ({type(value).__name__})", True
+    try:
+        x = float(value)
+    except OverflowError:  # an integer beyond the float range
+        x = math.copysign(math.inf, value)
+    if not math.isfinite(x):
+        return x, f"must be finite, got {show(value)}", False
+    if (lo is not None and (x <= lo if lo_open else x < lo)) or \
+            (hi is not None and (x if lo is not None else abs(x)) > hi):
+        return x, f"must be {range_text(lo, lo_open, hi, unit)}, got {show(value)}", False
+    return x, None, False
+
+
+def number(where: str, name: str, value: Any, *, lo: float | None = None,
+           lo_open: bool = False, hi: float | None = None, unit: str = "",
+           valid: str | None = None) -> float:
+    """``value`` as a finite float in range (:func:`check_real`), else an
+    :class:`ArgumentError` or :class:`ArgumentTypeError` naming ``where`` (the function,
+    ``"PaperRollLaw.mass"``) and ``name`` (the argument); ``valid`` replaces the generated
+    description of the range in the message."""
+    x, problem, wrong_type = check_real(value, lo=lo, lo_open=lo_open, hi=hi, unit=unit)
+    if problem is None:
+        return x
+    if wrong_type:
+        raise ArgumentTypeError(f"{where}: {name} {problem}")
+    if valid is not None:
+        problem = f"= {show(value)} is out of range; valid: {valid}"
+    raise ArgumentError(f"{where}: {name} {problem}")
+
+
+def integer(where: str, name: str, value: Any, *, lo: int, hi: int) -> int:
+    """``value`` as an int in ``[lo, hi]`` (bool and non-integral numbers are refused)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ArgumentTypeError(f"{where}: {name} must be an integer, got {show(value)} "
+                                f"({type(value).__name__})")
+    if not lo <= int(value) <= hi:
+        raise ArgumentError(f"{where}: {name} = {value!r} is out of range; valid: an integer "
+                            f"{lo} … {hi}")
+    return int(value)
