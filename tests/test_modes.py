@@ -4,11 +4,14 @@ resonance map against a simulation through a crossing."""
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 import winder
 from winder._linearise import jacobian
@@ -110,19 +113,126 @@ def test_simulated_vibration_peaks_at_predicted_critical_radius(paper_scene) -> 
     assert np.max(amp) > 3 * np.median(amp)  # a real resonance peak
 
 
-def test_modes_cli_writes_plot_and_csv(models_dir, tmp_path) -> None:
+def _bounce_closed_form(scene: winder.Scene, r: np.ndarray) -> np.ndarray:
+    """Damped bounce frequency [Hz] of the roll's mass on the linear nip, from the scene's
+    numbers alone: √(k/m − (c/2m)²)/2π with m(r) = m_core + ρπL(r² − r_c²) (spec §2, §4)."""
+    ro, k, c = scene.roll, scene.contact.stiffness, scene.contact.damping
+    m = ro.core_mass + scene.paper.density * math.pi * ro.width * (r**2 - ro.core_radius**2)
+    return np.sqrt(k / m - (c / (2 * m)) ** 2) / (2 * math.pi)
+
+
+def test_modes_cli_against_closed_forms(models_dir, tmp_path) -> None:
+    """``winder modes`` on the paper scene: the table's radii span core to the no-slip
+    radius at the end of the run, its bounce frequencies and critical web speeds follow the
+    roll's mass on the nip spring, a critical web speed is the speed at which the 1× line
+    meets the bounce mode there, and the printed crossing radii are the roots of
+    ``k v/(2π r) = f_bounce(r)``."""
+    scene = winder.load_scene(models_dir / "paper_winding.toml")
     png, csv = tmp_path / "campbell.png", tmp_path / "modes.csv"
     proc = subprocess.run([sys.executable, "-m", "winder", "modes",
                            str(models_dir / "paper_winding.toml"), "--plot", str(png),
-                           "--csv", str(csv), "--points", "40"],
+                           "--no-simulate", "--csv", str(csv), "--points", "150"],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
-    assert "3x rotation meets the bounce mode at r = 0.11" in proc.stdout
-    assert png.stat().st_size > 20_000
     table = np.genfromtxt(csv, delimiter=",", names=True)
-    assert len(table) == 40
-    np.testing.assert_allclose(table["critical_web_speed"],
-                               2 * np.pi * table["radius"] * table["bounce_frequency"])
+    r, v = table["radius"], scene.drum.drive.web_speed
+    assert len(r) == 150 and r[0] == scene.roll.core_radius
+    # r² − r_c² = h v T/π: one caliper per revolution at no slip
+    r_end = math.sqrt(r[0] ** 2 + scene.paper.caliper * v * scene.scene.duration / math.pi)
+    assert r[-1] == pytest.approx(r_end, rel=1e-9)
+    # the coupling with slip and web momentum shifts the bounce mode by 5.4e-5 (measured)
+    f = _bounce_closed_form(scene, r)
+    np.testing.assert_allclose(table["bounce_frequency"], f, rtol=5e-4)
+    np.testing.assert_allclose(table["critical_web_speed"], 2 * np.pi * r * f, rtol=5e-4)
+    for i in (20, 60, 149):  # at v_crit the roll turns at the bounce frequency: 2.1e-5
+        v_crit = table["critical_web_speed"][i]
+        bounce = modes_at(scene, float(r[i]), web_speed=float(v_crit))[0].frequency
+        assert v_crit / (2 * np.pi * r[i]) == pytest.approx(bounce, rel=2e-4)
+    for k in (1, 2, 3):
+        line = re.search(rf"{k}x rotation meets the bounce mode at r = (.*)", proc.stdout)
+        assert line, proc.stdout
+        printed = [float(x) for x in re.findall(r"([0-9.]+) m", line.group(1))]
+        g = lambda x, k=k: k * v / (2 * math.pi * x) - _bounce_closed_form(scene, x)  # noqa: E731
+        grid = np.linspace(r[0], r[-1], 4000)
+        s = np.sign(g(grid))
+        roots = [brentq(g, grid[j], grid[j + 1], xtol=1e-14)
+                 for j in np.nonzero(s[:-1] * s[1:] < 0)[0]]
+        assert len(printed) == len(roots), (k, printed, roots)
+        # printed to 0.1 mm; measured 3.3e-5 m from the root (3x: 0.1160 against 0.11597)
+        np.testing.assert_allclose(printed, roots, rtol=0, atol=3e-4)
+    assert [len(re.findall(r"[0-9.]+ m", ln)) for ln in proc.stdout.splitlines()
+            if "rotation meets" in ln] == [0, 0, 1]
+    image = plt.imread(png)
+    assert image.shape[0] > 300 and image.shape[1] > 400 and np.ptp(image[..., :3]) > 0.5
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda s: modes_at(s, -1.0), r"operating_point: radius = -1.0 is out of range; valid: "
+                                  r"a finite radius >= \[roll\] core_radius = 0.075 m"),
+    (lambda s: modes_at(s, math.nan), r"radius = nan is out of range"),
+    (lambda s: modes_at(s, 0.07), r"radius = 0.07 is out of range"),
+    (lambda s: modes_at(s, 0.3, web_speed=-1.0), r"web_speed must be >= 0 m/s and <= 1000 "
+                                                 r"m/s, got -1.0"),
+    (lambda s: modes_at(s, 0.3, web_speed=math.nan), r"web_speed must be finite, got nan"),
+    (lambda s: mode_map(s, n=0), r"mode_map: n = 0 is out of range; valid: an integer 2 … "
+                                 r"10000"),
+    (lambda s: mode_map(s, n=-5), r"n = -5 is out of range"),
+    (lambda s: mode_map(s, web_speed=0.0), r"mode_map: web_speed must be > 0 m/s"),
+    (lambda s: mode_map(s, web_speed=math.inf), r"web_speed must be finite, got inf"),
+    (lambda s: mode_map(s, [0.1, 0.05]), r"radii\[1\] = 0.05 is out of range; valid: finite "
+                                         r"radii >= \[roll\] core_radius = 0.075 m"),
+    (lambda s: mode_map(s, np.zeros((2, 2))), r"radii must be a 1-D array"),
+    (lambda s: mode_map(s, []), r"radii must be a 1-D array of 1 … 10000 radii"),
+    (lambda s: mode_map(s.replace(drum={"drive": {"web_speed": 0.0}})),
+     r"web_speed is not given and the scene's \[drum.drive\] web_speed is 0.0"),
+    (lambda s: modes_at(s.replace(effects={"contact": False, "slip_relaxation": False}),
+                        0.3), r"needs the nip: \[effects\] contact = false"),
+    (lambda s: modes_at(s.replace(effects={"gravity": False}), 0.3),
+     r"needs the roll's weight on the nip, but \[effects\] gravity = false"),
+    (lambda s: modes_at(s.replace(drum={"drive": {"kind": "torque"}}), 0.3),
+     r"needs \[drum.drive\] kind = 'speed_profile'"),
+    (lambda s: modes_at(s, 0.075, web_speed=60.0), r"at radius = 0.075 m and web_speed = 60 "
+                                                   r"m/s the nip cannot carry the roll's "
+                                                   r"torque"),
+])
+def test_bad_mode_arguments_name_the_argument(paper_scene, call, match) -> None:
+    with pytest.raises(winder.ArgumentError, match=match):
+        call(paper_scene)
+
+
+def test_wrong_argument_types(paper_scene) -> None:
+    with pytest.raises(winder.ArgumentTypeError, match="scene must be a winder.Scene"):
+        modes_at("models/paper_winding.toml", 0.3)
+    with pytest.raises(winder.ArgumentTypeError, match="n must be an integer, got 2.5"):
+        mode_map(paper_scene, n=2.5)
+    with pytest.raises(winder.ArgumentTypeError, match="web_speed expected a number"):
+        mode_map(paper_scene, web_speed="fast")
+    system = WinderSystem(paper_scene)
+    with pytest.raises(winder.ArgumentTypeError, match="system must be a winder.WinderSystem"):
+        jacobian(paper_scene, 0.0, np.zeros(6))
+    with pytest.raises(winder.ArgumentError, match=r"y must be 6 finite values \(z, "):
+        jacobian(system, 0.0, np.zeros(5))
+    with pytest.raises(winder.ArgumentError, match="jacobian: t must be finite, got nan"):
+        jacobian(system, math.nan, system.initial_state())
+
+
+def test_frictionless_nip_has_no_mode_map(models_dir, tmp_path) -> None:
+    """μ = 0: the drum cannot drive the roll, so there is no winding operating point (and no
+    slip mode): ``winder modes`` exits 2 naming [friction] mu, and writes nothing."""
+    text = (models_dir / "paper_winding.toml").read_text()
+    scene_file = tmp_path / "frictionless.toml"
+    scene_file.write_text(re.sub(r"(?m)^mu = .*$", "mu = 0.0", text))
+    scene = winder.load_scene(scene_file)
+    assert scene.friction.mu == 0.0
+    with pytest.raises(winder.ArgumentError, match=r"\[friction\] mu = 0: without friction"):
+        modes_at(scene, 0.3)
+    proc = subprocess.run([sys.executable, "-m", "winder", "modes", str(scene_file), "--csv",
+                           str(tmp_path / "m.csv"), "--points", "5"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert str(scene_file) in proc.stderr and "[friction] mu = 0" in proc.stderr
+    assert not (tmp_path / "m.csv").exists()
 
 
 def test_pinocchio_jacobian_in_implicit_methods(models_dir) -> None:
@@ -134,5 +244,5 @@ def test_pinocchio_jacobian_in_implicit_methods(models_dir) -> None:
     b = winder.simulate(scene, jacobian="fd", **kw)
     for k in ("radius", "roll_speed", "z", "normal_force"):
         np.testing.assert_allclose(a[k], b[k], rtol=1e-5, atol=1e-6 * np.max(np.abs(b[k])))
-    with pytest.raises(winder.SimulationError, match="valid: fd, pinocchio"):
+    with pytest.raises(winder.WinderError, match="valid: fd, pinocchio"):
         winder.simulate(scene, t_end=0.1, jacobian="exact")

@@ -15,7 +15,10 @@ __all__ = ["show", "range_text", "check_real", "number", "integer"]
 
 def show(value: Any, limit: int = 60) -> str:
     """``repr(value)`` cut to about ``limit`` characters (messages stay one line)."""
-    text = repr(value)
+    try:
+        text = repr(value)
+    except ValueError:  # an integer of more digits than Python converts to text
+        return f"<an integer of {value.bit_length()} bits>"
     if len(text) <= limit:
         return text
     size = f"{len(value)} characters" if isinstance(value, str | bytes) else \
@@ -43,7 +46,7 @@ def check_real(value: Any, *, lo: float | None = None, lo_open: bool = False,
     try:
         x = float(value)
     except OverflowError:  # an integer beyond the float range
-        x = math.copysign(math.inf, value)
+        x = math.inf if value > 0 else -math.inf
     if not math.isfinite(x):
         return x, f"must be finite, got {show(value)}", False
     if (lo is not None and (x <= lo if lo_open else x < lo)) or \

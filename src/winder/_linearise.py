@@ -17,6 +17,8 @@ import math
 import numpy as np
 import pinocchio as pin
 
+from ._args import number, show
+from ._errors import ArgumentError, ArgumentTypeError
 from ._model import DRUM, ROLL, ROLL_Z
 from ._system import WinderSystem
 
@@ -24,8 +26,20 @@ __all__ = ["jacobian"]
 
 
 def jacobian(system: WinderSystem, t: float, y: np.ndarray) -> np.ndarray:
-    """``∂f/∂y`` [n × n] of ``f = system.rhs`` at ``(t, y)``."""
-    y = np.asarray(y, dtype=float)
+    """``∂f/∂y`` [n × n] of ``f = system.rhs`` at time ``t`` [s] and state ``y`` (finite,
+    ``system.n_states`` values in the order of ``system.state_names``)."""
+    if not isinstance(system, WinderSystem):
+        raise ArgumentTypeError(f"jacobian: system must be a winder.WinderSystem, got "
+                                f"{show(system)} ({type(system).__name__})")
+    t = number("jacobian", "t", t, unit="s")
+    try:
+        y = np.asarray(y, dtype=float)
+    except (TypeError, ValueError):
+        raise ArgumentTypeError(f"jacobian: y must be an array of {system.n_states} numbers, "
+                                f"got {show(y)} ({type(y).__name__})") from None
+    if y.shape != (system.n_states,) or not np.all(np.isfinite(y)):
+        raise ArgumentError(f"jacobian: y must be {system.n_states} finite values "
+                            f"({', '.join(system.state_names)}), got {show(y.tolist())}")
     n = len(y)
     sc = system.scene
     fx_on = sc.effects

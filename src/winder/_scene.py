@@ -511,8 +511,8 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
     text = _scene_text(p)
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{p}: not valid TOML: {exc}") from None
+    except (tomllib.TOMLDecodeError, ValueError) as exc:  # ValueError: 5000-digit integers
+        raise SceneError(f"{p}: not valid TOML: {show(str(exc), 200)[1:-1]}") from None
     except RecursionError:
         raise SceneError(f"{p}: not a scene: arrays or tables nested too deeply for TOML "
                          "parsing (a scene is a few flat tables)") from None
