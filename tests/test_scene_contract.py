@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import winder
-from winder._scene import _SPEC
+from winder._scene import _CHOICES, _MAX, _SPEC
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 SCENES = sorted(MODELS.glob("*.toml"))
@@ -70,15 +70,15 @@ def mutate(path: Path, table: str, key: str, category: str, value: Any = None) -
     return data
 
 
-def outcome(path: Path, data: dict, table: str, key: str) -> str:
-    """How a mutated scene ends: ``scene_error`` (naming file and key), ``runs`` (loads and
-    runs sanely), ``run_error`` (loads; the short run stops with a clean winder error), or
-    ``bad: ...`` (anything else, with the reason)."""
+def outcome(path: Path, data: dict, keys: list[str]) -> str:
+    """How a mutated scene ends: ``scene_error`` (naming the file and one of the changed
+    ``keys``), ``runs`` (loads and runs sanely), ``run_error`` (loads; the short run stops
+    with a clean winder error), or ``bad: ...`` (anything else, with the reason)."""
     try:
         scene = winder.scene_from_dict(data, source=str(path))
     except winder.SceneError as exc:
         msg = str(exc)
-        if key not in msg or str(path) not in msg:
+        if not any(k in msg for k in keys) or str(path) not in msg:
             return f"bad: SceneError not naming file and key: {msg[:200]}"
         if len(msg) > 2000:
             return f"bad: SceneError of {len(msg)} characters"
@@ -122,7 +122,7 @@ def run_corpus(scenes=SCENES, categories=CATEGORIES) -> dict[str, Counter]:
             original = _table(base, table).get(key)
             for cat in categories:
                 data = mutate(path, table, key, cat, corpus_value(cat, kind, original))
-                res = outcome(path, data, table, key)
+                res = outcome(path, data, [key])
                 counts[cat][res.split(":")[0]] += 1
                 if res.startswith("bad"):
                     print(f"{path.name} [{table}] {key} {cat}: {res}", file=sys.stderr)
@@ -170,8 +170,46 @@ def _cases(draw) -> tuple[Path, str, str, str, Any]:
 def test_bad_scene_key_gives_clean_error_or_sane_run(case) -> None:
     path, table, key, category, value = case
     data = mutate(path, table, key, category, value)
-    res = outcome(path, data, table, key)
+    res = outcome(path, data, [key])
     assert not res.startswith("bad"), f"{path.name} [{table}] {key} = {category}: {res}"
+
+
+def _in_range(table: str, key: str) -> st.SearchStrategy:
+    """Any value a scene accepts for ``[table] key`` on its own (log-uniform in its range)."""
+    kind, _, bound = _SPEC[table][key]
+    if kind == "bool":
+        return st.booleans()
+    if kind == "str":
+        return st.sampled_from(_CHOICES.get((table, key), ("a scene",)))
+    hi = _MAX.get((table, key), 1e3)
+    lo = bound[0] if bound else None
+    exp = st.floats(min_value=math.log10(max(lo or 0.0, 1e-9 * hi)), max_value=math.log10(hi))
+    if lo is None:
+        values = st.tuples(exp, st.sampled_from((-1.0, 1.0))).map(lambda p: p[1] * 10 ** p[0])
+    else:
+        values = exp.map(lambda x: min(hi, 10**x))
+    return values.map(round) if key == "max_rhs" else values
+
+
+@st.composite
+def _combinations(draw) -> tuple[Path, dict, list[str]]:
+    path = draw(st.sampled_from(SCENES))
+    data = _load(path)
+    keys = draw(st.lists(st.sampled_from(KEYS), min_size=2, max_size=4, unique=True))
+    for table, key, _ in keys:
+        _table(data, table)[key] = draw(_in_range(table, key))
+    return path, data, [key for _, key, _ in keys]
+
+
+@settings(max_examples=150, deadline=None, database=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(case=_combinations())
+def test_combinations_of_valid_values_give_clean_error_or_sane_run(case) -> None:
+    """Several keys at once, each within its own range: a combination that makes no
+    physical sense is refused naming one of the keys; the others run sanely."""
+    path, data, keys = case
+    res = outcome(path, data, keys)
+    assert not res.startswith("bad"), (keys, res)
 
 
 @pytest.mark.parametrize("category", CATEGORIES)

@@ -448,9 +448,11 @@ def _check_rest_on_nip(scene: Scene) -> None:
                     f"{c.stiffness!r} ({c.law}) is too soft for the roll's weight "
                     f"{weight:.4g} N: at rest the nip would be compressed by {delta:.3g} m, "
                     f"more than the roll's radius {r!r} m, with the roll axis inside the "
-                    "drum (the weight comes from [roll] core_mass, initial_radius, width, "
-                    "[paper] density and [scene] gravity); valid: a stiffer nip or a "
-                    "lighter roll, so that the compression stays below the roll's radius")
+                    "drum (weight from [roll] core_mass, initial_radius, width, [paper] "
+                    "density, [scene] gravity; compression from [contact] stiffness, "
+                    "damping, exponent, hc_damping and [roll] initial_speed); valid: a "
+                    "stiffer nip or a lighter roll, so that the compression stays below the "
+                    "roll's radius")
 
 
 #: Largest scene file read [bytes] (scenes are a few kB; this stops a device or a huge
