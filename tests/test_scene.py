@@ -212,3 +212,17 @@ def test_max_wall_key(tmp_path, models_dir, paper_scene) -> None:
     path = _write(tmp_path, models_dir, lambda d: d["solver"].update(max_wall=0.0))
     with pytest.raises(winder.SceneError, match=r"\[solver\] max_wall: must be > 0"):
         winder.load_scene(path)
+
+
+@pytest.mark.parametrize("edit, pattern", [
+    (lambda d: d["roll"].update({"k" * 100_000: 1}),
+     r"\[roll\] 'kkk.*\(100000 characters\): unknown key; valid keys: core_radius"),
+    (lambda d: d.update({"t\nx": {}}), r"\['t\\nx'\]: unknown table; valid tables: scene"),
+    (lambda d: d.update(roll=[1] * 100_000), r"\[roll\] must be a table of keys, got \[1, 1"),
+])
+def test_junk_names_stay_on_one_short_line(paper_scene, edit, pattern) -> None:
+    data = paper_scene.to_dict()
+    edit(data)
+    with pytest.raises(winder.SceneError, match=pattern) as info:
+        winder.scene_from_dict(data, source="junk.toml")
+    assert "\n" not in str(info.value) and len(str(info.value)) < 300

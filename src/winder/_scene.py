@@ -37,8 +37,14 @@ MAX_SAMPLES = 10_000_000
 MAX_NAME = 200
 
 
+def _name(key: Any) -> str:
+    """A table or key name for a message: as is if short and printable, else its repr."""
+    plain = isinstance(key, str) and 0 < len(key) <= 40 and key.isprintable()
+    return key if plain else show(key, 40)
+
+
 def _fail(source: str, table: str, key: str, message: str) -> SceneError:
-    return SceneError(f"{source}: [{table}] {show(key, 40)[1:-1]}: {message}")
+    return SceneError(f"{source}: [{table}] {_name(key)}: {message}")
 
 
 def _check_number(source: str, table: str, key: str, value: Any, *, lo: float | None = None,
@@ -309,7 +315,7 @@ def _parse_table(source: str, table: str, raw: Any) -> dict[str, Any]:
         if table == "drum" and key == "drive":
             continue
         if key not in spec:
-            raise _fail(source, table, str(key), f"unknown key; valid keys: {', '.join(spec)}")
+            raise _fail(source, table, key, f"unknown key; valid keys: {', '.join(spec)}")
         kind, _, bound = spec[key]
         if kind == "bool":
             if not isinstance(value, bool):
@@ -353,7 +359,7 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
     valid = ", ".join(t for t in _SPEC if t != "drum.drive")
     for table in data:
         if table not in _SPEC or table == "drum.drive":
-            raise SceneError(f"{source}: [{show(table, 40)[1:-1]}]: unknown table; valid "
+            raise SceneError(f"{source}: [{_name(table)}]: unknown table; valid "
                              f"tables: {valid}")
     for table in _REQUIRED_TABLES:
         if table not in data:
