@@ -21,8 +21,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from ._jit import njit
 from ._planar import AUTO, FREE, IN_CONTACT, N_AUX, P_CONTACT, evaluate, mode_of, switch
 
 __all__ = ["dopri5", "rk4", "DONE", "PAUSED", "STEP_UNDERFLOW", "NON_FINITE"]
@@ -43,7 +43,7 @@ D1, D3, D4 = -12715105075 / 11282082432, 87487479700 / 32700410799, -10690763975
 D5, D6, D7 = 701980252875 / 199316789632, -1453857185 / 822651844, 69997945 / 29380423
 
 
-@njit(cache=True)
+@njit
 def _dense(rc: np.ndarray, theta: float, out: np.ndarray) -> None:
     th1 = 1.0 - theta
     for i in range(out.shape[0]):
@@ -51,7 +51,7 @@ def _dense(rc: np.ndarray, theta: float, out: np.ndarray) -> None:
                                                        * (rc[3, i] + th1 * rc[4, i])))
 
 
-@njit(cache=True)
+@njit
 def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol: float,
            h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
            budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
@@ -212,7 +212,7 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
     return status, t, h, k
 
 
-@njit(cache=True)
+@njit
 def rk4(t0: float, t1: float, y: np.ndarray, p: np.ndarray, h: float, t_out: np.ndarray,
         Y_out: np.ndarray, k: int, stats: np.ndarray) -> tuple[int, float, float, int]:
     """Classical RK4 with steps of at most ``h`` evenly dividing ``[t0, t1]`` (the clamped

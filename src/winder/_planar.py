@@ -19,9 +19,9 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 
 from ._drive import SpeedProfile
+from ._jit import njit
 from ._scene import Scene
 
 if TYPE_CHECKING:
@@ -74,7 +74,7 @@ def pack(scene: Scene, *, drum_torque: float = 0.0) -> np.ndarray:
     return p
 
 
-@njit(cache=True)
+@njit
 def _force_unclamped(p: np.ndarray, delta: float, ddot: float) -> float:
     """Contact law without the ``max(0, ·)`` clamp, smoothly extended to ``δ < 0``."""
     if p[P_LAW] == 0.0:
@@ -84,7 +84,7 @@ def _force_unclamped(p: np.ndarray, delta: float, ddot: float) -> float:
     return p[P_K] * pw * (1.0 + p[P_ALPHA] * ddot)
 
 
-@njit(cache=True)
+@njit
 def switch(t: float, y: np.ndarray, p: np.ndarray) -> float:
     """Contact switching function [m]: ``min(δ, F_unclamped/k)``; > 0 exactly where the
     clamped law gives ``F_n > 0``. Its zeros are lift-off and touch-down."""
@@ -95,7 +95,7 @@ def switch(t: float, y: np.ndarray, p: np.ndarray) -> float:
     return delta if delta < f else f
 
 
-@njit(cache=True)
+@njit
 def mode_of(t: float, y: np.ndarray, p: np.ndarray) -> int:
     """The contact mode a step starting at ``y`` runs in (``FREE`` without contact)."""
     if p[P_CONTACT] == 0.0:
@@ -103,7 +103,7 @@ def mode_of(t: float, y: np.ndarray, p: np.ndarray) -> int:
     return IN_CONTACT if switch(t, y, p) > 0.0 else FREE
 
 
-@njit(cache=True)
+@njit
 def evaluate(t: float, y: np.ndarray, p: np.ndarray, mode: int, dy: np.ndarray,
              aux: np.ndarray) -> None:
     """``dy/dt`` of the state ``(z, φ, ż, ω, r, [θ_d, Ω], [F_t])`` into ``dy`` and the
@@ -182,7 +182,7 @@ def evaluate(t: float, y: np.ndarray, p: np.ndarray, mode: int, dy: np.ndarray,
     aux[15] = fss
 
 
-@njit(cache=True)
+@njit
 def channels_into(t: np.ndarray, Y: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
     """:data:`AUX_NAMES` at each column of ``Y`` into ``out`` (shape ``(N_AUX, len(t))``),
     clamped law (mode ``AUTO``)."""
