@@ -44,7 +44,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_realtime.py
 
-# Side by side with MuJoCo (docs/peers.md, docs/peers.png; a few minutes).
+# Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
 peers: $(STAMP)
 	$(PY) benchmarks/peers/study.py
 
