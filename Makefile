@@ -5,12 +5,12 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.winder-installed
 OUT    ?= out
 
-.PHONY: demo test test-slow bench fmu docs-figures lint chromium clean
+.PHONY: demo test test-slow bench peers fmu docs-figures lint chromium clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test,fmu]'
+	$(PY) -m pip install --quiet -e '.[test,fmu,peers]'
 	touch $(STAMP)
 
 venv: $(STAMP)
@@ -43,6 +43,10 @@ bench: $(STAMP)
 	$(PY) benchmarks/rhs_speed.py
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_realtime.py
+
+# Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
+peers: $(STAMP)
+	$(PY) benchmarks/peers/study.py
 
 # The README's resonance map (committed under docs/).
 docs-figures: $(STAMP)
