@@ -147,13 +147,14 @@ class Friction:
 
 @dataclass(frozen=True)
 class Solver:
-    """``[solver]``: method (one of :data:`METHODS`), rtol, atol, max_rhs (guard),
-    backend (one of :data:`BACKENDS`)."""
+    """``[solver]``: method (one of :data:`METHODS`), rtol, atol, max_rhs and max_wall
+    [s] (budgets), backend (one of :data:`BACKENDS`)."""
 
     method: str = "auto"
     rtol: float = 1e-6
     atol: float = 1e-8
     max_rhs: int = 50_000_000
+    max_wall: float = 600.0
     backend: str = "compiled"
 
 
@@ -229,7 +230,7 @@ _SPEC: dict[str, dict[str, tuple]] = {
                  "min_speed": ("num", False, _POS)},
     "solver": {"method": ("str", False, None), "rtol": ("num", False, _POS),
                "atol": ("num", False, _POS), "max_rhs": ("num", False, _POS),
-               "backend": ("str", False, None)},
+               "max_wall": ("num", False, _POS), "backend": ("str", False, None)},
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,
             ("solver", "method"): METHODS, ("solver", "backend"): BACKENDS}
