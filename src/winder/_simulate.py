@@ -18,7 +18,7 @@ from scipy.optimize import brentq
 
 from . import _integrators as integ
 from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError
-from ._planar import AT_CORE, WINDING, PlanarSystem, pack, switch
+from ._planar import AT_CORE, CORE_AUTO, WINDING, PlanarSystem, pack, switch
 from ._result import Result
 from ._scene import BACKENDS, METHODS, Scene, load_scene
 from ._system import WinderSystem
@@ -517,9 +517,10 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
             raise ArgumentTypeError(f"initial_state must be {system.n_states} numbers, got "
                                     f"{initial_state!r:.200}") from None
         if y0.shape != (system.n_states,) or not np.all(np.isfinite(y0)) or y0[4] < r_core:
-            raise ArgumentError(f"initial_state = {initial_state!r:.200} is not valid: "
+            given = ", ".join(f"{v:.9g}" for v in y0.ravel()[:20])
+            raise ArgumentError(f"initial_state = [{given}] is not valid: valid are "
                                 f"{system.n_states} finite values "
-                                f"({', '.join(system.state_names)}), radius >= the core "
+                                f"({', '.join(system.state_names)}) with radius >= the core "
                                 f"radius {r_core:g} m")
     planar = PlanarSystem(scene, system) if be == "compiled" else None
     bar = _Progress(T, scene.name) if progress else None
@@ -542,6 +543,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                 filled, n_events = _run_python(scene, counter, meth, y0, t_s, t_out, Ys, breaks,
                                                rtol, atol, max_step, events, jacobian, guards)
         except _Stop as stop:
+            counter.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
             if compiled_run:
                 planar.nfev = int(stats[0])
                 t_at, h_at, filled = at
@@ -563,6 +565,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     if filled != len(t_out):
         raise SimulationError(f"internal error: {filled} of {len(t_out)} output samples")
     wall = time.perf_counter() - guards.wall0
+    counter.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
     np.maximum(Ys[4], r_core, out=Ys[4])  # dense output between events never dips below
     channels = counter.channels(t_out, Ys)
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
