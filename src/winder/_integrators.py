@@ -8,7 +8,9 @@ ends on the other side of the switching function, the crossing is located on the
 dense output (Illinois method, to ~1e-12 s), the step is cut there and the integration
 restarts in the new mode. The discontinuity of the damped force at touch-down and the
 kink at lift-off therefore never fall inside a step, and the error keeps converging with
-the tolerance through bouncing.
+the tolerance through bouncing. The core mode of spec §2 (winding, or held at the core
+while turning backwards) is locked and switched the same way, on both integrators:
+unwinding below ``r_c`` lands exactly on ``r_c``; turning forwards releases it.
 
 Both functions integrate ``y`` in place, write samples at output times into a caller's
 array and keep counters in ``stats = [nfev, accepted, rejected, events]``; a fifth entry,
@@ -40,14 +42,17 @@ from ._planar import (
     switch,
 )
 
-__all__ = ["dopri5", "rk4", "DONE", "PAUSED", "STEP_UNDERFLOW", "NON_FINITE"]
+__all__ = ["dopri5", "rk4", "DONE", "PAUSED", "STEP_UNDERFLOW", "NON_FINITE", "CHUNK",
+           "TIME_RESOLUTION", "switching", "G_CONTACT", "G_UNWOUND", "G_FORWARD"]
 
 DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE = 0, 1, 2, 3
-# switching functions of :func:`_switching`: contact (:func:`~winder._planar.switch`),
-# ``r_c − r`` (> 0: unwound past the core), ``ω`` (> 0: turning forwards again)
+#: Switching functions of :func:`switching`: contact (:func:`~winder._planar.switch`, > 0:
+#: touching), ``r_c − r`` (> 0: unwound past the core), ``ω`` (> 0: turning forwards)
 G_CONTACT, G_UNWOUND, G_FORWARD = 0, 1, 2
 #: Shortest step [s] relative to ``max(1 s, |t|)``; below it the time is not resolved.
 TIME_RESOLUTION = 1e-14
+#: Evaluations per call of a caller that checks its budgets between calls (20–40 ms).
+CHUNK = 200_000
 
 # Dormand–Prince 5(4) tableau
 C2, C3, C4, C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
@@ -72,7 +77,9 @@ def _dense(rc: np.ndarray, theta: float, out: np.ndarray) -> None:
 
 
 @njit(cache=True)
-def _switching(which: int, t: float, y: np.ndarray, p: np.ndarray) -> float:
+def switching(which: int, t: float, y: np.ndarray, p: np.ndarray) -> float:
+    """The switching function ``which`` (:data:`G_CONTACT`, :data:`G_UNWOUND`,
+    :data:`G_FORWARD`) at ``(t, y)``."""
     if which == G_CONTACT:
         return switch(t, y, p)
     if which == G_UNWOUND:
@@ -87,9 +94,9 @@ def _locate(which: int, new_pos: bool, rc: np.ndarray, t: float, hh: float, p: n
     switching function ``which`` is on its new side (``g > 0`` if ``new_pos``, else
     ``g <= 0``); Illinois method to ~1e-12 s. The step's end is on the new side."""
     _dense(rc, 1.0, yt)
-    gb = _switching(which, t + hh, yt, p)
+    gb = switching(which, t + hh, yt, p)
     _dense(rc, 0.0, yt)
-    ga = _switching(which, t, yt, p)
+    ga = switching(which, t, yt, p)
     if new_pos and ga > 0.0:  # the start belongs to the old side
         ga = -1e-300
     elif not new_pos and ga <= 0.0:
@@ -104,7 +111,7 @@ def _locate(which: int, new_pos: bool, rc: np.ndarray, t: float, hh: float, p: n
         if not (ta < th < tb):
             th = 0.5 * (ta + tb)
         _dense(rc, th, yt)
-        g = _switching(which, t + th * hh, yt, p)
+        g = switching(which, t + th * hh, yt, p)
         if (g > 0.0) == new_pos:
             tb, gb = th, g
             if side == -1:
@@ -260,15 +267,13 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
             theta_end = theta_k
             new_core = AT_CORE if core == WINDING else WINDING
         t_end = t + theta_end * hh
-        # samples inside the accepted part of the step (never below the core)
+        # samples inside the accepted part of the step
         while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
             if t_out[k] > t1 + 1e-13 * max(1.0, abs(t1)):
                 break
             _dense(rc, min(theta_end, max(0.0, (t_out[k] - t) / hh)), yt)
             for i in range(n):
                 Y_out[i, k] = yt[i]
-            if Y_out[4, k] < p[P_RC]:
-                Y_out[4, k] = p[P_RC]
             k += 1
         stats[1] += 1
         if theta_end < 1.0:  # event: restart at the crossing in the new mode
@@ -371,7 +376,7 @@ def rk4(t0: float, t1: float, y: np.ndarray, p: np.ndarray, h: float, t_out: np.
                 for _ in range(60):
                     th = 0.5 * (ta + tb)
                     _hermite(y, k1, y1, k2, hs, th, yt)
-                    if _switching(which, t + th * hs, yt, p) > 0.0:
+                    if switching(which, t + th * hs, yt, p) > 0.0:
                         tb = th
                     else:
                         ta = th
@@ -381,8 +386,6 @@ def rk4(t0: float, t1: float, y: np.ndarray, p: np.ndarray, h: float, t_out: np.
                 _hermite(y, k1, y1, k2, hs, min(theta, max(0.0, (t_out[k] - t) / hs)), yt)
                 for i in range(n):
                     Y_out[i, k] = yt[i]
-                if Y_out[4, k] < r_core:
-                    Y_out[4, k] = r_core
                 k += 1
             if which < 0:
                 for i in range(n):

@@ -18,7 +18,7 @@ from scipy.optimize import brentq
 
 from . import _integrators as integ
 from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError
-from ._planar import AT_CORE, CORE_AUTO, WINDING, PlanarSystem, pack, switch
+from ._planar import AT_CORE, CORE_AUTO, WINDING, PlanarSystem, core_mode_of, pack
 from ._result import Result
 from ._scene import BACKENDS, METHODS, Scene, load_scene
 from ._system import WinderSystem
@@ -32,7 +32,6 @@ DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
 COMPILED_METHODS = ("DOPRI5",)
 #: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
 MAX_SAMPLES = 10_000_000
-_CHUNK = 200_000  # evaluations per compiled call (progress, wall clock: ~20-40 ms each)
 _WALL_EVERY = 256  # evaluations between wall-clock checks on the Python paths
 _STEP_OVER = 1e-6  # [s] integrated without contact events after a grazing contact
 _SCIPY = {"RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF, "LSODA": LSODA,
@@ -337,7 +336,7 @@ def _locate(event: _Event, sol: DenseOutput, ta: float, tb: float,
     ga, gb = on_sol(ta), on_sol(tb)
     if _on_new_side(ga, new_pos):
         return ta, sol(ta)
-    if not _on_new_side(gb, new_pos) or ga == 0.0:
+    if not _on_new_side(gb, new_pos):
         return tb, y_end
     eps = np.finfo(float).eps
     t_ev = brentq(on_sol, ta, tb, xtol=4 * eps * max(1.0, abs(tb)), rtol=4 * eps)
@@ -397,14 +396,15 @@ def _run_compiled(meth: str, p: np.ndarray, y: np.ndarray, t_out: np.ndarray,
                   Ys: np.ndarray, breaks: list[float], rtol: float, atol: float,
                   max_step: float | None, guards: _Guards, stats: np.ndarray,
                   at: list[Any]) -> int:
-    """Integrate ``y`` in place with a compiled method in chunks of :data:`_CHUNK`
-    evaluations (progress and budgets between chunks). Returns the samples written; ``at``
-    holds ``[t, step, samples]`` of the last chunk (for a budget error)."""
+    """Integrate ``y`` in place with a compiled method in chunks of
+    :data:`~winder._integrators.CHUNK` evaluations (progress and budgets between chunks).
+    Returns the samples written; ``at`` holds ``[t, step, samples]`` of the last chunk
+    (for a budget error)."""
     t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
     for tb in breaks:
         while t < tb:
-            budget = min(_CHUNK, guards.limit - int(stats[0]))
+            budget = min(integ.CHUNK, guards.limit - int(stats[0]))
             if budget <= 0:
                 raise _Stop("max_rhs")
             if meth == "DOPRI5":
@@ -430,11 +430,6 @@ def _run_compiled(meth: str, p: np.ndarray, y: np.ndarray, t_out: np.ndarray,
                                    "method='Radau' or 'LSODA'", t, y)
             guards.tick(t)
     return k
-
-
-def _core_mode(y: np.ndarray, r_core: float) -> int:
-    """Core mode of a segment starting at ``y`` (as :func:`winder._planar.core_mode_of`)."""
-    return AT_CORE if y[4] <= r_core and y[3] <= 0.0 else WINDING
 
 
 # ---- simulate -----------------------------------------------------------------------
@@ -566,7 +561,9 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         raise SimulationError(f"internal error: {filled} of {len(t_out)} output samples")
     wall = time.perf_counter() - guards.wall0
     counter.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
-    np.maximum(Ys[4], r_core, out=Ys[4])  # dense output between events never dips below
+    # interpolated samples between a step's start and its core event may dip below r_c
+    # by round-off; the state never does
+    np.maximum(Ys[4], r_core, out=Ys[4])
     channels = counter.channels(t_out, Ys)
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
     if bad:
@@ -629,18 +626,14 @@ def _run_python(scene: Scene, counter: PlanarSystem | WinderSystem, meth: str,
 
     p = counter.params if isinstance(counter, PlanarSystem) else pack(scene)
 
-    def gap(t: float, y: np.ndarray) -> float:  # min(δ, F_unclamped/k); > 0: F_n > 0
-        return switch(t, y, p)
+    def event(which: int) -> Callable[[float, np.ndarray], float]:
+        return lambda t, y: integ.switching(which, t, y, p)
 
-    def unwound(t: float, y: np.ndarray) -> float:  # > 0: below the core
-        return r_core - y[4]
-
-    def forward(t: float, y: np.ndarray) -> float:  # > 0: turning forwards again
-        return y[3]
-
+    gap, unwound, forward = event(integ.G_CONTACT), event(integ.G_UNWOUND), \
+        event(integ.G_FORWARD)
     contact_events = events and scene.effects.contact and meth != "RK4"
     filled, n_events, t0, y = 0, 0, t_s, np.array(y0, dtype=float)
-    core = _core_mode(y, r_core)
+    core = core_mode_of(y, p)
     counter.set_core_mode(core)
     step_over_until = -math.inf
     touching: bool | None = None  # contact side; None: read it from the state

@@ -118,7 +118,7 @@ class Stepper:
                         "max_wall" if time.perf_counter() - wall0 > self.max_wall else None)
                 if over is not None:
                     raise self._over(over, t_start, t_end, spent, steps0, stiff0, wall0)
-                budget = min(self._CHUNK, self.max_rhs - spent)
+                budget = min(integ.CHUNK, self.max_rhs - spent)
                 status, t, h, _ = integ.dopri5(self.t, tb, self.y, p, self.rtol, self.atol,
                                                self._h, math.inf, empty_t, empty_y, 0,
                                                budget, self._stats)
@@ -133,8 +133,6 @@ class Stepper:
                 self._outputs = None
         self.t = t_end
         self._outputs = None
-
-    _CHUNK = 200_000  # evaluations per compiled call (wall-clock checks between them)
 
     def _over(self, kind: str, t_start: float, t_end: float, nfev: int, steps0: int,
               stiff0: int, wall0: float) -> Exception:

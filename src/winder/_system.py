@@ -111,7 +111,7 @@ class WinderSystem:
         """Input torque of a free drum (drive kind ``torque``) [N·m]."""
         if not self._free_drum:
             raise ArgumentError("drum_torque is an input only with [drum.drive] kind = "
-                                  "'torque'; this scene prescribes the drum speed")
+                                "'torque'; this scene prescribes the drum speed")
         self._tau[0] = torque
 
     def radius_rate(self, r: float, omega: float) -> float:
@@ -128,7 +128,7 @@ class WinderSystem:
         lock it between the core events."""
         if core not in (CORE_AUTO, WINDING, AT_CORE):
             raise ArgumentError(f"core mode must be one of {CORE_AUTO}, {WINDING}, {AT_CORE}, "
-                             f"got {core!r}")
+                                f"got {core!r}")
         self.core = core
 
     # ---- evaluation -----------------------------------------------------------------
