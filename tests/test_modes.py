@@ -244,5 +244,5 @@ def test_pinocchio_jacobian_in_implicit_methods(models_dir) -> None:
     b = winder.simulate(scene, jacobian="fd", **kw)
     for k in ("radius", "roll_speed", "z", "normal_force"):
         np.testing.assert_allclose(a[k], b[k], rtol=1e-5, atol=1e-6 * np.max(np.abs(b[k])))
-    with pytest.raises(winder.WinderError, match="valid: fd, pinocchio"):
+    with pytest.raises(winder.ArgumentError, match="valid: fd, pinocchio"):
         winder.simulate(scene, t_end=0.1, jacobian="exact")

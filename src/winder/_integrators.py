@@ -8,10 +8,14 @@ ends on the other side of the switching function, the crossing is located on the
 dense output (Illinois method, to ~1e-12 s), the step is cut there and the integration
 restarts in the new mode. The discontinuity of the damped force at touch-down and the
 kink at lift-off therefore never fall inside a step, and the error keeps converging with
-the tolerance through bouncing.
+the tolerance through bouncing. The core mode of spec §2 (winding, or held at the core
+while turning backwards) is locked and switched the same way, on both integrators:
+unwinding below ``r_c`` lands exactly on ``r_c``; turning forwards releases it.
 
 Both functions integrate ``y`` in place, write samples at output times into a caller's
-array and keep counters in ``stats = [nfev, accepted, rejected, events]``.
+array and keep counters in ``stats = [nfev, accepted, rejected, events]``; a fifth entry,
+if present, counts DOPRI5's accepted steps at its stability limit (Hairer's stiffness
+test: ``h·|λ| > 3.25``).
 Status codes: :data:`DONE`, :data:`PAUSED` (the evaluation budget of this call is spent;
 call again to resume), :data:`STEP_UNDERFLOW`, :data:`NON_FINITE`.
 """
@@ -23,11 +27,32 @@ import math
 import numpy as np
 
 from ._jit import njit
-from ._planar import AUTO, FREE, IN_CONTACT, N_AUX, P_CONTACT, evaluate, mode_of, switch
+from ._planar import (
+    AT_CORE,
+    AUTO,
+    FREE,
+    IN_CONTACT,
+    N_AUX,
+    P_CONTACT,
+    P_RC,
+    WINDING,
+    core_mode_of,
+    evaluate,
+    mode_of,
+    switch,
+)
 
-__all__ = ["dopri5", "rk4", "DONE", "PAUSED", "STEP_UNDERFLOW", "NON_FINITE"]
+__all__ = ["dopri5", "rk4", "DONE", "PAUSED", "STEP_UNDERFLOW", "NON_FINITE", "CHUNK",
+           "TIME_RESOLUTION", "switching", "G_CONTACT", "G_UNWOUND", "G_FORWARD"]
 
 DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE = 0, 1, 2, 3
+#: Switching functions of :func:`switching`: contact (:func:`~winder._planar.switch`, > 0:
+#: touching), ``r_c − r`` (> 0: unwound past the core), ``ω`` (> 0: turning forwards)
+G_CONTACT, G_UNWOUND, G_FORWARD = 0, 1, 2
+#: Shortest step [s] relative to ``max(1 s, |t|)``; below it the time is not resolved.
+TIME_RESOLUTION = 1e-14
+#: Evaluations per call of a caller that checks its budgets between calls (20–40 ms).
+CHUNK = 200_000
 
 # Dormand–Prince 5(4) tableau
 C2, C3, C4, C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
@@ -52,12 +77,77 @@ def _dense(rc: np.ndarray, theta: float, out: np.ndarray) -> None:
 
 
 @njit
+def switching(which: int, t: float, y: np.ndarray, p: np.ndarray) -> float:
+    """The switching function ``which`` (:data:`G_CONTACT`, :data:`G_UNWOUND`,
+    :data:`G_FORWARD`) at ``(t, y)``."""
+    if which == G_CONTACT:
+        return switch(t, y, p)
+    if which == G_UNWOUND:
+        return p[P_RC] - y[4]
+    return y[3]
+
+
+@njit
+def _locate(which: int, new_pos: bool, rc: np.ndarray, t: float, hh: float, p: np.ndarray,
+            yt: np.ndarray) -> float:
+    """First ``θ`` in ``(0, 1]`` of an accepted step (dense output ``rc``) where the
+    switching function ``which`` is on its new side (``g > 0`` if ``new_pos``, else
+    ``g <= 0``); Illinois method to ~1e-12 s. The step's end is on the new side."""
+    _dense(rc, 1.0, yt)
+    gb = switching(which, t + hh, yt, p)
+    _dense(rc, 0.0, yt)
+    ga = switching(which, t, yt, p)
+    if new_pos and ga > 0.0:  # the start belongs to the old side
+        ga = -1e-300
+    elif not new_pos and ga <= 0.0:
+        ga = 1e-300
+    ta, tb = 0.0, 1.0
+    side = 0
+    tol = 1e-12 * max(1.0, abs(t)) / hh
+    for _ in range(100):
+        if tb - ta <= tol:
+            break
+        th = (ta * gb - tb * ga) / (gb - ga)
+        if not (ta < th < tb):
+            th = 0.5 * (ta + tb)
+        _dense(rc, th, yt)
+        g = switching(which, t + th * hh, yt, p)
+        if (g > 0.0) == new_pos:
+            tb, gb = th, g
+            if side == -1:
+                ga *= 0.5
+            side = -1
+        else:
+            ta, ga = th, g
+            if side == 1:
+                gb *= 0.5
+            side = 1
+    return tb
+
+
+@njit
+def _sliver(t: float, t1: float, y: np.ndarray, f: np.ndarray, t_out: np.ndarray,
+            Y_out: np.ndarray, k: int) -> int:
+    """Finish an interval shorter than the time resolution with one Euler step; samples."""
+    for i in range(y.shape[0]):
+        y[i] += (t1 - t) * f[i]
+    while k < t_out.shape[0] and t_out[k] <= t1 + 1e-13 * max(1.0, abs(t1)):
+        for i in range(y.shape[0]):
+            Y_out[i, k] = y[i]
+        k += 1
+    return k
+
+
+@njit
 def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol: float,
            h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
            budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
     """Integrate ``y`` from ``t0`` to ``t1``. Samples at ``t_out[k:]`` up to ``t1`` go to
     the columns of ``Y_out``. ``h <= 0`` picks the first step. Stops after ``budget``
-    evaluations with :data:`PAUSED`. Returns ``(status, t, h, k)``."""
+    evaluations with :data:`PAUSED`. Contact and core modes start from the state
+    (:func:`~winder._planar.mode_of`, :func:`~winder._planar.core_mode_of`) and switch at
+    located events; landing on the core sets ``r = r_c`` exactly. Returns
+    ``(status, t, h, k)``."""
     n = y.shape[0]
     k1, k2, k3, k4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     k5, k6, k7 = np.empty(n), np.empty(n), np.empty(n)
@@ -67,7 +157,8 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
     contact = p[P_CONTACT] != 0.0
     t = t0
     mode = mode_of(t, y, p)
-    evaluate(t, y, p, mode, k1, aux)
+    core = core_mode_of(y, p)
+    evaluate(t, y, p, mode, k1, aux, core)
     nfev = 1
     if h <= 0.0:  # Hairer's starting step, first part
         d0 = d1 = 0.0
@@ -86,29 +177,33 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
         hh = min(h, max_step)
         if t + 1.01 * hh >= t1:
             hh = t1 - t
-        if hh < 1e-14 * max(1.0, abs(t)):
+            if hh < TIME_RESOLUTION * max(1.0, abs(t)):  # a sliver is left
+                k = _sliver(t, t1, y, k1, t_out, Y_out, k)
+                t = t1
+                break
+        if hh < TIME_RESOLUTION * max(1.0, abs(t)):
             status = STEP_UNDERFLOW
             break
         for i in range(n):
             yt[i] = y[i] + hh * A21 * k1[i]
-        evaluate(t + C2 * hh, yt, p, mode, k2, aux)
+        evaluate(t + C2 * hh, yt, p, mode, k2, aux, core)
         for i in range(n):
             yt[i] = y[i] + hh * (A31 * k1[i] + A32 * k2[i])
-        evaluate(t + C3 * hh, yt, p, mode, k3, aux)
+        evaluate(t + C3 * hh, yt, p, mode, k3, aux, core)
         for i in range(n):
             yt[i] = y[i] + hh * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-        evaluate(t + C4 * hh, yt, p, mode, k4, aux)
+        evaluate(t + C4 * hh, yt, p, mode, k4, aux, core)
         for i in range(n):
             yt[i] = y[i] + hh * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-        evaluate(t + C5 * hh, yt, p, mode, k5, aux)
+        evaluate(t + C5 * hh, yt, p, mode, k5, aux, core)
         for i in range(n):
             yt[i] = y[i] + hh * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                  + A65 * k5[i])
-        evaluate(t + hh, yt, p, mode, k6, aux)
+        evaluate(t + hh, yt, p, mode, k6, aux, core)
         for i in range(n):
             y1[i] = y[i] + hh * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i]
                                  + A76 * k6[i])
-        evaluate(t + hh, y1, p, mode, k7, aux)
+        evaluate(t + hh, y1, p, mode, k7, aux, core)
         nfev += 6
         err = 0.0
         for i in range(n):
@@ -130,7 +225,16 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
             h = hh * max(0.2, 0.9 * err ** -0.2)
             rejected_last = True
             continue
-        # accepted: dense output coefficients
+        # accepted. Stiffness test of Hairer's DOPRI5: h·|λ| from the last two stages
+        # (both at t + h); above ~3.3 the step is limited by stability, not accuracy
+        if stats.shape[0] > 4:
+            stnum = stden = 0.0
+            for i in range(n):
+                stnum += (k7[i] - k6[i]) ** 2
+                stden += (y1[i] - yt[i]) ** 2
+            if stden > 0.0 and hh * hh * stnum > 3.25 ** 2 * stden:
+                stats[4] += 1
+        # dense output coefficients
         for i in range(n):
             dyi = y1[i] - y[i]
             bspl = hh * k1[i] - dyi
@@ -140,47 +244,34 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
             rc[3, i] = dyi - hh * k7[i] - bspl
             rc[4, i] = hh * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i]
                              + D7 * k7[i])
+        # events: contact (mode) and core (spec §2); the step is cut at the first one
         theta_end = 1.0
-        new_mode = mode
+        new_mode, new_core = mode, core
+        theta_c = 2.0
         if contact:
             s1 = switch(t + hh, y1, p)
-            crossed = (mode == IN_CONTACT and s1 <= 0.0) or (mode == FREE and s1 > 0.0)
-            if crossed:
-                new_mode = IN_CONTACT if s1 > 0.0 else FREE
-                s0 = switch(t, y, p)
-                if mode == IN_CONTACT and s0 <= 0.0:
-                    s0 = 1e-300
-                elif mode == FREE and s0 > 0.0:
-                    s0 = -1e-300
-                ta, ga, tb, gb = 0.0, s0, 1.0, s1
-                side = 0
-                tol = 1e-12 * max(1.0, abs(t)) / hh
-                for _ in range(100):
-                    if tb - ta <= tol:
-                        break
-                    th = (ta * gb - tb * ga) / (gb - ga)
-                    if not (ta < th < tb):
-                        th = 0.5 * (ta + tb)
-                    _dense(rc, th, yt)
-                    g = switch(t + th * hh, yt, p)
-                    in_new = g > 0.0 if new_mode == IN_CONTACT else g <= 0.0
-                    if in_new:
-                        tb, gb = th, g
-                        if side == -1:
-                            ga *= 0.5
-                        side = -1
-                    else:
-                        ta, ga = th, g
-                        if side == 1:
-                            gb *= 0.5
-                        side = 1
-                theta_end = tb
+            if (mode == IN_CONTACT and s1 <= 0.0) or (mode == FREE and s1 > 0.0):
+                if mode == IN_CONTACT:  # leaving contact: the new side is g <= 0
+                    theta_c = _locate(G_CONTACT, False, rc, t, hh, p, yt)
+                else:
+                    theta_c = _locate(G_CONTACT, True, rc, t, hh, p, yt)
+        theta_k = 2.0
+        if core == WINDING and y1[4] < p[P_RC]:
+            theta_k = _locate(G_UNWOUND, True, rc, t, hh, p, yt)
+        elif core == AT_CORE and y1[3] > 0.0:
+            theta_k = _locate(G_FORWARD, True, rc, t, hh, p, yt)
+        if theta_c <= theta_k and theta_c <= 1.0:
+            theta_end = theta_c
+            new_mode = IN_CONTACT if mode == FREE else FREE
+        if theta_k <= theta_c and theta_k <= 1.0:
+            theta_end = theta_k
+            new_core = AT_CORE if core == WINDING else WINDING
         t_end = t + theta_end * hh
         # samples inside the accepted part of the step
         while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
             if t_out[k] > t1 + 1e-13 * max(1.0, abs(t1)):
                 break
-            _dense(rc, min(1.0, max(0.0, (t_out[k] - t) / hh)), yt)
+            _dense(rc, min(theta_end, max(0.0, (t_out[k] - t) / hh)), yt)
             for i in range(n):
                 Y_out[i, k] = yt[i]
             k += 1
@@ -188,22 +279,22 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
         if theta_end < 1.0:  # event: restart at the crossing in the new mode
             _dense(rc, theta_end, y)
             t = t_end
-            mode = new_mode
-            evaluate(t, y, p, mode, k1, aux)
+        else:
+            for i in range(n):
+                y[i] = y1[i]
+                k1[i] = k7[i]
+            t = t + hh if t + hh < t1 else t1
+        if new_core == AT_CORE and core == WINDING:
+            y[4] = p[P_RC]  # land exactly on the core
+        if new_mode != mode or new_core != core or theta_end < 1.0:
+            mode, core = new_mode, new_core
+            evaluate(t, y, p, mode, k1, aux, core)
             nfev += 1
             stats[3] += 1
-            h = hh
-            rejected_last = False
-            continue
-        for i in range(n):
-            y[i] = y1[i]
-            k1[i] = k7[i]
-        t = t + hh if t + hh < t1 else t1
-        if new_mode != mode:  # crossing at the very end of the step
-            mode = new_mode
-            evaluate(t, y, p, mode, k1, aux)
-            nfev += 1
-            stats[3] += 1
+            if theta_end < 1.0:
+                h = hh
+                rejected_last = False
+                continue
         fac = 0.9 * max(err, 1e-10) ** -0.2
         fac = min(fac, 1.0) if rejected_last else min(fac, 10.0)
         h = hh * max(0.2, fac)
@@ -213,54 +304,107 @@ def dopri5(t0: float, t1: float, y: np.ndarray, p: np.ndarray, rtol: float, atol
 
 
 @njit
+def _hermite(y0: np.ndarray, f0: np.ndarray, y1: np.ndarray, f1: np.ndarray, h: float,
+             s: float, out: np.ndarray) -> None:
+    """Cubic Hermite interpolant of a step of length ``h`` at ``s`` in ``[0, 1]``."""
+    h00, h10 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s
+    h01, h11 = -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2
+    for i in range(out.shape[0]):
+        out[i] = h00 * y0[i] + h10 * h * f0[i] + h01 * y1[i] + h11 * h * f1[i]
+
+
+@njit
 def rk4(t0: float, t1: float, y: np.ndarray, p: np.ndarray, h: float, t_out: np.ndarray,
         Y_out: np.ndarray, k: int, stats: np.ndarray) -> tuple[int, float, float, int]:
     """Classical RK4 with steps of at most ``h`` evenly dividing ``[t0, t1]`` (the clamped
-    nip law, no event location: for real-time stepping). Samples by cubic Hermite
-    interpolation. Returns ``(status, t, h, k)``."""
+    nip law, no contact event location: for real-time stepping). The core events of
+    spec §2 are located on the step's cubic Hermite interpolant; the step is cut there
+    and the rest of the interval divided again. Samples by the same interpolant.
+    Returns ``(status, t, h, k)``."""
     n = y.shape[0]
-    steps = max(1, int(math.ceil((t1 - t0) / h - 1e-9)))
-    hh = (t1 - t0) / steps
     k1, k2, k3, k4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     yt, y1 = np.empty(n), np.empty(n)
     aux = np.empty(N_AUX)
-    evaluate(t0, y, p, AUTO, k1, aux)
+    r_core = p[P_RC]
+    core = core_mode_of(y, p)
+    evaluate(t0, y, p, AUTO, k1, aux, core)
     nfev = 1
     t = t0
+    hh = h
     status = DONE
-    for j in range(steps):
-        for i in range(n):
-            yt[i] = y[i] + 0.5 * hh * k1[i]
-        evaluate(t + 0.5 * hh, yt, p, AUTO, k2, aux)
-        for i in range(n):
-            yt[i] = y[i] + 0.5 * hh * k2[i]
-        evaluate(t + 0.5 * hh, yt, p, AUTO, k3, aux)
-        for i in range(n):
-            yt[i] = y[i] + hh * k3[i]
-        evaluate(t + hh, yt, p, AUTO, k4, aux)
-        for i in range(n):
-            y1[i] = y[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-        tn = t0 + (j + 1) * hh
-        evaluate(tn, y1, p, AUTO, k2, aux)  # f at the step end (next k1)
-        nfev += 4
-        ok = True
-        for i in range(n):
-            if not math.isfinite(y1[i]):
-                ok = False
-        if not ok:
-            status = NON_FINITE
+    while t < t1 and status == DONE:
+        if t1 - t < TIME_RESOLUTION * max(1.0, abs(t)):
+            k = _sliver(t, t1, y, k1, t_out, Y_out, k)
+            t = t1
             break
-        while k < t_out.shape[0] and t_out[k] <= tn + 1e-13 * max(1.0, abs(tn)):
-            s = (t_out[k] - t) / hh
-            h00, h10 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s
-            h01, h11 = -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2
+        steps = max(1, int(math.ceil((t1 - t) / h - 1e-9)))
+        ts = t
+        hh = (t1 - ts) / steps
+        for j in range(steps):
+            tn = t1 if j == steps - 1 else ts + (j + 1) * hh
+            hs = tn - t
             for i in range(n):
-                Y_out[i, k] = h00 * y[i] + h10 * hh * k1[i] + h01 * y1[i] + h11 * hh * k2[i]
-            k += 1
-        for i in range(n):
-            y[i] = y1[i]
-            k1[i] = k2[i]
-        t = tn
+                yt[i] = y[i] + 0.5 * hs * k1[i]
+            evaluate(t + 0.5 * hs, yt, p, AUTO, k2, aux, core)
+            for i in range(n):
+                yt[i] = y[i] + 0.5 * hs * k2[i]
+            evaluate(t + 0.5 * hs, yt, p, AUTO, k3, aux, core)
+            for i in range(n):
+                yt[i] = y[i] + hs * k3[i]
+            evaluate(t + hs, yt, p, AUTO, k4, aux, core)
+            for i in range(n):
+                y1[i] = y[i] + hs / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            evaluate(tn, y1, p, AUTO, k2, aux, core)  # f at the step end (next k1)
+            nfev += 4
+            stats[1] += 1
+            ok = True
+            for i in range(n):
+                if not math.isfinite(y1[i]):
+                    ok = False
+            if not ok:
+                status = NON_FINITE
+                break
+            # core event (spec §2): first point of the interpolant on the new side
+            which = -1
+            if core == WINDING and y1[4] < r_core:
+                which = G_UNWOUND
+            elif core == AT_CORE and y1[3] > 0.0:
+                which = G_FORWARD
+            theta = 1.0
+            if which >= 0:
+                ta, tb = 0.0, 1.0
+                for _ in range(60):
+                    th = 0.5 * (ta + tb)
+                    _hermite(y, k1, y1, k2, hs, th, yt)
+                    if switching(which, t + th * hs, yt, p) > 0.0:
+                        tb = th
+                    else:
+                        ta = th
+                theta = tb
+            t_end = t + theta * hs
+            while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
+                _hermite(y, k1, y1, k2, hs, min(theta, max(0.0, (t_out[k] - t) / hs)), yt)
+                for i in range(n):
+                    Y_out[i, k] = yt[i]
+                k += 1
+            if which < 0:
+                for i in range(n):
+                    y[i] = y1[i]
+                    k1[i] = k2[i]
+                t = tn
+                continue
+            _hermite(y, k1, y1, k2, hs, theta, yt)
+            for i in range(n):
+                y[i] = yt[i]
+            if core == WINDING:
+                y[4] = r_core  # land exactly on the core
+                core = AT_CORE
+            else:
+                core = WINDING
+            t = t_end if theta < 1.0 else tn
+            evaluate(t, y, p, AUTO, k1, aux, core)
+            nfev += 1
+            stats[3] += 1
+            break  # divide the rest of the interval again
     stats[0] += nfev
-    stats[1] += steps
     return status, t, hh, k

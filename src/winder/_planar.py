@@ -10,7 +10,9 @@ Scenes are packed into a parameter vector (:func:`pack`); effects that are off a
 that skip their terms. The nip can be evaluated in a *locked mode* (see :data:`AUTO`):
 the integrator of :mod:`winder._integrators` keeps contact or no-contact fixed within a
 step and switches exactly at the located event, so the discontinuity of the damped
-normal force at touch-down never sits inside a step.
+normal force at touch-down never sits inside a step. The radius floor of spec §2 (a roll
+turning backwards unwinds down to its core and no further) is a second locked mode
+(:data:`WINDING` or :data:`AT_CORE`, see :func:`core_mode_of`), switched the same way.
 """
 
 from __future__ import annotations
@@ -27,8 +29,9 @@ from ._scene import Scene
 if TYPE_CHECKING:
     from ._system import WinderSystem
 
-__all__ = ["pack", "evaluate", "switch", "mode_of", "N_AUX", "AUX_NAMES", "AUTO",
-           "FREE", "IN_CONTACT", "PlanarSystem", "channels_into"]
+__all__ = ["pack", "evaluate", "switch", "mode_of", "core_mode_of", "N_AUX", "AUX_NAMES",
+           "AUTO", "FREE", "IN_CONTACT", "CORE_AUTO", "WINDING", "AT_CORE", "PlanarSystem",
+           "channels_into"]
 
 # parameter slots of the packed scene
 (P_R, P_JD, P_AW, P_VW, P_TRAMP, P_RC, P_MCORE, P_JCORE, P_RPL, P_H2PI, P_E, P_G, P_LAW,
@@ -40,6 +43,11 @@ __all__ = ["pack", "evaluate", "switch", "mode_of", "N_AUX", "AUX_NAMES", "AUTO"
 #: unclamped law, smoothly extended (``δ|δ|^(p-1)``), valid while :func:`switch` > 0.
 AUTO, FREE, IN_CONTACT = -1, 0, 1
 
+#: Core modes (spec §2): ``WINDING`` winds and unwinds, ``ṙ = h ω/2π``; ``AT_CORE`` holds
+#: the radius at the core, ``ṙ = 0`` (no paper left to unwind while ``ω < 0``);
+#: ``CORE_AUTO`` picks by the state: ``ṙ = 0`` where ``r <= r_c`` and ``ω < 0``.
+CORE_AUTO, WINDING, AT_CORE = -1, 0, 1
+
 #: Auxiliary outputs of :func:`evaluate`, in order.
 AUX_NAMES = ("theta", "drum_speed", "drum_accel", "mass", "inertia", "mass_rate",
              "inertia_rate", "normal_force", "friction_force", "slip_velocity", "web_force",
@@ -47,8 +55,9 @@ AUX_NAMES = ("theta", "drum_speed", "drum_accel", "mass", "inertia", "mass_rate"
 N_AUX = len(AUX_NAMES)
 
 
-def pack(scene: Scene, *, drum_torque: float = 0.0) -> np.ndarray:
-    """The scene as the parameter vector of the compiled functions."""
+def pack(scene: Scene, *, drum_torque: float | None = None) -> np.ndarray:
+    """The scene as the parameter vector of the compiled functions; ``drum_torque`` [N·m]
+    overrides the input torque of a free drum (default ``[drum.drive] torque``)."""
     fx, d, ro, pa, co, fr = (scene.effects, scene.drum, scene.roll, scene.paper,
                              scene.contact, scene.friction)
     p = np.zeros(N_PARAMS)
@@ -68,7 +77,8 @@ def pack(scene: Scene, *, drum_torque: float = 0.0) -> np.ndarray:
     p[P_SIGMA], p[P_VMIN] = fr.relaxation_length, fr.min_speed
     p[P_VM], p[P_WEB] = float(fx.variable_mass), float(fx.web_momentum)
     p[P_CONTACT], p[P_RELAX] = float(fx.contact), float(fx.slip_relaxation)
-    p[P_FREE], p[P_TAU] = float(free), drum_torque
+    p[P_FREE] = float(free)
+    p[P_TAU] = (d.drive.torque if drum_torque is None else drum_torque) if free else 0.0
     n = 5 + (2 if free else 0)
     p[P_IFT] = float(n) if fx.slip_relaxation else -1.0
     return p
@@ -104,10 +114,18 @@ def mode_of(t: float, y: np.ndarray, p: np.ndarray) -> int:
 
 
 @njit
+def core_mode_of(y: np.ndarray, p: np.ndarray) -> int:
+    """The core mode a step starting at ``y`` runs in: ``AT_CORE`` where ``r <= r_c`` and
+    ``ω <= 0``, else ``WINDING``."""
+    return AT_CORE if y[4] <= p[P_RC] and y[3] <= 0.0 else WINDING
+
+
+@njit
 def evaluate(t: float, y: np.ndarray, p: np.ndarray, mode: int, dy: np.ndarray,
-             aux: np.ndarray) -> None:
+             aux: np.ndarray, core: int = CORE_AUTO) -> None:
     """``dy/dt`` of the state ``(z, φ, ż, ω, r, [θ_d, Ω], [F_t])`` into ``dy`` and the
-    quantities of :data:`AUX_NAMES` into ``aux``."""
+    quantities of :data:`AUX_NAMES` into ``aux``; ``mode`` is the contact mode, ``core``
+    the core mode."""
     z, phi, zd, w, r = y[0], y[1], y[2], y[3], y[4]
     R = p[P_R]
     # drive (spec §5)
@@ -124,7 +142,10 @@ def evaluate(t: float, y: np.ndarray, p: np.ndarray, mode: int, dy: np.ndarray,
     # mass properties (spec §2)
     rpl = p[P_RPL]
     rc = p[P_RC]
-    rdot = p[P_H2PI] * w
+    if core == AT_CORE or (core == CORE_AUTO and r <= rc and w < 0.0):
+        rdot = 0.0  # at the core: nothing left to unwind (spec §2)
+    else:
+        rdot = p[P_H2PI] * w
     m = p[P_MCORE] + rpl * (r * r - rc * rc)
     J = p[P_JCORE] + 0.5 * rpl * (r ** 4 - rc ** 4)
     mrate = 2.0 * rpl * r * rdot
@@ -185,7 +206,7 @@ def evaluate(t: float, y: np.ndarray, p: np.ndarray, mode: int, dy: np.ndarray,
 @njit
 def channels_into(t: np.ndarray, Y: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
     """:data:`AUX_NAMES` at each column of ``Y`` into ``out`` (shape ``(N_AUX, len(t))``),
-    clamped law (mode ``AUTO``)."""
+    clamped law (mode ``AUTO``), core mode by the state (``CORE_AUTO``)."""
     n = Y.shape[0]
     dy = np.empty(n)
     aux = np.empty(N_AUX)
@@ -212,6 +233,9 @@ class PlanarSystem:
         self.params = pack(scene)
         self.n_states = system.n_states
         self.nfev = 0
+        #: core mode of :meth:`rhs` (:data:`CORE_AUTO`, :data:`WINDING` or :data:`AT_CORE`);
+        #: :func:`~winder.simulate` locks it between core events.
+        self.core = CORE_AUTO
         self._aux = np.empty(N_AUX)
 
     def set_drum_torque(self, torque: float) -> None:
@@ -219,11 +243,16 @@ class PlanarSystem:
         self.system.set_drum_torque(torque)
         self.params[P_TAU] = torque
 
+    def set_core_mode(self, core: int) -> None:
+        """Lock the core mode of :meth:`rhs` (see :meth:`WinderSystem.set_core_mode`)."""
+        self.system.set_core_mode(core)
+        self.core = core
+
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """``dy/dt`` with the clamped nip law (for scipy's integrators)."""
         self.nfev += 1
         dy = np.empty(self.n_states)
-        evaluate(t, y, self.params, AUTO, dy, self._aux)
+        evaluate(t, y, self.params, AUTO, dy, self._aux, self.core)
         if not math.isfinite(dy[2] + dy[3]):
             raise self.system.blowup_error(t, y, dy)
         return dy

@@ -177,6 +177,7 @@ class Solver:
     rtol: float = 1e-6
     atol: float = 1e-8
     max_rhs: int = 50_000_000
+    max_wall: float = 600.0
     backend: str = "compiled"
     max_wall: float = 600.0
 

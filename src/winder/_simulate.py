@@ -1,53 +1,138 @@
-"""Time integration of a scene: breakpoints, contact events, guards, progress."""
+"""Time integration of a scene: arguments, breakpoints, contact and core events, budgets,
+progress."""
 
 from __future__ import annotations
 
 import math
+import numbers
+import os
 import sys
 import time
+from collections.abc import Callable
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from scipy.integrate import solve_ivp
+from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, DenseOutput, OdeSolver, Radau
+from scipy.optimize import brentq
 
 from . import _integrators as integ
-from ._errors import SimulationError
-from ._planar import PlanarSystem, pack, switch
+from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError
+from ._planar import AT_CORE, CORE_AUTO, WINDING, PlanarSystem, core_mode_of, pack
 from ._result import Result
-from ._scene import BACKENDS, METHODS, Scene
+from ._scene import BACKENDS, METHODS, Scene, load_scene
 from ._system import WinderSystem
 
-__all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS"]
+__all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
+           "check_real", "check_tolerances", "check_budgets", "budget_error"]
 
 #: What ``method="auto"`` picks (chosen from the work–precision study, docs/), per backend.
 DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
 #: Methods that run entirely compiled (planar backend only).
 COMPILED_METHODS = ("DOPRI5",)
-_CHUNK = 200_000  # evaluations per compiled call (progress, guards)
-_STEP_OVER = 1e-6  # [s] integrated without event location after a grazing contact
+#: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
+MAX_SAMPLES = 10_000_000
+_WALL_EVERY = 256  # evaluations between wall-clock checks on the Python paths
+_STEP_OVER = 1e-6  # [s] integrated without contact events after a grazing contact
+_SCIPY = {"RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF, "LSODA": LSODA,
+          "RK23": RK23}
+_IMPLICIT = ("Radau", "BDF", "LSODA")
+JACOBIANS = ("fd", "pinocchio")
+
+
+# ---- arguments ----------------------------------------------------------------------
+
+def check_real(name: str, value: Any, ok: Callable[[float], bool], valid: str) -> float:
+    """``value`` as a float if it is a real number with ``ok(value)``; else
+    :class:`~winder.ArgumentTypeError` (not a number) or :class:`~winder.ArgumentError`
+    naming ``name``, the value and ``valid`` (the valid range, in words)."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+        raise ArgumentTypeError(f"{name} must be a real number ({valid}), got {value!r} of "
+                                f"type {type(value).__name__}")
+    v = float(value)
+    if not ok(v):
+        raise ArgumentError(f"{name} = {value!r} is out of range; valid: {valid}")
+    return v
+
+
+def check_tolerances(rtol: Any, atol: Any) -> tuple[float, float]:
+    """Validated ``(rtol, atol)``: rtol finite in ``(0, 1)``, atol finite and ``> 0``."""
+    r = check_real("rtol", rtol, lambda v: math.isfinite(v) and 0.0 < v < 1.0,
+                   "finite, > 0 and < 1 (a relative tolerance, e.g. 1e-6)")
+    a = check_real("atol", atol, lambda v: math.isfinite(v) and v > 0.0,
+                   "finite and > 0 (an absolute tolerance in state units, e.g. 1e-8)")
+    return r, a
+
+
+def check_budgets(max_rhs: Any, max_wall: Any) -> tuple[int, float]:
+    """Validated ``(max_rhs, max_wall)``: a whole number of evaluations ``>= 1`` and a wall
+    time ``> 0`` [s] (``inf`` for none)."""
+    n = check_real("max_rhs", max_rhs, lambda v: math.isfinite(v) and v >= 1 and v == int(v),
+                   "a whole number >= 1 (right-hand side evaluations)")
+    w = check_real("max_wall", max_wall, lambda v: v > 0.0,
+                   "> 0 (wall-clock seconds; inf for no limit)")
+    return int(n), w
+
+
+def _check_choice(name: str, value: Any, valid: tuple[str, ...]) -> str:
+    if not isinstance(value, str):
+        raise ArgumentTypeError(f"{name} must be a string, one of {', '.join(valid)}; got "
+                                f"{value!r} of type {type(value).__name__}")
+    if value not in valid:
+        raise ArgumentError(f"{name} = {value!r} is unknown; valid: {', '.join(valid)}")
+    return value
+
+
+def _check_bool(name: str, value: Any) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise ArgumentTypeError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _as_scene(scene: Any) -> Scene:
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, str | os.PathLike):
+        return load_scene(scene)
+    raise ArgumentTypeError(f"scene must be a winder.Scene or the path of a scene file (str "
+                            f"or pathlib.Path), got {type(scene).__name__}: {scene!r:.80}")
+
+
+def resolve_backend(backend: str | None, scene: Scene) -> str:
+    """The backend to run: ``backend`` or ``[solver] backend``."""
+    return _check_choice("backend", scene.solver.backend if backend is None else backend,
+                         BACKENDS)
 
 
 def resolve_method(method: str | None, scene: Scene, backend: str | None = None) -> str:
-    m = method or scene.solver.method
-    if m not in METHODS:
-        raise SimulationError(f"unknown method {m!r}; valid: {', '.join(METHODS)}")
+    """The method to run (``auto`` resolved per backend, :data:`DEFAULT_METHOD`)."""
+    m = _check_choice("method", scene.solver.method if method is None else method, METHODS)
     b = resolve_backend(backend, scene)
     if m == "auto":
         return DEFAULT_METHOD[b]
     if m in COMPILED_METHODS and b != "compiled":
-        raise SimulationError(f"method {m!r} needs backend 'compiled', got {b!r}; valid "
-                              f"methods for backend {b!r}: "
-                              + ", ".join(x for x in METHODS if x not in COMPILED_METHODS))
+        raise ArgumentError(f"method = {m!r} needs backend 'compiled', got {b!r}; valid "
+                            f"methods for backend {b!r}: "
+                            + ", ".join(x for x in METHODS if x not in COMPILED_METHODS))
     return m
 
 
-def resolve_backend(backend: str | None, scene: Scene) -> str:
-    b = backend or scene.solver.backend
-    if b not in BACKENDS:
-        raise SimulationError(f"unknown backend {b!r}; valid: {', '.join(BACKENDS)}")
-    return b
+def _output_grid(t_s: float, T: float, dt: float, t_key: str, dt_key: str) -> np.ndarray:
+    """Output times from ``t_s`` to ``T`` every ``dt`` (``T`` included); refuses more than
+    :data:`MAX_SAMPLES` before allocating."""
+    count = (T - t_s) / dt + 1.0
+    if not count <= MAX_SAMPLES:
+        raise ArgumentError(f"{t_key} = {T:g} s with {dt_key} = {dt:g} s asks for {count:.3g} "
+                            f"output samples; the limit is {MAX_SAMPLES:,} samples: raise "
+                            f"{dt_key} or shorten {t_key}")
+    n_out = int(math.floor((T - t_s) / dt + 1e-9)) + 1
+    t_out = np.minimum(t_s + np.arange(n_out) * dt, T)
+    if t_out[-1] < T - 1e-12 * T:
+        t_out = np.append(t_out, T)
+    return t_out
 
+
+# ---- progress and budgets -------------------------------------------------------------
 
 class _Progress:
     """Progress on stderr: a one-line bar redrawn at most every 0.2 s on a terminal;
@@ -77,88 +162,251 @@ class _Progress:
             sys.stderr.write("\n")
 
 
-def _rk4(fun: Any, t0: float, t1: float, y0: np.ndarray, h: float,
-         t_eval: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-    """Classical fixed-step RK4 (real-time capable); output at ``t_eval`` by cubic
-    Hermite interpolation within a step."""
-    n = max(1, math.ceil((t1 - t0) / h - 1e-9))
-    h = (t1 - t0) / n
-    out = np.empty((len(y0), len(t_eval)))
-    k = 0
-    y, t = y0.astype(float), t0
-    f0 = fun(t, y)
-    nfev = 1
-    for i in range(n):
-        k1 = f0
-        k2 = fun(t + h / 2, y + h / 2 * k1)
-        k3 = fun(t + h / 2, y + h / 2 * k2)
-        k4 = fun(t + h, y + h * k3)
-        y1 = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        t1_ = t0 + (i + 1) * h
-        f1 = fun(t1_, y1)
-        nfev += 4
-        while k < len(t_eval) and t_eval[k] <= t1_ + 1e-12 * max(1.0, abs(t1_)):
-            s = (t_eval[k] - t) / h
-            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
-            h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
-            out[:, k] = h00 * y + h10 * h * f0 + h01 * y1 + h11 * h * f1
-            k += 1
-        y, t, f0 = y1, t1_, f1
-    return out, y, nfev
+#: How to raise each budget, from :func:`~winder.simulate` (``how`` of :func:`budget_error`).
+RAISE_SIMULATE = {"max_rhs": "simulate(max_rhs=...), [solver] max_rhs, or --max-evals on the "
+                             "command line",
+                  "max_wall": "simulate(max_wall=...), [solver] max_wall, or --max-wall on "
+                              "the command line"}
+
+
+def budget_error(kind: str, limit: float, *, meth: str, t: float, t_start: float,
+                 t_end: float, step: float | None, steps: int, stiff_steps: int | None,
+                 nfev: int, wall: float, state: dict[str, float],
+                 partial: Result | None = None, how: dict[str, str] = RAISE_SIMULATE,
+                 alternatives: str = "method='Radau' or 'LSODA'") -> BudgetExceeded:
+    """The :class:`~winder.BudgetExceeded` of a run that reached its budget ``kind``
+    (``max_rhs`` or ``max_wall``) at ``t`` [s], naming the time, the last step [s] and the
+    state, and saying which of three it is:
+
+    - the step size collapsed (last step below 1e-3 of the mean step so far, or no
+      progress): stiff or discontinuous here;
+    - stiff: over a quarter of the accepted steps (``stiff_steps`` of ``steps``) at the
+      stability limit (DOPRI5's stiffness test), with the projection below;
+    - merely long: steady steps; the evaluations and wall time to reach ``t_end`` at the
+      current rate.
+    """
+    name = "evaluation" if kind == "max_rhs" else "wall-clock"
+    value = f"{int(limit)} evaluations" if kind == "max_rhs" else f"{limit:g} s"
+    raise_it = f"raise {kind} ({how[kind]})"
+    span, done = t_end - t_start, t - t_start
+    where = ", ".join(f"{n}={v:.6g}" for n, v in state.items())
+    h = f"{step:.3g} s" if step is not None else "none yet"
+    msg = (f"{name} budget {kind} = {value} reached at t = {t:.6g} s of t_end = {t_end:g} s "
+           f"with method {meth!r} after {nfev} evaluations and {wall:.3g} s (last step {h}; "
+           f"state: {where}). ")
+    mean_step = done / steps if steps else 0.0
+    projection = ""
+    if done > 0.0:
+        projection = (f"at the current rate it needs about {nfev * span / done:.3g} "
+                      f"evaluations and {wall * span / done:.3g} s in all to reach t_end")
+    if done <= 0.0 or step is None or step < 1e-3 * mean_step:
+        msg += (f"The step size collapsed (last step {h}, mean step {mean_step:.3g} s): the "
+                f"problem is stiff or discontinuous near t = {t:.6g} s for this method; try "
+                f"{alternatives}, a looser rtol, or check the scene there; or {raise_it}.")
+    elif stiff_steps is not None and steps and stiff_steps > 0.25 * steps:
+        msg += (f"The problem is stiff for {meth!r}: {100 * stiff_steps / steps:.0f} % of "
+                f"its steps (mean {mean_step:.3g} s) are limited by stability, not accuracy; "
+                f"{projection}. Try {alternatives}, or {raise_it}.")
+    else:
+        msg += (f"The run is long, not stiff (steady steps, mean {mean_step:.3g} s): "
+                f"{projection}; {raise_it}.")
+    if partial is not None:
+        msg += f" The samples up to t = {partial.t[-1]:.6g} s are in .partial."
+    return BudgetExceeded(msg, time=t, state=state, step=step, partial=partial)
+
+
+class _Stop(Exception):
+    """Raised inside the right-hand side when a budget is spent (Python paths)."""
+
+    def __init__(self, kind: str) -> None:
+        super().__init__(kind)
+        self.kind = kind
 
 
 class _Guards:
-    """The run's guards, shared by the scipy and the compiled paths: evaluation budget,
-    wall clock and radius floor (one caliper below the core: the roll unwound); they also
-    drive the progress bar. Each failure names the time and the state."""
+    """The run's budgets (evaluations ``max_rhs``, wall clock ``max_wall``) and progress,
+    shared by the scipy and the compiled paths."""
 
-    def __init__(self, scene: Scene, names: tuple[str, ...], meth: str, *, limit: int,
-                 max_wall: float | None, bar: _Progress | None) -> None:
+    def __init__(self, names: tuple[str, ...], meth: str, *, limit: int, max_wall: float,
+                 bar: _Progress | None, t_start: float, t_end: float) -> None:
         self.names, self.meth = names, meth
         self.limit, self.max_wall, self.bar = limit, max_wall, bar
-        self.core_radius = scene.roll.core_radius
-        self.r_floor = scene.roll.core_radius - scene.paper.caliper
+        self.t_start, self.t_end = t_start, t_end
         self.wall0 = time.perf_counter()
+        self.steps = 0
+        self.stiff_steps: int | None = None  # known for the compiled DOPRI5
+
+    def state(self, y: np.ndarray) -> dict[str, float]:
+        return dict(zip(self.names, map(float, y), strict=True))
 
     def error(self, msg: str, t: float, y: np.ndarray) -> SimulationError:
-        state = dict(zip(self.names, map(float, y), strict=True))
+        state = self.state(y)
         where = ", ".join(f"{n}={v:.6g}" for n, v in state.items())
         return SimulationError(f"{msg} at t = {t:.6g} s (state: {where})", time=t, state=state)
 
-    def over_budget(self, t: float, y: np.ndarray) -> SimulationError:
-        return self.error(f"more than {self.limit} right-hand side evaluations (max_rhs "
-                          f"guard); the problem is stiffer than method {self.meth!r} can "
-                          "handle: try method='Radau' or 'LSODA', a looser rtol or a larger "
-                          "max_rhs", t, y)
+    def wall_spent(self) -> bool:
+        return time.perf_counter() - self.wall0 > self.max_wall
 
-    def tick(self, t: float, y: np.ndarray) -> None:
-        """Progress and the wall-clock guard (call now and then, not every evaluation)."""
+    def tick(self, t: float) -> None:
+        """Progress and the wall clock (call after each step or chunk)."""
         if self.bar is not None:
             self.bar.update(t)
-        if self.max_wall is not None and time.perf_counter() - self.wall0 > self.max_wall:
-            raise self.error(f"wall-clock guard of {self.max_wall:g} s exceeded", t, y)
+        if self.wall_spent():
+            raise _Stop("max_wall")
 
-    def check_radius(self, t: float, y: np.ndarray) -> None:
-        if y[4] < self.r_floor:
-            raise self.error(f"radius {y[4]:.6g} m fell more than one caliper below the core "
-                             f"radius {self.core_radius:g} m (the roll turned backwards and "
-                             "unwound)", t, y)
+    def exceeded(self, kind: str, t: float, y: np.ndarray, step: float | None, nfev: int,
+                 partial: Result | None) -> BudgetExceeded:
+        limit = self.limit if kind == "max_rhs" else self.max_wall
+        return budget_error(kind, limit, meth=self.meth, t=t, t_start=self.t_start,
+                            t_end=self.t_end, step=step, steps=self.steps,
+                            stiff_steps=self.stiff_steps, nfev=nfev,
+                            wall=time.perf_counter() - self.wall0, state=self.state(y),
+                            partial=partial)
 
 
-def _run_compiled(meth: str, p: np.ndarray, y0: np.ndarray, t_out: np.ndarray,
+# ---- the Python paths: scipy's solvers and RK4, one step at a time ----------------------
+
+class _HermiteDense(DenseOutput):
+    """Cubic Hermite interpolant of one RK4 step."""
+
+    def __init__(self, t_old: float, t: float, y0: np.ndarray, f0: np.ndarray,
+                 y1: np.ndarray, f1: np.ndarray) -> None:
+        super().__init__(t_old, t)
+        self.y0, self.f0, self.y1, self.f1 = y0, f0, y1, f1
+
+    def _call_impl(self, t: np.ndarray) -> np.ndarray:
+        h = self.t - self.t_old
+        s = (np.asarray(t, dtype=float) - self.t_old) / h
+        h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+        h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+        return (np.multiply.outer(self.y0, h00) + np.multiply.outer(h * self.f0, h10)
+                + np.multiply.outer(self.y1, h01) + np.multiply.outer(h * self.f1, h11))
+
+
+class _RK4(OdeSolver):
+    """Classical fixed-step RK4 as a scipy solver: steps of at most ``max_step`` evenly
+    dividing ``[t0, t_bound]``; dense output by cubic Hermite interpolation."""
+
+    def __init__(self, fun: Callable, t0: float, y0: np.ndarray, t_bound: float, *,
+                 max_step: float = 1e-3, **_: Any) -> None:
+        super().__init__(fun, t0, y0, t_bound, vectorized=False)
+        self.n_steps = max(1, math.ceil((t_bound - t0) / max_step - 1e-9))
+        self.h = (t_bound - t0) / self.n_steps
+        self.t_first, self.i = t0, 0
+        self.f = self.fun(self.t, self.y)
+        self._last: tuple[np.ndarray, ...] = ()
+
+    def _step_impl(self) -> tuple[bool, str | None]:
+        t, y, f0 = self.t, self.y, self.f
+        self.i += 1
+        t1 = self.t_bound if self.i >= self.n_steps else self.t_first + self.i * self.h
+        h = t1 - t
+        k2 = self.fun(t + h / 2, y + h / 2 * f0)
+        k3 = self.fun(t + h / 2, y + h / 2 * k2)
+        k4 = self.fun(t + h, y + h * k3)
+        y1 = y + h / 6 * (f0 + 2 * k2 + 2 * k3 + k4)
+        f1 = self.fun(t1, y1)
+        self._last = (y, f0, y1, f1)
+        self.t, self.y, self.f = t1, y1, f1
+        return True, None
+
+    def _dense_output_impl(self) -> DenseOutput:
+        return _HermiteDense(self.t_old, self.t, *self._last)
+
+
+#: An event of a segment: switching function ``g(t, y)`` and which side is new
+#: (``True``: ``g > 0``; ``False``: ``g <= 0``); the step's end on the new side fires it.
+_Event = tuple[Callable[[float, np.ndarray], float], bool]
+
+
+def _on_new_side(g: float, new_pos: bool) -> bool:
+    return g > 0.0 if new_pos else g <= 0.0
+
+
+def _locate(event: _Event, sol: DenseOutput, ta: float, tb: float,
+            y_end: np.ndarray) -> tuple[float, np.ndarray]:
+    """Time and state of an event within a step ``[ta, tb]`` whose end is on the new side:
+    the root of ``g`` on the step's interpolant (the step's end where the interpolant does
+    not change sides)."""
+    g, new_pos = event
+
+    def on_sol(t: float) -> float:
+        return g(t, sol(t))
+
+    ga, gb = on_sol(ta), on_sol(tb)
+    if _on_new_side(ga, new_pos):
+        return ta, sol(ta)
+    if not _on_new_side(gb, new_pos):
+        return tb, y_end
+    eps = np.finfo(float).eps
+    t_ev = brentq(on_sol, ta, tb, xtol=4 * eps * max(1.0, abs(tb)), rtol=4 * eps)
+    return t_ev, sol(t_ev)
+
+
+def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
+             y0: np.ndarray, t_stop: float, events: list[_Event], t_out: np.ndarray,
+             Ys: np.ndarray, filled: int, guards: _Guards, meth: str
+             ) -> tuple[float, np.ndarray, int, int]:
+    """Integrate from ``t0`` until ``t_stop`` or the first event; samples into ``Ys``.
+    Returns ``(t, y, filled, event index or -1)``. A spent budget raises :class:`_Stop`
+    carrying the last accepted ``(t, y, step)``."""
+    while filled < len(t_out) and t_out[filled] <= t0:
+        Ys[:, filled] = y0
+        filled += 1
+    solver = None
+    try:
+        solver = make(t0, y0, t_stop)
+        while True:
+            message = solver.step()
+            if solver.status == "failed":
+                raise guards.error(f"integrator {meth} failed: {message}; try a stiff "
+                                   "method (Radau, BDF) or a looser/tighter rtol",
+                                   float(solver.t), solver.y)
+            guards.steps += 1
+            t_a, t_b, y_b = float(solver.t_old), float(solver.t), solver.y
+            hit, t_lim, y_lim, sol = -1, t_b, y_b, None
+            for i, (g, new_pos) in enumerate(events):
+                if _on_new_side(g(t_b, y_b), new_pos):
+                    sol = sol or solver.dense_output()
+                    t_ev, y_ev = _locate(events[i], sol, t_a, t_b, y_b)
+                    if hit < 0 or t_ev < t_lim:
+                        hit, t_lim, y_lim = i, t_ev, y_ev
+            while filled < len(t_out) and t_out[filled] <= t_lim:
+                if t_out[filled] == t_b:
+                    Ys[:, filled] = y_b
+                else:
+                    sol = sol or solver.dense_output()
+                    Ys[:, filled] = sol(t_out[filled])
+                filled += 1
+            if hit >= 0:
+                return t_lim, np.array(y_lim, dtype=float), filled, hit
+            if solver.status == "finished":
+                return t_b, np.array(y_b, dtype=float), filled, -1
+            guards.tick(t_b)
+    except _Stop as stop:
+        t, y = (float(solver.t), solver.y) if solver is not None else (t0, y0)
+        step = solver.step_size if solver is not None else None
+        stop.at = (t, np.array(y, dtype=float), step, filled)  # type: ignore[attr-defined]
+        raise
+
+
+# ---- the compiled paths ----------------------------------------------------------------
+
+def _run_compiled(meth: str, p: np.ndarray, y: np.ndarray, t_out: np.ndarray,
                   Ys: np.ndarray, breaks: list[float], rtol: float, atol: float,
-                  max_step: float | None, guards: _Guards) -> tuple[int, tuple[int, int]]:
-    """Integrate with a compiled method in chunks of :data:`_CHUNK` evaluations (progress,
-    guards between chunks). Returns samples written and ``(nfev, events)``."""
-    stats = np.zeros(4, dtype=np.int64)
-    y = np.array(y0, dtype=float)
+                  max_step: float | None, guards: _Guards, stats: np.ndarray,
+                  at: list[Any]) -> int:
+    """Integrate ``y`` in place with a compiled method in chunks of
+    :data:`~winder._integrators.CHUNK` evaluations (progress and budgets between chunks).
+    Returns the samples written; ``at`` holds ``[t, step, samples]`` of the last chunk
+    (for a budget error)."""
     t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
     for tb in breaks:
         while t < tb:
-            budget = min(_CHUNK, guards.limit - int(stats[0]))
+            budget = min(integ.CHUNK, guards.limit - int(stats[0]))
             if budget <= 0:
-                raise guards.over_budget(t, y)
+                raise _Stop("max_rhs")
             if meth == "DOPRI5":
                 status, t, h, k = integ.dopri5(t, tb, y, p, rtol, atol, h, hmax, t_out, Ys,
                                                k, budget, stats)
@@ -167,7 +415,11 @@ def _run_compiled(meth: str, p: np.ndarray, y0: np.ndarray, t_out: np.ndarray,
                 t_next = min(tb, t + step * budget / 4)
                 if tb - t_next < 1e-9 * step:
                     t_next = tb
-                status, t, _, k = integ.rk4(t, t_next, y, p, step, t_out, Ys, k, stats)
+                status, t, h, k = integ.rk4(t, t_next, y, p, step, t_out, Ys, k, stats)
+            at[:] = [t, h, k]
+            guards.steps = int(stats[1])
+            if meth == "DOPRI5":
+                guards.stiff_steps = int(stats[4])
             if status == integ.NON_FINITE or not np.all(np.isfinite(y)):
                 raise guards.error(f"the state went non-finite with method {meth!r}; try a "
                                    "stiff method (method='Radau', 'BDF' or 'LSODA') or a "
@@ -176,13 +428,15 @@ def _run_compiled(meth: str, p: np.ndarray, y0: np.ndarray, t_out: np.ndarray,
                 raise guards.error(f"step size underflow with method {meth!r} (the problem "
                                    "is too stiff or discontinuous for it): try "
                                    "method='Radau' or 'LSODA'", t, y)
-            guards.check_radius(t, y)
-            guards.tick(t, y)
-    return k, (int(stats[0]), int(stats[3]))
+            guards.tick(t)
+    return k
 
 
-def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = None,
-             rtol: float | None = None, atol: float | None = None, progress: bool = False,
+# ---- simulate -----------------------------------------------------------------------
+
+def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
+             method: str | None = None, rtol: float | None = None,
+             atol: float | None = None, progress: bool = False,
              output_step: float | None = None, events: bool = True,
              max_step: float | None = None, max_rhs: int | None = None,
              max_wall: float | None = None, backend: str | None = None,
@@ -190,20 +444,28 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
              jacobian: str = "fd") -> Result:
     """Simulate a scene and return its result channels.
 
+    Every argument is checked before any work: a bad one raises
+    :class:`~winder.ArgumentError` (or :class:`~winder.ArgumentTypeError`) naming it, the
+    value and the valid range.
+
     Parameters
     ----------
-    scene: from :func:`winder.load_scene`.
-    t_end: end time [s] (default: ``[scene] duration``).
+    scene: from :func:`winder.load_scene`, or the path of a scene file.
+    t_end: end time [s], finite and > 0 (default: ``[scene] duration``).
     method: one of ``auto`` (:data:`DEFAULT_METHOD`), DOPRI5 (compiled Dormand–Prince
         with contact events), RK4 (fixed step ``max_step``, default 1 ms), or scipy's
         RK45, DOP853, Radau, BDF, LSODA, RK23; default ``[solver] method``.
-    rtol, atol: tolerances (default ``[solver]``).
+    rtol, atol: tolerances, rtol finite in (0, 1), atol finite > 0 (default ``[solver]``).
     progress: print a progress bar on stderr.
-    output_step: sampling of the result [s] (default ``[scene] output_step``).
-    events: locate contact lift-off and touch-down and restart the integrator there.
-    max_step: largest step [s] (the step of RK4).
-    max_rhs, max_wall: guards: right-hand side evaluations, wall-clock seconds; exceeding
-        one raises :class:`~winder.SimulationError` naming time and state.
+    output_step: sampling of the result [s], finite > 0 (default ``[scene] output_step``);
+        at most :data:`MAX_SAMPLES` samples.
+    events: locate contact lift-off and touch-down and restart the integrator there. (The
+        core events of spec §2, the roll unwinding to its core and turning forwards
+        again, are located on every path.)
+    max_step: largest step [s], finite > 0 (the step of RK4).
+    max_rhs, max_wall: budgets: right-hand side evaluations (default ``[solver] max_rhs``)
+        and wall-clock seconds (default ``[solver] max_wall``); reaching one raises
+        :class:`~winder.BudgetExceeded` with the samples so far in ``.partial``.
     backend: ``compiled`` (planar equations in numba, default) or ``pinocchio`` (ABA
         with the variable-mass terms); default ``[solver] backend``.
     t_start, initial_state: start the run at ``t_start`` [s] from a full state vector
@@ -213,148 +475,193 @@ def simulate(scene: Scene, *, t_end: float | None = None, method: str | None = N
 
     Raises
     ------
-    SimulationError: the integrator failed, a state went non-finite, or a guard tripped.
+    ArgumentError, ArgumentTypeError: a bad argument (nothing was run).
+    BudgetExceeded: the run reached ``max_rhs`` or ``max_wall``.
+    SimulationError: the integrator failed or a state went non-finite.
     """
-    system = WinderSystem(scene)
+    scene = _as_scene(scene)
     be = resolve_backend(backend, scene)
-    planar = PlanarSystem(scene, system) if be == "compiled" else None
-    T = scene.scene.duration if t_end is None else float(t_end)
-    if not (math.isfinite(T) and T > 0):
-        raise SimulationError(f"t_end must be finite and > 0, got {t_end!r}")
     meth = resolve_method(method, scene, be)
-    rtol = scene.solver.rtol if rtol is None else float(rtol)
-    atol = scene.solver.atol if atol is None else float(atol)
-    dt = scene.scene.output_step if output_step is None else float(output_step)
-    limit = scene.solver.max_rhs if max_rhs is None else int(max_rhs)
-    t_s = float(t_start)
-    if not (math.isfinite(t_s) and 0.0 <= t_s < T):
-        raise SimulationError(f"t_start must be finite, >= 0 and < t_end = {T:g}, got "
-                              f"{t_start!r}")
-    n_out = int(math.floor((T - t_s) / dt + 1e-9)) + 1
-    t_out = np.minimum(t_s + np.arange(n_out) * dt, T)
-    if t_out[-1] < T - 1e-12 * T:
-        t_out = np.append(t_out, T)
+    _check_choice("jacobian", jacobian, JACOBIANS)
+    progress, events = _check_bool("progress", progress), _check_bool("events", events)
+    rtol, atol = check_tolerances(scene.solver.rtol if rtol is None else rtol,
+                                  scene.solver.atol if atol is None else atol)
+    limit, wall_limit = check_budgets(scene.solver.max_rhs if max_rhs is None else max_rhs,
+                                      scene.solver.max_wall if max_wall is None else max_wall)
+    positive = "finite and > 0 [s]"
+    t_key = "[scene] duration" if t_end is None else "t_end"
+    T = check_real(t_key, scene.scene.duration if t_end is None else t_end,
+                   lambda v: math.isfinite(v) and v > 0.0, positive)
+    dt_key = "[scene] output_step" if output_step is None else "output_step"
+    dt = check_real(dt_key, scene.scene.output_step if output_step is None else output_step,
+                    lambda v: math.isfinite(v) and v > 0.0, positive)
+    if max_step is not None:
+        max_step = check_real("max_step", max_step, lambda v: math.isfinite(v) and v > 0.0,
+                              positive)
+    t_s = check_real("t_start", t_start, lambda v: math.isfinite(v) and 0.0 <= v < T,
+                     f"finite, >= 0 and < {t_key} = {T:g} [s]")
+    t_out = _output_grid(t_s, T, dt, t_key, dt_key)
+    system = WinderSystem(scene)
+    r_core = scene.roll.core_radius
     if initial_state is None:
         y0 = system.initial_state()
     else:
-        y0 = np.array(initial_state, dtype=float)
-        if y0.shape != (system.n_states,) or not np.all(np.isfinite(y0)):
-            raise SimulationError(f"initial_state must be {system.n_states} finite values "
-                                  f"({', '.join(system.state_names)}), got {initial_state!r}")
+        try:
+            y0 = np.array(initial_state, dtype=float)
+        except (TypeError, ValueError):
+            raise ArgumentTypeError(f"initial_state must be {system.n_states} numbers, got "
+                                    f"{initial_state!r:.200}") from None
+        if y0.shape != (system.n_states,) or not np.all(np.isfinite(y0)) or y0[4] < r_core:
+            given = ", ".join(f"{v:.9g}" for v in y0.ravel()[:20])
+            raise ArgumentError(f"initial_state = [{given}] is not valid: valid are "
+                                f"{system.n_states} finite values "
+                                f"({', '.join(system.state_names)}) with radius >= the core "
+                                f"radius {r_core:g} m")
+    planar = PlanarSystem(scene, system) if be == "compiled" else None
     bar = _Progress(T, scene.name) if progress else None
-    guards = _Guards(scene, system.state_names, meth, limit=limit, max_wall=max_wall, bar=bar)
-    counter = planar if planar is not None else system
-    rhs = counter.rhs
-
-    def fun(t: float, y: np.ndarray) -> np.ndarray:
-        if counter.nfev >= limit:
-            raise guards.over_budget(t, y)
-        if counter.nfev % 2000 == 0:
-            guards.tick(t, y)
-        guards.check_radius(t, y)
-        return rhs(t, y)
-
+    guards = _Guards(system.state_names, meth, limit=limit, max_wall=wall_limit, bar=bar,
+                     t_start=t_s, t_end=T)
+    counter: PlanarSystem | WinderSystem = planar if planar is not None else system
     breaks = sorted({b for b in system.drive.breakpoints if t_s < b < T} | {T})
-    use_events = events and system.contact is not None and meth != "RK4"
-    compiled_run = planar is not None and meth in (*COMPILED_METHODS, "RK4")
-    p_switch = planar.params if planar is not None else pack(scene)
-
-    def gap(t: float, y: np.ndarray) -> float:  # min(δ, F_unclamped/k); > 0: F_n > 0
-        return switch(t, y, p_switch)
-
-    gap.terminal = True  # type: ignore[attr-defined]
     Ys = np.empty((len(y0), len(t_out)))
-    filled = 0
-    t0, y = t_s, y0
-    n_events = 0
-    expect = 0.0
-    step_over_until = -math.inf
-    events_lost: float | None = None
-    options: dict[str, Any] = {"rtol": rtol, "atol": atol}
-    if jacobian not in ("fd", "pinocchio"):
-        raise SimulationError(f"unknown jacobian {jacobian!r}; valid: fd, pinocchio")
-    if jacobian == "pinocchio" and meth in ("Radau", "BDF", "LSODA"):
-        from ._linearise import jacobian as _jac
-
-        jac_system = WinderSystem(scene)
-        options["jac"] = lambda t, y: _jac(jac_system, t, y)
-    if max_step is not None:
-        options["max_step"] = max_step
+    compiled_run = planar is not None and meth in (*COMPILED_METHODS, "RK4")
+    stats = np.zeros(5, dtype=np.int64)
+    at: list[Any] = [t_s, None, 0]
     try:
-        for tb in () if compiled_run else breaks:
-            while t0 < tb:
-                t_stop = tb if t0 >= step_over_until else min(tb, step_over_until)
-                mask = (t_out >= t0) & (t_out <= t_stop)
-                if filled:  # points already written (the start of a restarted segment)
-                    mask[:filled] = False
-                t_eval = t_out[mask]
-                if meth == "RK4":
-                    h = max_step or 1e-3
-                    Yseg, y, _ = _rk4(fun, t0, tb, y, h, t_eval)
-                    Ys[:, filled:filled + len(t_eval)] = Yseg
-                    filled += len(t_eval)
-                    t0 = tb
-                    continue
-                ev = None
-                if use_events and t0 >= step_over_until:
-                    if expect == 0.0:  # first segment: look for leaving the current side
-                        expect = -1.0 if gap(t0, y) > 0.0 else 1.0
-                    gap.direction = expect  # type: ignore[attr-defined]
-                    ev = [gap]
-                extra = not (len(t_eval) and t_eval[-1] == t_stop)
-                te = np.append(t_eval, t_stop) if extra else t_eval
-                try:
-                    sol = solve_ivp(fun, (t0, t_stop), y, method=meth, t_eval=te, events=ev,
-                                    **options)
-                except ValueError as exc:
-                    # scipy's root bracketing fails when a method's interpolant disagrees
-                    # with its step ends (seen with LSODA): finish without event location
-                    if ev is None or "different signs" not in str(exc):
-                        raise
-                    use_events, events_lost = False, t0
-                    continue
-                if sol.status < 0:
-                    ys = np.asarray(sol.y, dtype=float).reshape(len(y0), -1)
-                    t_bad, y_bad = (float(sol.t[-1]), ys[:, -1]) if ys.shape[1] else (t0, y)
-                    raise guards.error(f"integrator {meth} failed: {sol.message}; try a stiff "
-                                       "method (Radau, BDF) or a looser/tighter rtol", t_bad,
-                                       y_bad)
-                cols = np.asarray(sol.y, dtype=float).reshape(len(y0), -1)
-                if sol.status == 0 and extra:
-                    cols = cols[:, :-1]
-                k = cols.shape[1]
-                Ys[:, filled:filled + k] = cols
-                filled += k
-                if sol.status == 1:  # contact event: restart exactly there
-                    n_events += 1
-                    t_ev, y_ev = float(sol.t_events[0][0]), sol.y_events[0][0]
-                    expect = -expect  # lift-off is followed by touch-down and vice versa
-                    if t_ev - t0 <= 1e-10 * max(1.0, abs(t0)):
-                        # grazing: the crossing is back at the restart point; step over
-                        # a short stretch without event location, then re-arm
-                        step_over_until, expect = t0 + _STEP_OVER, 0.0
-                    t0, y = t_ev, y_ev
-                else:
-                    t0, y = t_stop, sol.y[:, -1]
-        if compiled_run:
-            filled, (planar.nfev, n_events) = _run_compiled(meth, planar.params, y, t_out,
-                                                            Ys, breaks, rtol, atol, max_step,
-                                                            guards)
+        try:
+            if compiled_run:
+                y = np.array(y0)
+                filled = _run_compiled(meth, planar.params, y, t_out, Ys, breaks, rtol, atol,
+                                       max_step, guards, stats, at)
+                planar.nfev, n_events = int(stats[0]), int(stats[3])
+            else:
+                filled, n_events = _run_python(scene, counter, meth, y0, t_s, t_out, Ys, breaks,
+                                               rtol, atol, max_step, events, jacobian, guards)
+        except _Stop as stop:
+            counter.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
+            if compiled_run:
+                planar.nfev = int(stats[0])
+                t_at, h_at, filled = at
+                y_at = y
+            else:
+                t_at, y_at, h_at, filled = stop.at  # type: ignore[attr-defined]
+            partial = None
+            if filled:
+                np.maximum(Ys[4, :filled], r_core, out=Ys[4, :filled])
+                wall = time.perf_counter() - guards.wall0
+                partial = Result(counter.channels(t_out[:filled], Ys[:, :filled]),
+                                 _meta(scene, meth, be, rtol, atol, counter.nfev, wall, 0,
+                                       t_s, T, partial=True))
+            raise guards.exceeded(stop.kind, t_at, y_at, h_at, counter.nfev,
+                                  partial) from None
     finally:
         if bar is not None:
             bar.close()
     if filled != len(t_out):
         raise SimulationError(f"internal error: {filled} of {len(t_out)} output samples")
     wall = time.perf_counter() - guards.wall0
-    nfev = counter.nfev
+    counter.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
+    # interpolated samples between a step's start and its core event may dip below r_c
+    # by round-off; the state never does
+    np.maximum(Ys[4], r_core, out=Ys[4])
     channels = counter.channels(t_out, Ys)
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
     if bad:
         raise SimulationError(f"non-finite values in result channels {bad}")
-    meta = {"scene": scene.name, "source": scene.source, "method": meth, "backend": be,
-            "rtol": rtol, "atol": atol, "rhs_evaluations": nfev, "wall_time": wall,
-            "events": n_events, "event_location_stopped_at": events_lost,
-            "t_start": t_s, "t_end": T, "effects": list(scene.effects.enabled()),
-            "drum_radius": scene.drum.radius, "scene_dict": scene.to_dict()}
-    return Result(channels, meta)
+    return Result(channels, _meta(scene, meth, be, rtol, atol, counter.nfev, wall, n_events,
+                                  t_s, T))
 
+
+def _meta(scene: Scene, meth: str, be: str, rtol: float, atol: float, nfev: int,
+          wall: float, n_events: int, t_s: float, T: float, *,
+          partial: bool = False) -> dict[str, Any]:
+    """The ``meta`` of a result; ``wall`` [s] is the integration's wall time."""
+    return {"scene": scene.name, "source": scene.source, "method": meth, "backend": be,
+            "rtol": rtol, "atol": atol, "rhs_evaluations": nfev,
+            "wall_time": wall, "events": n_events,
+            "t_start": t_s, "t_end": T, "effects": list(scene.effects.enabled()),
+            "drum_radius": scene.drum.radius, "scene_dict": scene.to_dict(),
+            "partial": partial}
+
+
+def _run_python(scene: Scene, counter: PlanarSystem | WinderSystem, meth: str,
+                y0: np.ndarray, t_s: float, t_out: np.ndarray, Ys: np.ndarray,
+                breaks: list[float], rtol: float, atol: float, max_step: float | None,
+                events: bool, jacobian: str, guards: _Guards) -> tuple[int, int]:
+    """scipy's solvers and RK4, one step at a time: contact events (restart at lift-off
+    and touch-down, stepping over grazing contacts) and core events (spec §2: land on the
+    core, ``ṙ = 0`` locked until the roll turns forwards). Returns ``(samples, events)``."""
+    rhs, limit = counter.rhs, guards.limit
+    r_core = scene.roll.core_radius
+
+    def fun(t: float, y: np.ndarray) -> np.ndarray:
+        n = counter.nfev
+        if n >= limit:
+            raise _Stop("max_rhs")
+        if n % _WALL_EVERY == 0 and guards.wall_spent():
+            raise _Stop("max_wall")
+        return rhs(t, y)
+
+    options: dict[str, Any] = {"rtol": rtol, "atol": atol}
+    if max_step is not None:
+        options["max_step"] = max_step
+    if meth == "RK4":
+        cls: Any = _RK4
+        options = {"max_step": max_step or 1e-3}
+    else:
+        cls = _SCIPY[meth]
+    if jacobian == "pinocchio" and meth in _IMPLICIT:
+        from ._linearise import jacobian as _jac
+
+        jac_system = WinderSystem(scene)
+
+        def jac(t: float, y: np.ndarray) -> np.ndarray:
+            jac_system.set_core_mode(counter.core)
+            return _jac(jac_system, t, y)
+
+        options["jac"] = jac
+
+    def make(t0: float, y: np.ndarray, t1: float) -> OdeSolver:
+        return cls(fun, t0, y, t1, **options)
+
+    p = counter.params if isinstance(counter, PlanarSystem) else pack(scene)
+
+    def event(which: int) -> Callable[[float, np.ndarray], float]:
+        return lambda t, y: integ.switching(which, t, y, p)
+
+    gap, unwound, forward = event(integ.G_CONTACT), event(integ.G_UNWOUND), \
+        event(integ.G_FORWARD)
+    contact_events = events and scene.effects.contact and meth != "RK4"
+    filled, n_events, t0, y = 0, 0, t_s, np.array(y0, dtype=float)
+    core = core_mode_of(y, p)
+    counter.set_core_mode(core)
+    step_over_until = -math.inf
+    touching: bool | None = None  # contact side; None: read it from the state
+    for tb in breaks:
+        while t0 < tb:
+            stepping_over = t0 < step_over_until
+            t_stop = min(tb, step_over_until) if stepping_over else tb
+            evs: list[_Event] = [(unwound, True) if core == WINDING else (forward, True)]
+            if contact_events and not stepping_over:
+                if touching is None:
+                    touching = gap(t0, y) > 0.0
+                evs.append((gap, not touching))  # the event leaves the current side
+            t1, y, filled, hit = _segment(make, t0, y, t_stop, evs, t_out, Ys, filled,
+                                          guards, meth)
+            if hit == 0:  # core event: land on the core, or leave it turning forwards
+                n_events += 1
+                if core == WINDING:
+                    y[4] = r_core
+                    core = AT_CORE
+                else:
+                    core = WINDING
+                counter.set_core_mode(core)
+            elif hit == 1:  # contact event: restart exactly there
+                n_events += 1
+                touching = not touching  # lift-off is followed by touch-down and vice versa
+                if t1 - t0 <= 1e-10 * max(1.0, abs(t0)):
+                    # grazing: the crossing is back at the restart point; step over a
+                    # short stretch without contact events, then re-arm
+                    step_over_until, touching = t0 + _STEP_OVER, None
+            t0 = t1
+    return filled, n_events

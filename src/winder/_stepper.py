@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import math
+import time
+from typing import Any
 
 import numpy as np
 
 from . import _integrators as integ
-from ._errors import SimulationError
+from ._errors import ArgumentError, SimulationError
 from ._planar import PlanarSystem
+from ._result import Result
 from ._scene import Scene
+from ._simulate import budget_error, check_budgets, check_real, check_tolerances
 from ._system import CHANNELS, EXTRA_CHANNELS, WinderSystem
 
 __all__ = ["Stepper", "INPUTS", "OUTPUTS"]
@@ -18,14 +22,20 @@ __all__ = ["Stepper", "INPUTS", "OUTPUTS"]
 INPUTS = ("drum_torque",)
 #: Outputs: every result channel but ``t``.
 OUTPUTS = CHANNELS[1:] + EXTRA_CHANNELS
+_RAISE = {"max_rhs": "Stepper(max_rhs=...) or [solver] max_rhs; it is the budget of one step",
+          "max_wall": "Stepper(max_wall=...) or [solver] max_wall; it is the budget of one "
+                      "step"}
 
 
 class Stepper:
     """A scene advanced by fixed communication steps, with inputs set between steps.
 
     Inside each step the compiled DOPRI5 of :func:`winder.simulate` (adaptive, contact
-    events located, drive breakpoints respected) integrates to ``rtol``; the step size of
-    the integrator carries over between communication steps, so short steps cost little.
+    and core events located, drive breakpoints respected) integrates to ``rtol``; the
+    step size of the integrator carries over between communication steps, so short steps
+    cost little. Each step has a budget (``max_rhs`` evaluations, ``max_wall`` seconds):
+    a step that reaches it raises :class:`~winder.BudgetExceeded` and leaves the stepper
+    at the time reached (``t``), from where it may go on.
 
     >>> sim = Stepper(scene)                       # doctest: +SKIP
     >>> sim.set_input("drum_torque", 250.0)        # doctest: +SKIP
@@ -34,17 +44,23 @@ class Stepper:
 
     Parameters
     ----------
-    scene: the scene (drive kind ``torque`` for a torque input).
-    rtol, atol: tolerances of the internal integrator (default ``1e-8``, ``1e-10``).
+    scene: the scene (drive kind ``torque`` for a torque input; its ``[drum.drive]
+        torque`` is the input until :meth:`set_input` changes it).
+    rtol, atol: tolerances of the internal integrator (default ``1e-8``, ``1e-10``): rtol
+        finite in (0, 1), atol finite > 0.
+    max_rhs, max_wall: budget of each :meth:`step`: evaluations and wall-clock seconds
+        (default ``[solver] max_rhs`` and ``max_wall``).
     """
 
-    def __init__(self, scene: Scene, *, rtol: float = 1e-8, atol: float = 1e-10) -> None:
-        if not (rtol > 0 and atol > 0):
-            raise SimulationError(f"rtol and atol must be > 0, got {rtol!r}, {atol!r}")
+    def __init__(self, scene: Scene, *, rtol: float = 1e-8, atol: float = 1e-10,
+                 max_rhs: int | None = None, max_wall: float | None = None) -> None:
+        self.rtol, self.atol = check_tolerances(rtol, atol)
+        self.max_rhs, self.max_wall = check_budgets(
+            scene.solver.max_rhs if max_rhs is None else max_rhs,
+            scene.solver.max_wall if max_wall is None else max_wall)
         self.scene = scene
         self.system = WinderSystem(scene)
         self._planar = PlanarSystem(scene, self.system)
-        self.rtol, self.atol = float(rtol), float(atol)
         self.free_drum = scene.drum.drive.kind == "torque"
         self._breaks = tuple(self.system.drive.breakpoints)
         self.reset()
@@ -54,7 +70,7 @@ class Stepper:
         self.t = 0.0
         self.y = self.system.initial_state()
         self._h = 0.0
-        self._stats = np.zeros(4, dtype=np.int64)
+        self._stats = np.zeros(5, dtype=np.int64)
         self._outputs: dict[str, float] | None = None
 
     @property
@@ -69,35 +85,67 @@ class Stepper:
     def set_input(self, name: str, value: float) -> None:
         """Set an input (held constant over the next steps)."""
         if name not in INPUTS:
-            raise SimulationError(f"unknown input {name!r}; valid: {', '.join(INPUTS)}")
-        v = float(value)
-        if not math.isfinite(v):
-            raise SimulationError(f"input {name} must be finite, got {value!r}")
+            raise ArgumentError(f"unknown input {name!r}; valid: {', '.join(INPUTS)}")
+        v = check_real(name, value, math.isfinite, "a finite number [N·m]")
         self._planar.set_drum_torque(v)
         self._outputs = None
 
     def step(self, dt: float) -> None:
-        """Advance by ``dt`` [s]."""
-        if not (math.isfinite(dt) and dt > 0):
-            raise SimulationError(f"step size must be finite and > 0, got {dt!r}")
-        t_end = self.t + dt
+        """Advance by ``dt`` [s]: finite, and at least the time resolution at ``t``
+        (``1e-14·max(1 s, |t|)``).
+
+        Raises
+        ------
+        ArgumentError: a bad ``dt``.
+        BudgetExceeded: the step reached its budget; the stepper stays at the time
+            reached (``.time``) and may go on from there.
+        SimulationError: the integration failed.
+        """
+        resolution = integ.TIME_RESOLUTION * max(1.0, abs(self.t))
+        dt = check_real("dt", dt, lambda v: math.isfinite(v) and v >= resolution,
+                        f"finite and >= {resolution:.3g} s (the time resolution at t = "
+                        f"{self.t:.6g} s, 1e-14·max(1 s, |t|))")
+        t_start, t_end = self.t, self.t + dt
         stops = [b for b in self._breaks if self.t < b < t_end] + [t_end]
         empty_t, empty_y = np.empty(0), np.empty((len(self.y), 0))
         p = self._planar.params
+        nfev0, steps0, stiff0 = (int(x) for x in self._stats[[0, 1, 4]])
+        wall0 = time.perf_counter()
         for tb in stops:
             while self.t < tb:
+                spent = int(self._stats[0]) - nfev0
+                over = ("max_rhs" if spent >= self.max_rhs else
+                        "max_wall" if time.perf_counter() - wall0 > self.max_wall else None)
+                if over is not None:
+                    raise self._over(over, t_start, t_end, spent, steps0, stiff0, wall0)
+                budget = min(integ.CHUNK, self.max_rhs - spent)
                 status, t, h, _ = integ.dopri5(self.t, tb, self.y, p, self.rtol, self.atol,
                                                self._h, math.inf, empty_t, empty_y, 0,
-                                               10_000_000, self._stats)
+                                               budget, self._stats)
                 if status in (integ.NON_FINITE, integ.STEP_UNDERFLOW) or \
                         not np.all(np.isfinite(self.y)):
                     where = ", ".join(f"{k}={v:.6g}" for k, v in self.state.items())
-                    raise SimulationError(f"integration failed at t = {t:.6g} s (state: "
-                                          f"{where}); check the inputs", time=t,
-                                          state=self.state)
+                    what = ("the state went non-finite" if status == integ.NON_FINITE
+                            else "the step size underflowed (too stiff or discontinuous)")
+                    raise SimulationError(f"integration failed at t = {t:.6g} s: {what} "
+                                          f"(state: {where})", time=t, state=self.state)
                 self.t, self._h = (tb if status == integ.DONE else t), h
+                self._outputs = None
         self.t = t_end
         self._outputs = None
+
+    def _over(self, kind: str, t_start: float, t_end: float, nfev: int, steps0: int,
+              stiff0: int, wall0: float) -> Exception:
+        partial = Result({"t": np.array([self.t]),
+                          **{k: np.array([v]) for k, v in self.outputs().items()}},
+                         {"scene": self.scene.name, "partial": True})
+        limit: Any = self.max_rhs if kind == "max_rhs" else self.max_wall
+        return budget_error(kind, limit, meth="DOPRI5", t=self.t, t_start=t_start,
+                            t_end=t_end, step=self._h or None,
+                            steps=int(self._stats[1]) - steps0,
+                            stiff_steps=int(self._stats[4]) - stiff0, nfev=nfev,
+                            wall=time.perf_counter() - wall0, state=self.state,
+                            partial=partial, how=_RAISE, alternatives="a looser rtol")
 
     def outputs(self) -> dict[str, float]:
         """All outputs (:data:`OUTPUTS`) at the current time."""
@@ -109,5 +157,5 @@ class Stepper:
     def output(self, name: str) -> float:
         """One output at the current time."""
         if name not in OUTPUTS:
-            raise SimulationError(f"unknown output {name!r}; valid: {', '.join(OUTPUTS)}")
+            raise ArgumentError(f"unknown output {name!r}; valid: {', '.join(OUTPUTS)}")
         return self.outputs()[name]

@@ -12,8 +12,9 @@ import numpy as np
 import pinocchio as pin
 
 from ._drive import SpeedProfile, TorqueDrive, make_drive
-from ._errors import SimulationError
+from ._errors import ArgumentError, SimulationError
 from ._model import DRUM, ROLL, ROLL_Z, WinderModel
+from ._planar import AT_CORE, CORE_AUTO, WINDING
 from ._scene import Scene
 from ._variable_mass import VariableMassModel
 from .effects import EFFECTS, Context, Effect
@@ -72,6 +73,10 @@ class WinderSystem:
             self._fext.append(pin.Force.Zero())
         self._free_drum = isinstance(self.drive, TorqueDrive)
         self._tau = np.zeros(self.model.nv)
+        if isinstance(self.drive, TorqueDrive):
+            self._tau[0] = self.drive.torque  # [drum.drive] torque until set_drum_torque
+        self.core = CORE_AUTO
+        self.r_core = scene.roll.core_radius
         self.ctx = Context()
         self.nfev = 0
 
@@ -89,7 +94,7 @@ class WinderSystem:
         if roll.initial_height is not None:
             z = roll.initial_height
         elif self.contact is not None:
-            z = self.contact.initial_height(m, r, self.h_over_2pi * w, self.g)
+            z = self.contact.initial_height(m, r, self.radius_rate(r, w), self.g)
         else:
             z = self.drum_radius + r
         y = np.zeros(self.n_states)
@@ -105,9 +110,26 @@ class WinderSystem:
     def set_drum_torque(self, torque: float) -> None:
         """Input torque of a free drum (drive kind ``torque``) [N·m]."""
         if not self._free_drum:
-            raise SimulationError("drum_torque is an input only with [drum.drive] kind = "
-                                  "'torque'; this scene prescribes the drum speed")
+            raise ArgumentError("drum_torque is an input only with [drum.drive] kind = "
+                                "'torque'; this scene prescribes the drum speed")
         self._tau[0] = torque
+
+    def radius_rate(self, r: float, omega: float) -> float:
+        """``ṙ`` [m/s] of spec §2 in the current core mode: ``h ω/2π``, or 0 at the core."""
+        core = self.core
+        if core == AT_CORE or (core == CORE_AUTO and r <= self.r_core and omega < 0.0):
+            return 0.0  # at the core: nothing left to unwind
+        return self.h_over_2pi * omega
+
+    def set_core_mode(self, core: int) -> None:
+        """Lock the core mode of spec §2: ``WINDING`` (``ṙ = h ω/2π``), ``AT_CORE``
+        (``ṙ = 0``: the roll sits at its core and turns backwards) or ``CORE_AUTO`` (by the
+        state: ``ṙ = 0`` where ``r <= r_c`` and ``ω < 0``; the default). The integrators
+        lock it between the core events."""
+        if core not in (CORE_AUTO, WINDING, AT_CORE):
+            raise ArgumentError(f"core mode must be one of {CORE_AUTO}, {WINDING}, {AT_CORE}, "
+                                f"got {core!r}")
+        self.core = core
 
     # ---- evaluation -----------------------------------------------------------------
     def _fill(self, t: float, y: np.ndarray) -> Context:
@@ -118,7 +140,7 @@ class WinderSystem:
         c.theta, c.Omega, omd = self.drive.kinematics(t, y[di:di + 2])
         c.Omega_dot = math.nan if omd is None else omd
         law, r = self.law, c.r
-        c.r_dot = rdot = self.h_over_2pi * c.omega
+        c.r_dot = rdot = self.radius_rate(r, c.omega)
         c.mass, c.inertia, dm_dr, dJ_dr = law.scalars(r)  # unchecked: trial states may dip
         c.mass_rate = dm_dr * rdot
         c.inertia_rate = dJ_dr * rdot
