@@ -45,10 +45,10 @@ def check_drawable(result: Result, where: str = "result") -> None:
         bad = np.flatnonzero(~np.isfinite(result[c]))
         if len(bad):
             raise WinderError(f"{where}: channel {c!r} is not finite at t = {t[bad[0]]:g} s "
-                              f"(sample {bad[0]}: {result[c][bad[0]]!r})")
+                              f"(sample {bad[0]}: {float(result[c][bad[0]])!r})")
     small = np.flatnonzero(result["radius"] <= 0)
     if len(small):
-        raise WinderError(f"{where}: radius {result['radius'][small[0]]!r} m at t = "
+        raise WinderError(f"{where}: radius {float(result['radius'][small[0]])!r} m at t = "
                           f"{t[small[0]]:g} s; a roll radius is > 0")
 
 

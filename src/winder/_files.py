@@ -15,6 +15,7 @@ and atomic writes that leave the complete file or nothing.
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import tempfile
@@ -80,13 +81,14 @@ def _existing_ancestor(arg: str, path: Path) -> tuple[Path, list[str]]:
         try:
             here.lstat()
             break
-        except FileNotFoundError:
-            missing.append(here.name)
-            here = here.parent
-        except NotADirectoryError:
+        except (FileNotFoundError, NotADirectoryError):
             missing.append(here.name)
             here = here.parent
         except OSError as exc:
+            if exc.errno == errno.ENAMETOOLONG:
+                missing.append(here.name)
+                here = here.parent
+                continue
             raise _fail(arg, path, f"cannot be checked ({exc.strerror})") from None
     missing.reverse()
     if not here.is_dir():
@@ -121,12 +123,14 @@ def check_output_file(path: str | os.PathLike[str], arg: str, *,
     that cannot be written, or (``suffixes``) does not end in one of ``suffixes``."""
     text = os.fspath(path)
     p = _check_text(arg, text)
-    if text.endswith(("/", os.sep)) or p.is_dir():
+    if text.endswith(("/", os.sep)):
+        raise _fail(arg, p, "is a directory; give a file name")
+    here, missing = _existing_ancestor(arg, p)
+    if not missing and here.is_dir():
         raise _fail(arg, p, "is a directory; give a file name")
     if suffixes is not None and p.suffix.lower() not in suffixes:
         raise _fail(arg, p, f"unknown file type {p.suffix!r}; valid: {', '.join(suffixes)}")
-    here, missing = _existing_ancestor(arg, p)
-    if not missing and not p.is_file():
+    if not missing and not here.is_file():
         raise _fail(arg, p, "exists and is not a regular file")
     _check_writable(arg, p, here)
     return p

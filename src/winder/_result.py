@@ -199,11 +199,12 @@ def _check_channels(p: Path, arrays: dict[str, np.ndarray]) -> None:
         raise _bad(p, "no samples")
     bad = np.flatnonzero(~np.isfinite(t))
     if len(bad):
-        raise _bad(p, f"time t[{bad[0]}] = {t[bad[0]]!r} is not finite")
+        raise _bad(p, f"time t[{bad[0]}] = {float(t[bad[0]])!r} is not finite")
     back = np.flatnonzero(np.diff(t) <= 0)
     if len(back):
         i = back[0]
-        raise _bad(p, f"time is not increasing: t[{i}] = {t[i]!r}, t[{i + 1}] = {t[i + 1]!r}")
+        raise _bad(p, f"time is not increasing: t[{i}] = {float(t[i])!r}, "
+                      f"t[{i + 1}] = {float(t[i + 1])!r}")
 
 
 def load_result(path: str | Path) -> Result:
@@ -215,7 +216,7 @@ def load_result(path: str | Path) -> Result:
     p = Path(path)
     try:
         if not p.is_file():
-            raise _bad(p, "no such result file")
+            raise _bad(p, "not a file" if p.exists() else "no such result file")
         suffix = p.suffix.lower()
         if suffix == ".npz":
             arrays, meta = _read_npz(p)
