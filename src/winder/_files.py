@@ -91,7 +91,7 @@ def _existing_ancestor(arg: str, path: Path) -> tuple[Path, list[str]]:
                 continue
             raise _fail(arg, path, f"cannot be checked ({exc.strerror})") from None
     missing.reverse()
-    if not here.is_dir():
+    if missing and not here.is_dir():
         raise _fail(arg, path, f"its parent {here} is a file, not a directory")
     limit = _name_max(here)
     for name in missing:
@@ -132,7 +132,7 @@ def check_output_file(path: str | os.PathLike[str], arg: str, *,
         raise _fail(arg, p, f"unknown file type {p.suffix!r}; valid: {', '.join(suffixes)}")
     if not missing and not here.is_file():
         raise _fail(arg, p, "exists and is not a regular file")
-    _check_writable(arg, p, here)
+    _check_writable(arg, p, here if missing else here.parent)
     return p
 
 

@@ -116,10 +116,12 @@ def _handle(signo: int, frame: object) -> None:
 
 
 @contextmanager
-def handling_signals() -> Iterator[None]:
+def handling_signals(*, exiting: bool = False) -> Iterator[None]:
     """Turn SIGINT, SIGTERM and SIGHUP into :class:`Interrupted` inside the block (main
     thread only; elsewhere the block runs unchanged). Registered clean-ups left over when
-    the block ends are run."""
+    the block ends are run. ``exiting``: the process ends right after the block (the
+    command line); once stopped by a signal, further signals are then ignored instead of
+    killing it between the block and its exit."""
     try:
         previous = {s: signal.signal(s, _handle) for s in SIGNALS}
     except ValueError:  # not the main thread
@@ -132,4 +134,4 @@ def handling_signals() -> Iterator[None]:
         run_abort_cleanups()
         _State.active = False
         for s, h in previous.items():
-            signal.signal(s, h)
+            signal.signal(s, signal.SIG_IGN if exiting and _State.stopping else h)

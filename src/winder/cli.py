@@ -366,7 +366,7 @@ def _say(text: str) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; returns the exit status (see the module text)."""
-    with handling_signals():
+    with handling_signals(exiting=argv is None):
         try:
             try:
                 args = _build_parser().parse_args(argv)
