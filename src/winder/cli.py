@@ -10,13 +10,16 @@ Exit status
   SIGHUP. Temporary files are removed and child processes stopped; files already complete
   stay, no partial file is left. A second signal during that clean-up stops at once, with
   a message.
+- 141 when the reader of stdout went away (``winder modes ... | head``), as for SIGPIPE.
 - 1: an internal error of winder (a bug): the traceback and a line saying so.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
 import sys
 import traceback
 from collections.abc import Callable, Sequence
@@ -385,6 +388,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         except KeyboardInterrupt:
             _say("winder: interrupted (no partial file left)")
             return 130
+        except BrokenPipeError:  # stdout closed by the reader (winder ... | head)
+            if argv is None:  # keep Python's exit flush from failing on it too
+                with contextlib.suppress(OSError):
+                    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 128 + 13  # as if killed by SIGPIPE
         except MemoryError:
             _say("winder: error: not enough memory for this run (shorten it or sample it "
                  "more coarsely)")
