@@ -289,6 +289,11 @@ def _option_cases() -> list[Case]:
                       names=("--playback",)))
     cases.append(Case("option", "view --every 1e-9", view_opt("--every", "1e-9"),
                       names=("--every",)))
+
+    def scene_every(d: Path) -> list[str]:  # refused before the scene is simulated
+        return ["view", str(quick_scene(d)), "--snapshots", str(d / "out"), "--every", "1e-4"]
+    cases.append(Case("option", "view scene.toml --every 1e-4", scene_every,
+                      names=("--every", "5001 snapshots")))
     for opt in ("--points", "--web-speed"):
         for v in (*JUNK_NUMBERS, "-5", "2.5", "1e12"):
             if opt == "--web-speed" and v == "1e12":

@@ -139,7 +139,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _load_for_view(path: str):
+def _load_for_view(path: str, check_span: Callable[[float], None]):
+    """The scene and result to view; ``check_span(t_end)`` runs before a scene is simulated
+    (and before a result file is used)."""
     from ._files import _check_text
     from ._result import load_result
     from ._scene import load_scene, scene_from_dict
@@ -148,6 +150,7 @@ def _load_for_view(path: str):
     p = _check_text("source", path)
     if p.suffix.lower() == ".toml":
         scene = load_scene(p)
+        check_span(scene.scene.duration)
         print(f"simulating {p} for the view ...", file=sys.stderr)
         return scene, simulate(scene, progress=sys.stderr.isatty())
     if p.suffix.lower() not in (".npz", ".csv"):
@@ -184,13 +187,16 @@ def _cmd_view(args: argparse.Namespace) -> int:
         snapshots,
     )
 
-    scene, result = _load_for_view(args.source)
+    def check_span(t_end: float) -> None:
+        if snaps is not None:
+            try:
+                snapshot_names(t_end, args.every)
+            except WinderError as exc:
+                raise WinderError(f"--every: {exc}") from None
+
+    scene, result = _load_for_view(args.source, check_span)
     check_drawable(result, args.source)
-    if snaps is not None:
-        try:
-            snapshot_names(float(result.t[-1]), args.every)
-        except WinderError as exc:
-            raise WinderError(f"--every: {exc}") from None
+    check_span(float(result.t[-1]))
     graph = WinderGraph(scene)
     if html is not None:
         path = export_html(graph, result, html, playback=args.playback)
