@@ -87,15 +87,13 @@ def test_signal_while_writing(sig: int, previous: bool, tmp_path: Path) -> None:
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP],
                          ids=["SIGTERM", "SIGHUP"])
 def test_signal_during_the_run(sig: int, tmp_path: Path) -> None:
-    """The scene is a FIFO: the test knows the command has started (imports done) when the
-    process opens it; the signal then arrives while it integrates."""
+    """Sent 0.3 s after ``main`` installed its handlers: while the scene is integrated."""
     scene = tmp_path / "scene.toml"
-    os.mkfifo(scene)
+    scene.write_text(FREE_SPIN)
     out = tmp_path / "r.npz"
     proc = _spawn(tmp_path, "run", str(scene), "--out", str(out), "--plots",
                   str(tmp_path / "plots"))
-    with open(scene, "w") as fh:  # blocks until winder opens it
-        fh.write(FREE_SPIN)
+    _wait_for(lambda: _catches(proc.pid, signal.SIGTERM), proc)
     time.sleep(0.3)
     proc.send_signal(sig)
     _assert_stopped(*_finish(proc), sig)
@@ -193,6 +191,17 @@ def test_live_view_stops_its_meshcat_server(sig: int, tmp_path: Path, paper_scen
     assert not _alive(servers[0])
 
 
+def _catches(pid: int, sig: int) -> bool:
+    """Whether process ``pid`` has a handler for ``sig`` (``SigCgt`` in /proc/PID/status):
+    the command line installs its SIGTERM handler first thing in ``main``."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    mask = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("SigCgt")), 16)
+    return bool(mask >> (sig - 1) & 1)
+
+
 @functools.cache
 def _winder_imports_lazily() -> bool:
     probe = subprocess.run([sys.executable, "-c", "import sys, winder.cli; "
@@ -203,12 +212,14 @@ def _winder_imports_lazily() -> bool:
 
 @pytest.mark.parametrize("sig", SIGNALS, ids=lambda s: signal.Signals(s).name)
 def test_signal_during_start_up(sig: int, tmp_path: Path) -> None:
-    """Signals while the command's modules are imported (after ``main`` has started)."""
+    """Signals as soon as ``main`` has started, while the command imports its modules
+    (only where ``import winder.cli`` is light: otherwise everything is imported before
+    ``main`` runs, and a signal then is Python's own)."""
     if not _winder_imports_lazily():
         pytest.skip("'import winder.cli' imports all of winder before the command line "
                     "starts; a signal during that import is Python's own")
     proc = _spawn(tmp_path, "run", str(_big_scene(tmp_path)), "--out", str(tmp_path / "r.npz"))
-    time.sleep(0.4)
+    _wait_for(lambda: _catches(proc.pid, signal.SIGTERM), proc)  # main() has started
     proc.send_signal(sig)
     _assert_stopped(*_finish(proc), sig)
     assert not (tmp_path / "r.npz").exists()
