@@ -10,17 +10,16 @@ import os
 import shutil
 import signal
 import subprocess
-import tempfile
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
 import meshcat
 import numpy as np
 
 from winder._errors import ArgumentError, WinderError
-from winder._files import atomic_write
-from winder._interrupt import on_abort
+from winder._files import atomic_write, scratch_dir
+from winder._interrupt import deferred, on_abort
 from winder._result import Result
 
 from ._animation import animate, check_drawable, plan_animation
@@ -54,17 +53,17 @@ def _stop(proc: subprocess.Popen | None) -> None:
 def served(graph: WinderGraph) -> Iterator[meshcat.Visualizer]:
     """A meshcat server with ``graph`` built in it; the server subprocess is stopped on
     exit, on an error and on a signal (0.3.2's ViewerWindow has no close())."""
-    try:
-        vis = meshcat.Visualizer()
-    except Exception as exc:  # the zmq server subprocess could not start
-        raise WinderError(f"could not start the meshcat server: {exc}") from exc
-    proc = getattr(vis.window, "server_proc", None)
-    with on_abort(lambda: _stop(proc)):
-        try:
-            graph.build(vis)
-            yield vis
-        finally:
-            _stop(proc)
+    with ExitStack() as stack:
+        with deferred():  # a signal while the server starts is acted on once it is known
+            try:
+                vis = meshcat.Visualizer()
+            except Exception as exc:  # the zmq server subprocess could not start
+                raise WinderError(f"could not start the meshcat server: {exc}") from exc
+            proc = getattr(vis.window, "server_proc", None)
+            stack.callback(_stop, proc)
+            stack.enter_context(on_abort(lambda: _stop(proc)))
+        graph.build(vis)
+        yield vis
 
 
 def export_html(graph: WinderGraph, result: Result, path: str | Path, *,
@@ -101,27 +100,26 @@ def screenshot(html: Path, png: str | Path, *, size: tuple[int, int] = (1000, 75
         raise WinderError("no Chromium found for snapshots: install it (make chromium, or "
                           "apt-get install chromium)")
     target = Path(png)
-    with tempfile.TemporaryDirectory(prefix="winder-chromium-") as profile:
-        with on_abort(lambda: shutil.rmtree(profile, ignore_errors=True)):
-            shot = Path(profile) / "shot.png"
-            cmd = [exe, *CHROMIUM_FLAGS, f"--user-data-dir={profile}",
-                   f"--window-size={size[0]},{size[1]}", f"--virtual-time-budget={wait_ms}",
-                   f"--screenshot={shot}", Path(html).resolve().as_uri()]
-            env = dict(os.environ, HOME=profile)
-            proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                                    text=True, env=env, start_new_session=True)
-            with on_abort(lambda: _stop(proc)):
-                try:
-                    _, err = proc.communicate(timeout=120)
-                except subprocess.TimeoutExpired:
-                    raise WinderError(f"Chromium took more than 120 s to render {html}") \
-                        from None
-                finally:
-                    _stop(proc)
-            if not shot.is_file():
-                raise WinderError(f"Chromium wrote no screenshot of {html} (exit "
-                                  f"{proc.returncode}): {err.strip()[-400:]}")
-            atomic_write(target, lambda tmp: shutil.copyfile(shot, tmp))
+    with scratch_dir("winder-chromium-") as profile:
+        shot = profile / "shot.png"
+        cmd = [exe, *CHROMIUM_FLAGS, f"--user-data-dir={profile}",
+               f"--window-size={size[0]},{size[1]}", f"--virtual-time-budget={wait_ms}",
+               f"--screenshot={shot}", Path(html).resolve().as_uri()]
+        env = dict(os.environ, HOME=str(profile))
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                text=True, env=env, start_new_session=True)
+        with on_abort(lambda: _stop(proc)):
+            try:
+                _, err = proc.communicate(timeout=120)
+            except subprocess.TimeoutExpired:
+                raise WinderError(f"Chromium took more than 120 s to render {html}") \
+                    from None
+            finally:
+                _stop(proc)
+        if not shot.is_file():
+            raise WinderError(f"Chromium wrote no screenshot of {html} (exit "
+                              f"{proc.returncode}): {err.strip()[-400:]}")
+        atomic_write(target, lambda tmp: shutil.copyfile(shot, tmp))
     return target
 
 
@@ -163,15 +161,13 @@ def snapshots(graph: WinderGraph, result: Result, out_dir: str | Path, *, every:
     out = Path(out_dir)
     t = result.t
     paths = []
-    with tempfile.TemporaryDirectory(prefix="winder-snap-") as tmp, served(graph) as vis:
-        with on_abort(lambda: shutil.rmtree(tmp, ignore_errors=True)):
-            for k, (ti, name) in enumerate(plan):  # one meshcat server, re-posed per page
-                def at(channel: str, ti: float = ti) -> float:
-                    return float(np.interp(ti, t, result[channel]))
-                graph.show(vis, drum_angle=at("drum_angle") if "drum_angle" in result
-                           else 0.0, z=at("z"), roll_angle=at("roll_angle"),
-                           radius=at("radius"))
-                page = Path(tmp) / f"page{k}.html"
-                page.write_text(vis.static_html(), encoding="utf-8")
-                paths.append(screenshot(page, out / name, size=size, wait_ms=1500))
+    with scratch_dir("winder-snap-") as tmp, served(graph) as vis:
+        for k, (ti, name) in enumerate(plan):  # one meshcat server, re-posed for each page
+            def at(channel: str, ti: float = ti) -> float:
+                return float(np.interp(ti, t, result[channel]))
+            graph.show(vis, drum_angle=at("drum_angle") if "drum_angle" in result else 0.0,
+                       z=at("z"), roll_angle=at("roll_angle"), radius=at("radius"))
+            page = tmp / f"page{k}.html"
+            page.write_text(vis.static_html(), encoding="utf-8")
+            paths.append(screenshot(page, out / name, size=size, wait_ms=1500))
     return paths

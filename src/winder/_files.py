@@ -7,6 +7,8 @@ and atomic writes that leave the complete file or nothing.
   an output that cannot be written (read-only place, a directory given as a file, a parent
   that is a file, a name too long for the file system) is an error naming the argument and
   the path, and nothing is created.
+- :func:`scratch_dir` is a temporary directory that is removed even when a signal arrives
+  while it is being created.
 - :func:`atomic_write` and :func:`atomic_write_all` write into hidden temporary files
   (``.winder-XXXXXXXX.tmp``, short whatever the target's name) beside the targets and move
   them into place when all are complete; on an error, Ctrl-C, SIGTERM or SIGHUP the
@@ -18,15 +20,17 @@ from __future__ import annotations
 import errno
 import os
 import re
+import shutil
 import tempfile
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
 from ._errors import WinderError
 from ._interrupt import deferred, on_abort
 
 __all__ = ["OutputError", "atomic_write", "atomic_write_all", "check_output_dir",
-           "check_output_file", "safe_stem"]
+           "check_output_file", "safe_stem", "scratch_dir"]
 
 Writer = Callable[[Path], object]
 _TMP_PREFIX = ".winder-"
@@ -229,3 +233,15 @@ def atomic_write(path: str | os.PathLike[str], write: Writer) -> Path:
     """Call ``write(tmp_path)`` then move the file into place: the complete ``path`` or
     nothing (see :func:`atomic_write_all`)."""
     return atomic_write_all([(path, write)])[0]
+
+
+@contextmanager
+def scratch_dir(prefix: str = "winder-", *, dir: str | Path | None = None) -> Iterator[Path]:
+    """A temporary directory, removed with its contents when the block ends, on an error,
+    and on a signal (also one that arrives while it is being created)."""
+    with ExitStack() as stack:
+        with deferred():  # no signal between creating the directory and recording it
+            path = Path(tempfile.mkdtemp(prefix=prefix, dir=dir))
+            stack.callback(shutil.rmtree, path, ignore_errors=True)
+            stack.enter_context(on_abort(lambda: shutil.rmtree(path, ignore_errors=True)))
+        yield path

@@ -28,8 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from ._errors import WinderError
-from ._files import atomic_write
-from ._interrupt import on_abort
+from ._files import atomic_write, scratch_dir
 from ._scene import Scene, load_scene
 
 __all__ = ["build_fmu", "FMU_PARAMETERS", "scene_with_parameters", "FmuError"]
@@ -105,16 +104,14 @@ def build_fmu(scene_path: str | Path, out: str | Path) -> Path:
     out = Path(out)
     if out.suffix != ".fmu":
         raise FmuError(f"output file must end in .fmu, got {str(out)!r}")
-    with tempfile.TemporaryDirectory(prefix="winder_fmu_") as tmp, \
-            on_abort(lambda: shutil.rmtree(tmp, ignore_errors=True)):
-        d = Path(tmp)
+    with scratch_dir("winder_fmu_") as d:
         script = d / "winder_fmu.py"
         script.write_text(_SLAVE_SCRIPT, encoding="utf-8")
         scene_copy = d / "scene.toml"
         shutil.copyfile(scene_path, scene_copy)
         staged = d / "build" / "winder.fmu"
         # pythonfmu's own scratch folder goes inside ours (removed with it, even on a signal)
-        saved, tempfile.tempdir = tempfile.tempdir, tmp
+        saved, tempfile.tempdir = tempfile.tempdir, str(d)
         try:
             FmuBuilder.build_FMU(script, dest=staged, project_files=[scene_copy],
                                  needsExecutionTool="true")
