@@ -67,3 +67,32 @@ def test_npz_roundtrip(tmp_path: Path, models_dir: Path) -> None:
     for name in res:
         np.testing.assert_array_equal(back[name], res[name])
     assert back.meta["method"] == res.meta["method"]
+
+
+def _pixels(png: Path, hex_rgb: str, tol: int = 30) -> np.ndarray:
+    """Boolean mask of the pixels of one colour in a PNG (decoded)."""
+    import matplotlib.image as mpimg
+
+    img = np.round(255 * mpimg.imread(png)[..., :3]).astype(int)
+    rgb = np.array([int(hex_rgb[i:i + 2], 16) for i in (1, 3, 5)])
+    return np.all(np.abs(img - rgb) < tol, axis=-1)
+
+
+def test_free_spin_figure_draws_the_conserved_momentum(tmp_path, models_dir, capsys) -> None:
+    """The Fig. 2 PNG of a free spin: 8 × 6 in at 110 dpi; the J ω line (green, C2) is flat
+    over the whole axes width (J ω conserved to 1e-8, drawn on ±10 %), while the ω line
+    (blue, C0) falls from left to right as paper is added."""
+    out = tmp_path / "plots"
+    assert main(["run", str(models_dir / "free_spin.toml"), "--out", str(tmp_path / "r.npz"),
+                 "--t-end", "100", "--plots", str(out)]) == 0
+    (png,) = out.iterdir()
+    assert png.name == "free_spin_fig2_free_spin.png"
+    green = _pixels(png, "#2ca02c")
+    assert green.shape == (660, 880)
+    rows = np.bincount(np.nonzero(green)[0], minlength=660)
+    line = rows.argmax()
+    assert rows[line - 1:line + 2].sum() > 600  # one row across the ~700 px of the axes
+    blue = _pixels(png, "#1f77b4")
+    ys, xs = np.nonzero(blue[:330])  # upper axes
+    left, right = ys[xs < xs.min() + 20].mean(), ys[xs > xs.max() - 20].mean()
+    assert right - left > 50  # ω(100 s) well below ω(0): the curve ends lower

@@ -38,15 +38,29 @@ def test_fmpy_validate_reports_no_problems(fmu_path) -> None:
     assert proc.returncode == 0 and "No problems found" in proc.stdout, proc.stdout
 
 
-def test_interface(fmu_path) -> None:
+def test_interface(fmu_path, paper_scene) -> None:
+    """The model description lists exactly the Stepper's inputs and outputs (plus the
+    profile reference) and the FMU parameters, with start values from the scene."""
+    from winder._fmu import FMU_PARAMETERS
+    from winder._stepper import INPUTS, OUTPUTS
+
     md = fmpy.read_model_description(str(fmu_path))
     by = {v.name: v for v in md.modelVariables}
-    assert by["drum_torque_command"].causality == "input"
-    for name in winder.CHANNELS[1:]:
-        assert by[name].causality == "output" and by[name].initial == "exact", name
-    for name in ("profile_web_speed", "web_acceleration", "com_offset", "contact_stiffness",
-                 "contact_damping", "mu", "caliper", "density", "width", "speed_profile"):
-        assert by[name].causality == "parameter", name
+    kinds: dict[str, set[str]] = {}
+    for v in md.modelVariables:
+        kinds.setdefault(v.causality, set()).add(v.name)
+    assert kinds.pop("output") == {*OUTPUTS, "web_speed_reference"}
+    assert len(INPUTS) == 1 and kinds.pop("input") == {"drum_torque_command"}
+    assert kinds.pop("parameter") == {*FMU_PARAMETERS, "speed_profile", "rtol"}
+    assert kinds == {}
+    for name in OUTPUTS:
+        assert by[name].initial == "exact" and by[name].type == "Real", name
+    sc = paper_scene
+    tables = {"drum.drive": sc.drum.drive, "roll": sc.roll, "contact": sc.contact,
+              "friction": sc.friction, "paper": sc.paper}
+    for name, (table, key, _) in FMU_PARAMETERS.items():
+        assert float(by[name].start) == float(getattr(tables[table], key)), name
+    assert by["speed_profile"].start in (True, "true")
 
 
 def _host(case: str, fmu_path: Path, tmp_path: Path) -> dict:
@@ -103,6 +117,16 @@ def test_closed_loop_example_writes_its_plot(tmp_path) -> None:
     proc = subprocess.run([sys.executable, str(example), "--t-end", "8", "--out",
                            str(tmp_path)], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr[-3000:]
-    assert (tmp_path / "speed_control_fmu.png").stat().st_size > 10_000
     err = float(proc.stdout.split("web-speed error after 2 s: max ")[1].split()[0])
     assert err < 5e-3  # m/s, on the 0.5 m/s² ramp
+    # the figure (8 × 8 in at 100 dpi) draws the drum surface speed (blue, C0) on the
+    # ramp min(0.5 t, 20) in the top axes: a straight rising line, 0 → 4 m/s
+    import matplotlib.image as mpimg
+
+    img = np.round(255 * mpimg.imread(tmp_path / "speed_control_fmu.png")[..., :3])
+    assert img.shape == (800, 800, 3)
+    blue = np.all(np.abs(img[:270] - [0x1F, 0x77, 0xB4]) < 40, axis=-1)
+    blue[:130, :260] = False  # the legend
+    ys, xs = np.nonzero(blue)
+    assert np.ptp(xs) > 500 and np.ptp(ys) > 150  # spans the axes
+    assert np.corrcoef(xs, ys)[0, 1] < -0.99  # measured -0.99994

@@ -17,11 +17,39 @@ import meshcat
 import numpy as np
 from meshcat.animation import Animation
 
+from winder._errors import WinderError
 from winder._result import Result
 
 from ._scene_graph import WinderGraph
 
-__all__ = ["AnimationPlan", "plan_animation", "animate"]
+__all__ = ["AnimationPlan", "DRAWN_CHANNELS", "check_drawable", "plan_animation", "animate"]
+
+#: Channels the viewer draws (``drum_angle`` is optional: the drum is then still).
+DRAWN_CHANNELS = ("radius", "z", "roll_angle", "roll_speed", "drum_speed")
+
+
+def check_drawable(result: Result, where: str = "result") -> None:
+    """Raise :class:`~winder.WinderError` (prefixed by ``where``, e.g. the file) unless
+    ``result`` can be drawn: at least two samples on an increasing, finite time axis, the
+    channels of :data:`DRAWN_CHANNELS` present and finite, and the radius > 0."""
+    t = np.asarray(result.t, dtype=float)
+    if len(t) < 2:
+        raise WinderError(f"{where}: {len(t)} sample(s); the viewer needs at least 2")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise WinderError(f"{where}: the time axis is not finite and increasing")
+    missing = [c for c in DRAWN_CHANNELS if c not in result]
+    if missing:
+        raise WinderError(f"{where}: no channel {', '.join(missing)} (the viewer draws "
+                          f"{', '.join(DRAWN_CHANNELS)})")
+    for c in (*DRAWN_CHANNELS, *(("drum_angle",) if "drum_angle" in result else ())):
+        bad = np.flatnonzero(~np.isfinite(result[c]))
+        if len(bad):
+            raise WinderError(f"{where}: channel {c!r} is not finite at t = {t[bad[0]]:g} s "
+                              f"(sample {bad[0]}: {float(result[c][bad[0]])!r})")
+    small = np.flatnonzero(result["radius"] <= 0)
+    if len(small):
+        raise WinderError(f"{where}: radius {float(result['radius'][small[0]])!r} m at t = "
+                          f"{t[small[0]]:g} s; a roll radius is > 0")
 
 
 @dataclass(frozen=True)
@@ -41,6 +69,10 @@ class AnimationPlan:
 
 def plan_animation(result: Result, *, playback: float = 30.0, fps: int = 30,
                    max_turns_per_second: float = 0.5) -> AnimationPlan:
+    """Frame times and spin gain of an animation of ``result`` (see the module text)."""
+    check_drawable(result)
+    if not (math.isfinite(playback) and playback > 0):
+        raise WinderError(f"playback must be finite and > 0 [s], got {playback!r}")
     t = result.t
     n = max(2, int(round(playback * fps)) + 1)
     times = np.linspace(t[0], t[-1], n)

@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from ._errors import WinderError
+from ._files import atomic_write, scratch_dir
 from ._scene import Scene, load_scene
 
 __all__ = ["build_fmu", "FMU_PARAMETERS", "scene_with_parameters", "FmuError"]
@@ -91,8 +92,9 @@ def scene_with_parameters(scene: Scene, values: dict[str, float], *,
 
 
 def build_fmu(scene_path: str | Path, out: str | Path) -> Path:
-    """Build ``out`` (an ``.fmu``) from a scene file. Raises :class:`FmuError` when
-    pythonfmu is missing or the build fails."""
+    """Build ``out`` (an ``.fmu``) from a scene file, atomically: the complete FMU or
+    nothing at ``out``, and no build folder left in the temporary directory, on an error
+    or a signal. Raises :class:`FmuError` when pythonfmu is missing or the build fails."""
     try:
         from pythonfmu import FmuBuilder
     except ImportError as exc:
@@ -102,21 +104,21 @@ def build_fmu(scene_path: str | Path, out: str | Path) -> Path:
     out = Path(out)
     if out.suffix != ".fmu":
         raise FmuError(f"output file must end in .fmu, got {str(out)!r}")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix="winder_fmu_") as tmp:
-        d = Path(tmp)
+    with scratch_dir("winder_fmu_") as d:
         script = d / "winder_fmu.py"
         script.write_text(_SLAVE_SCRIPT, encoding="utf-8")
         scene_copy = d / "scene.toml"
         shutil.copyfile(scene_path, scene_copy)
-        staged = d / "build" / out.name
+        staged = d / "build" / "winder.fmu"
+        # pythonfmu's own scratch folder goes inside ours (removed with it, even on a signal)
+        saved, tempfile.tempdir = tempfile.tempdir, str(d)
         try:
             FmuBuilder.build_FMU(script, dest=staged, project_files=[scene_copy],
                                  needsExecutionTool="true")
         except Exception as exc:  # pythonfmu raises bare exceptions
             raise FmuError(f"pythonfmu could not build the FMU from {scene_path}: {exc}") \
                 from exc
-        tmp_out = out.with_name(f".{out.name}.tmp")
-        shutil.copyfile(staged, tmp_out)
-        tmp_out.replace(out)
+        finally:
+            tempfile.tempdir = saved
+        atomic_write(out, lambda tmp_out: shutil.copyfile(staged, tmp_out))
     return out

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import matplotlib
@@ -10,17 +11,25 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ._result import Result, atomic_write  # noqa: E402
+from ._files import atomic_write, safe_stem  # noqa: E402
+from ._result import Result  # noqa: E402
 from ._scene import Scene  # noqa: E402
 
 __all__ = ["paper_figures", "campbell_figure", "normal_force_envelope"]
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
-    fig.tight_layout()
-    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
-    plt.close(fig)
+    try:
+        fig.tight_layout()
+        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    finally:
+        plt.close(fig)
     return path
+
+
+def _label(text: object, limit: int = 80) -> str:
+    """Scene text as plain title text: no control characters, no mathtext (``$``)."""
+    return re.sub(r"[\x00-\x1f\x7f]", "?", str(text))[:limit].replace("$", r"\$")
 
 
 def _first_liftoff(result: Result) -> float | None:
@@ -40,7 +49,8 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     spin ω with the conserved ``J ω`` (Fig. 2).
     """
     out = Path(out_dir)
-    name = result.meta.get("scene", "result")
+    name = _label(result.meta.get("scene", "result"))  # for titles
+    stem = safe_stem(result.meta.get("scene", "result"))  # no scene text picks the directory
     t = result.t
     paths: list[Path] = []
     web = "web_momentum" in result.meta.get("effects", [])
@@ -59,7 +69,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
         for a in ax:
             a.grid(True, alpha=0.3)
             a.legend()
-        return [_save(fig, out / f"{name}_fig2_free_spin.png")]
+        return [_save(fig, out / f"{stem}_fig2_free_spin.png")]
 
     fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
     ax[0].plot(t, result["drum_speed"], label="drum Ω")
@@ -83,7 +93,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     ax[1].set_xlabel("t [s]")
     for a in ax:
         a.grid(True, alpha=0.3)
-    paths.append(_save(fig, out / f"{name}_fig{4 if web else 5}_speeds_torque.png"))
+    paths.append(_save(fig, out / f"{stem}_fig{4 if web else 5}_speeds_torque.png"))
 
     fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
     ax[0].plot(t, result["z_dot"] * 1e3, lw=0.5)
@@ -96,7 +106,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     ax[1].legend()
     for a in ax:
         a.grid(True, alpha=0.3)
-    paths.append(_save(fig, out / f"{name}_fig6_vertical_velocity_radius.png"))
+    paths.append(_save(fig, out / f"{stem}_fig6_vertical_velocity_radius.png"))
 
     fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
     ax[0].plot(t, result["roll_speed"], lw=0.6)
@@ -107,7 +117,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     ax[1].set_xlabel("t [s]")
     for a in ax:
         a.grid(True, alpha=0.3)
-    paths.append(_save(fig, out / f"{name}_fig7_roll_speed_accel.png"))
+    paths.append(_save(fig, out / f"{stem}_fig7_roll_speed_accel.png"))
 
     fig, ax = plt.subplots(2, 1, figsize=(9, 7))
     ax[0].plot(t, result["normal_force"] / 1e3, lw=0.4)
@@ -135,7 +145,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     ax[1].set_xlabel("t [s]")
     for a in ax:
         a.grid(True, alpha=0.3)
-    paths.append(_save(fig, out / f"{name}_fig8_normal_force.png"))
+    paths.append(_save(fig, out / f"{stem}_fig8_normal_force.png"))
     return paths
 
 
@@ -176,7 +186,7 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     ax.set_ylabel("frequency [Hz]")
     ax.legend(fontsize=8, loc="upper right")
     ax.grid(alpha=0.3)
-    ax.set_title(title or "Resonance map (Campbell chart)")
+    ax.set_title(_label(title, 120) or "Resonance map (Campbell chart)")
     if result is not None:
         r, lo, hi, _ = normal_force_envelope(result)
         b = axes[1, 0]

@@ -1,39 +1,32 @@
-"""Simulation results: named channels over time, saved atomically as CSV or NPZ."""
+"""Simulation results: named channels over time, saved atomically as CSV or NPZ, and read
+back without ever unpickling (a damaged or foreign file is an error naming the file)."""
 
 from __future__ import annotations
 
+import io
 import json
-import os
-import tempfile
-from collections.abc import Iterator, Mapping
+import math
+import struct
+import warnings
+import zipfile
+import zlib
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ._errors import WinderError
+from ._files import atomic_write, atomic_write_all
 
-__all__ = ["Result", "load_result", "atomic_write"]
+__all__ = ["Result", "ResultFileError", "load_result", "atomic_write"]
+
+#: Most members an NPZ result may have (channels and ``__meta__``).
+_MAX_MEMBERS = 1000
 
 
-def atomic_write(path: str | Path, write: Any, *, suffix: str = "") -> Path:
-    """Call ``write(tmp_path)`` then move the file into place: no partial ``path`` on
-    error or Ctrl-C."""
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix,
-                               dir=target.parent)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; results are ordinary files
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return target
+class ResultFileError(WinderError, ValueError):
+    """A result file cannot be read: the message names the file and the problem."""
 
 
 class Result(Mapping[str, np.ndarray]):
@@ -78,51 +71,160 @@ class Result(Mapping[str, np.ndarray]):
         span = f"t = {t[0]:g} … {t[-1]:g} s" if len(t) else "empty"
         return f"Result({self.meta.get('scene', '?')!r}, {len(t)} samples, {span})"
 
+    def _writer(self, path: str | Path) -> Callable[[Path], None]:
+        """The function that writes this result to a (temporary) file, by ``path``'s
+        suffix: ``.csv`` (header: channel names) or ``.npz`` (channels + ``__meta__``)."""
+        suffix = Path(path).suffix.lower()
+        if suffix == ".csv":
+            names = list(self._channels)
+            table = np.column_stack([self._channels[n] for n in names])
+
+            def write_csv(tmp: Path) -> None:
+                np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="",
+                           fmt="%.15g")
+            return write_csv
+        if suffix == ".npz":
+            meta = np.array(json.dumps(self.meta, default=str))
+
+            def write_npz(tmp: Path) -> None:
+                with open(tmp, "wb") as fh:
+                    np.savez_compressed(fh, __meta__=meta, **self._channels)
+            return write_npz
+        raise WinderError(f"{path}: unknown result format {suffix!r}; valid: .csv, .npz")
+
     def to_csv(self, path: str | Path) -> Path:
         """Write a CSV (header: channel names, first column ``t``), atomically."""
-        names = list(self._channels)
-        table = np.column_stack([self._channels[n] for n in names])
-
-        def write(tmp: Path) -> None:
-            np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="",
-                       fmt="%.15g")
-        return atomic_write(path, write)
+        return atomic_write(path, self._writer(Path(path).with_suffix(".csv")))
 
     def to_npz(self, path: str | Path) -> Path:
         """Write a compressed NPZ (channels + ``__meta__`` JSON), atomically."""
-        def write(tmp: Path) -> None:
-            with open(tmp, "wb") as fh:
-                np.savez_compressed(fh, __meta__=np.array(json.dumps(self.meta, default=str)),
-                                    **self._channels)
-        return atomic_write(path, write)
+        return atomic_write(path, self._writer(Path(path).with_suffix(".npz")))
 
-    def save(self, path: str | Path) -> Path:
-        """Write CSV or NPZ by the file's suffix."""
-        suffix = Path(path).suffix.lower()
-        if suffix == ".csv":
-            return self.to_csv(path)
-        if suffix == ".npz":
-            return self.to_npz(path)
-        raise WinderError(f"{path}: unknown result format {suffix!r}; valid: .csv, .npz")
+    def save(self, path: str | Path, *more: str | Path) -> Path:
+        """Write CSV or NPZ by the file's suffix; with ``more`` paths (e.g. the NPZ twin of
+        a CSV), all the files are written or none is. Returns ``path``."""
+        paths = [path, *more]
+        return atomic_write_all([(p, self._writer(p)) for p in paths])[0]
+
+
+def _bad(path: Path, problem: str) -> ResultFileError:
+    return ResultFileError(f"{path}: {problem}")
+
+
+def _read_npy(data: bytes) -> np.ndarray:
+    """One ``.npy`` member, parsed without pickle and checked against its header."""
+    fp = io.BytesIO(data)
+    version = np.lib.format.read_magic(fp)
+    if version == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(fp)
+    elif version == (2, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(fp)
+    else:
+        raise ValueError(f"unsupported .npy format version {version}")
+    if dtype.hasobject:
+        raise ValueError("it holds Python objects (pickled data), which winder never loads")
+    count = math.prod(shape)
+    size = len(data) - fp.tell()
+    if size != count * dtype.itemsize:
+        raise ValueError(f"{size} bytes of data for an array of shape {shape} ({dtype})")
+    array = np.frombuffer(data, dtype=dtype, count=count, offset=fp.tell())
+    return array.reshape(shape, order="F" if fortran else "C")
+
+
+def _read_npz(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    arrays: dict[str, np.ndarray] = {}
+    try:
+        with zipfile.ZipFile(p) as zf:
+            infos = zf.infolist()
+            if len(infos) > _MAX_MEMBERS:
+                raise ValueError(f"{len(infos)} members (at most {_MAX_MEMBERS})")
+            for info in infos:
+                if not info.filename.endswith(".npy") or info.is_dir():
+                    raise ValueError(f"unexpected member {info.filename!r}")
+                name = info.filename[:-4]
+                try:
+                    arrays[name] = _read_npy(zf.read(info))
+                except ValueError as exc:
+                    raise ValueError(f"member {info.filename!r}: {exc}") from None
+    except zipfile.BadZipFile as exc:
+        raise _bad(p, f"not a readable .npz archive ({exc})") from None
+    except (ValueError, EOFError, zlib.error, struct.error, NotImplementedError,
+            RuntimeError, OverflowError, UnicodeError) as exc:
+        raise _bad(p, f"damaged or not a winder result: {exc}") from None
+    meta: dict[str, Any] = {}
+    if "__meta__" in arrays:
+        raw = arrays.pop("__meta__")
+        try:
+            if raw.shape != () or raw.dtype.kind != "U":
+                raise ValueError("not a text")
+            meta = json.loads(str(raw))
+            if not isinstance(meta, dict):
+                raise ValueError("not a JSON object")
+        except ValueError as exc:
+            raise _bad(p, f"bad metadata (__meta__: {exc})") from None
+    return arrays, meta
+
+
+def _read_csv(p: Path) -> dict[str, np.ndarray]:
+    try:
+        with open(p, encoding="utf-8") as fh:
+            names = [n.strip() for n in fh.readline().strip().split(",")]
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                table = np.loadtxt(fh, delimiter=",", ndmin=2)
+    except UnicodeDecodeError as exc:
+        raise _bad(p, f"not UTF-8 text (byte {exc.start})") from None
+    except ValueError as exc:
+        raise _bad(p, f"not a table of numbers: {exc}") from None
+    if len(set(names)) != len(names) or not all(names):
+        raise _bad(p, f"header must name each column once, got {','.join(names)!r}"[:300])
+    if table.shape[0] == 0:
+        raise _bad(p, "no data rows")
+    if table.shape[1] != len(names):
+        raise _bad(p, f"header has {len(names)} names, rows have {table.shape[1]} columns")
+    return {n: table[:, i] for i, n in enumerate(names)}
+
+
+def _check_channels(p: Path, arrays: dict[str, np.ndarray]) -> None:
+    if "t" not in arrays:
+        raise _bad(p, f"no time channel 't' (channels: {', '.join(arrays)[:200]})")
+    n = arrays["t"].shape
+    for k, v in arrays.items():
+        if v.ndim != 1 or v.shape != n:
+            raise _bad(p, f"channel {k!r} has shape {v.shape}, expected ({n[0]},)")
+        if v.dtype.kind not in "biuf":
+            raise _bad(p, f"channel {k!r} is not numeric ({v.dtype})")
+    t = arrays["t"].astype(float)
+    if len(t) == 0:
+        raise _bad(p, "no samples")
+    bad = np.flatnonzero(~np.isfinite(t))
+    if len(bad):
+        raise _bad(p, f"time t[{bad[0]}] = {float(t[bad[0]])!r} is not finite")
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if len(back):
+        i = back[0]
+        raise _bad(p, f"time is not increasing: t[{i}] = {float(t[i])!r}, "
+                      f"t[{i + 1}] = {float(t[i + 1])!r}")
 
 
 def load_result(path: str | Path) -> Result:
-    """Read a result written by :meth:`Result.to_csv` or :meth:`Result.to_npz`."""
+    """Read a result written by :meth:`Result.to_csv` or :meth:`Result.to_npz`.
+
+    Raises :class:`ResultFileError` (a ``ValueError``) naming the file when it is missing,
+    damaged, not a winder result (NPZ members that need unpickling are refused, never
+    loaded), or its time channel is not finite and increasing."""
     p = Path(path)
-    if not p.is_file():
-        raise WinderError(f"{p}: no such result file")
-    suffix = p.suffix.lower()
-    if suffix == ".npz":
-        with np.load(p, allow_pickle=False) as z:
-            meta = json.loads(str(z["__meta__"])) if "__meta__" in z else {}
-            return Result({k: z[k] for k in z.files if k != "__meta__"}, meta)
-    if suffix == ".csv":
-        with open(p, encoding="utf-8") as fh:
-            names = fh.readline().strip().split(",")
-        table = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
-        if table.shape[1] != len(names):
-            raise WinderError(f"{p}: header has {len(names)} names, rows have "
-                              f"{table.shape[1]} columns")
-        return Result({n: table[:, i] for i, n in enumerate(names)},
-                      {"scene": p.stem, "source": str(p)})
-    raise WinderError(f"{p}: unknown result format {suffix!r}; valid: .csv, .npz")
+    try:
+        if not p.is_file():
+            raise _bad(p, "not a file" if p.exists() else "no such result file")
+        suffix = p.suffix.lower()
+        if suffix == ".npz":
+            arrays, meta = _read_npz(p)
+        elif suffix == ".csv":
+            arrays, meta = _read_csv(p), {"scene": p.stem, "source": str(p)}
+        else:
+            raise _bad(p, f"unknown result format {suffix!r}; valid: .csv, .npz")
+    except OSError as exc:
+        raise _bad(p, f"cannot be read ({exc.strerror or exc})") from None
+    _check_channels(p, arrays)
+    return Result({k: np.array(v, dtype=float) for k, v in arrays.items()}, meta)

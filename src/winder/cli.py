@@ -1,95 +1,225 @@
-"""Command-line interface: ``winder run|view|fmu|modes`` (also ``python -m winder``)."""
+"""Command-line interface: ``winder run|view|fmu|modes`` (also ``python -m winder``).
+
+Exit status
+-----------
+- 0: done.
+- 2: bad input or a failed run: one or a few lines on stderr naming the file, option or key,
+  the bad value and what is valid; nothing is left on disk. Every output location is
+  checked before a run starts.
+- 128 + N when stopped by signal N: 130 for Ctrl-C (SIGINT), 143 for SIGTERM, 129 for
+  SIGHUP. Temporary files are removed and child processes stopped; files already complete
+  stay, no partial file is left. A second signal during that clean-up stops at once, with
+  a message.
+- 141 when the reader of stdout went away (``winder modes ... | head``), as for SIGPIPE.
+- 1: an internal error of winder (a bug): the traceback and a line saying so.
+"""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import math
+import os
 import sys
-from collections.abc import Sequence
+import traceback
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any, NoReturn
 
 from ._errors import WinderError
+from ._interrupt import Interrupted, handling_signals
 
 __all__ = ["main"]
 
+EXIT_ERROR = 2
+EXIT_INTERNAL = 1
 
-def _positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"{text!r} must be > 0")
-    return value
+
+# ---- option types: each names the valid range ---------------------------------------------
+def _number(lo: float, hi: float = math.inf, *, lo_open: bool = True,
+            hi_open: bool = False, integer: bool = False) -> Callable[[str], Any]:
+    """An argparse type: a finite number (``integer``: a whole number) in the range."""
+    left = "<" if lo_open else "<="
+    right = "<" if hi_open else "<="
+    valid = f"{lo:g} {left} x" + (f" {right} {hi:g}" if math.isfinite(hi) else "")
+    valid = ("a whole number, " if integer else "a finite number, ") + valid
+
+    def parse(text: str) -> float | int:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number; valid: {valid}") \
+                from None
+        ok = math.isfinite(value) and (value > lo if lo_open else value >= lo) and \
+            (value < hi if hi_open else value <= hi)
+        if ok and integer and value != int(value):
+            ok = False
+        if not ok:
+            raise argparse.ArgumentTypeError(f"{text!r} is out of range; valid: {valid}")
+        return int(value) if integer else value
+    parse.__name__ = "number"
+    return parse
+
+
+_POSITIVE = _number(0.0)
+_RTOL = _number(1e-14, 1.0, lo_open=False, hi_open=True)
+_PLAYBACK = _number(0.0, 3600.0)
+_POINTS = _number(2, 100_000, lo_open=False, integer=True)
+_EVALS = _number(1, 1e15, lo_open=False, integer=True)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the project's error contract: one line naming the option, exit 2
+    (raised as :class:`_UsageError`, so that :func:`main` returns the status)."""
+
+    def error(self, message: str) -> NoReturn:
+        raise _UsageError(f"{self.prog}: error: {message} (see {self.prog} --help)")
+
+    def exit(self, status: int = 0, message: str | None = None) -> NoReturn:
+        if message:
+            sys.stderr.write(message)
+        raise _Exit(status)
+
+
+class _UsageError(Exception):
+    pass
+
+
+class _Exit(Exception):
+    def __init__(self, status: int) -> None:
+        super().__init__(status)
+        self.status = status
+
+
+# ---- commands -------------------------------------------------------------------------------
+def _result_files(out: Path) -> list[Path]:
+    """``--out`` and, for a CSV, its NPZ twin (the viewer reads it: it carries the scene)."""
+    return [out, out.with_suffix(".npz")] if out.suffix.lower() == ".csv" else [out]
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from ._files import check_output_dir, check_output_file
+
+    out = check_output_file(args.out, "--out", suffixes=(".csv", ".npz"))
+    files = _result_files(out)
+    for twin in files[1:]:
+        check_output_file(twin, "--out (its .npz twin)", suffixes=(".npz",))
+    plots = check_output_dir(args.plots, "--plots") if args.plots is not None else None
+
+    from ._errors import BudgetExceeded
     from ._plots import paper_figures
     from ._scene import load_scene
     from ._simulate import simulate
 
     scene = load_scene(args.scene)
-    out = Path(args.out)
-    if out.suffix.lower() not in (".csv", ".npz"):
-        raise WinderError(f"--out {out}: unknown result format {out.suffix!r}; valid: .csv, .npz")
     progress = sys.stderr.isatty() if args.progress is None else args.progress
-    result = simulate(scene, t_end=args.t_end, method=args.method, rtol=args.rtol,
-                      atol=args.atol, progress=progress, backend=args.backend)
-    result.save(out)
-    if out.suffix.lower() == ".csv":  # the viewer and later tools read the NPZ twin
-        result.to_npz(out.with_suffix(".npz"))
+    try:
+        result = simulate(scene, t_end=args.t_end, method=args.method, rtol=args.rtol,
+                          atol=args.atol, progress=progress, backend=args.backend,
+                          max_rhs=args.max_evals, max_wall=args.max_wall)
+    except BudgetExceeded as exc:
+        partial = getattr(exc, "partial", None)
+        if not args.keep_partial:
+            raise WinderError(f"{exc}\n  (--keep-partial writes the result up to that time "
+                              f"to {out}; --max-evals/--max-wall raise the budget)") from None
+        if partial is None or len(partial.t) == 0:
+            raise WinderError(f"{exc}\n  no partial result: no output sample was reached; "
+                              f"{out} not written") from None
+        partial.meta["partial"] = True
+        partial.save(*files)
+        raise WinderError(f"{exc}\n  partial result up to t = {partial.t[-1]:g} s written "
+                          f"to {', '.join(map(str, files))}") from None
+    result.save(*files)
     m = result.meta
     print(f"{scene.name}: {len(result.t)} samples to {out} ({m['method']}, rtol {m['rtol']:g}, "
           f"{m['rhs_evaluations']} RHS evaluations, {m['wall_time']:.2f} s integration)")
-    if args.plots:
-        for p in paper_figures(result, args.plots, scene=scene):
+    if plots is not None:
+        for p in paper_figures(result, plots, scene=scene):
             print(f"  figure {p}")
     return 0
 
 
-def _load_for_view(path: str):
+def _load_for_view(path: str, check_span: Callable[[float], None]):
+    """The scene and result to view; ``check_span(t_end)`` runs before a scene is simulated
+    (and before a result file is used)."""
+    from ._files import _check_text
     from ._result import load_result
     from ._scene import load_scene, scene_from_dict
     from ._simulate import simulate
 
-    p = Path(path)
+    p = _check_text("source", path)
     if p.suffix.lower() == ".toml":
         scene = load_scene(p)
+        check_span(scene.scene.duration)
         print(f"simulating {p} for the view ...", file=sys.stderr)
         return scene, simulate(scene, progress=sys.stderr.isatty())
+    if p.suffix.lower() not in (".npz", ".csv"):
+        raise WinderError(f"{p}: unknown file type {p.suffix!r}; valid: .npz (from "
+                          "'winder run') or .toml (a scene)")
     result = load_result(p)
-    if "scene_dict" not in result.meta:
+    stored = result.meta.get("scene_dict")
+    if not isinstance(stored, dict):
         raise WinderError(f"{p}: this result carries no scene (write it as .npz with "
                           "'winder run'), or pass the scene file instead")
-    scene = scene_from_dict(result.meta["scene_dict"], source=str(result.meta.get("source", p)))
+    try:
+        scene = scene_from_dict(stored, source=str(p))
+    except WinderError as exc:
+        raise WinderError(f"{p}: the scene stored in this result is invalid: {exc}") from None
+    except (TypeError, ValueError, KeyError, AttributeError) as exc:
+        raise WinderError(f"{p}: the scene stored in this result is invalid "
+                          f"({type(exc).__name__}: {exc})") from None
     return scene, result
 
 
 def _cmd_view(args: argparse.Namespace) -> int:
-    from winder.viewer import WinderGraph, export_html, snapshots
+    from ._files import check_output_dir, check_output_file
 
-    scene, result = _load_for_view(args.source)
+    html = check_output_file(args.html, "--html", suffixes=(".html", ".htm")) \
+        if args.html is not None else None
+    snaps = check_output_dir(args.snapshots, "--snapshots") \
+        if args.snapshots is not None else None
+
+    from winder.viewer import (
+        WinderGraph,
+        check_drawable,
+        export_html,
+        snapshot_names,
+        snapshots,
+    )
+
+    def check_span(t_end: float) -> None:
+        if snaps is not None:
+            try:
+                snapshot_names(t_end, args.every)
+            except WinderError as exc:
+                raise WinderError(f"--every: {exc}") from None
+
+    scene, result = _load_for_view(args.source, check_span)
+    check_drawable(result, args.source)
+    check_span(float(result.t[-1]))
     graph = WinderGraph(scene)
-    if args.html:
-        path = export_html(graph, result, args.html, playback=args.playback)
+    if html is not None:
+        path = export_html(graph, result, html, playback=args.playback)
         print(f"animation ({args.playback:g} s playback) written to {path}")
-    if args.snapshots:
-        for path in snapshots(graph, result, args.snapshots, every=args.every):
+    if snaps is not None:
+        for path in snapshots(graph, result, snaps, every=args.every):
             print(f"  snapshot {path}")
-    if not args.html and not args.snapshots:
-        import meshcat
+    if html is None and snaps is None:
+        import time
 
         from winder.viewer import animate, plan_animation
+        from winder.viewer._export import served
 
-        vis = meshcat.Visualizer()
-        graph.build(vis)
-        animate(vis, graph, result, plan_animation(result, playback=args.playback))
-        print(f"live view at {vis.url()}  (Ctrl-C to stop)")
-        try:
-            import time
-            while True:
-                time.sleep(1.0)
-        except KeyboardInterrupt:
-            return 0
+        with served(graph) as vis:
+            animate(vis, graph, result, plan_animation(result, playback=args.playback))
+            print(f"live view at {vis.url()}  (Ctrl-C to stop)", flush=True)
+            try:
+                while True:
+                    time.sleep(1.0)
+            except Interrupted as exc:
+                if exc.name != "SIGINT":
+                    raise
+                print("live view stopped", file=sys.stderr)
     return 0
 
 
@@ -117,9 +247,12 @@ def _check_fmu(path: Path) -> str:
 
 
 def _cmd_fmu(args: argparse.Namespace) -> int:
+    from ._files import check_output_file
+
+    out = check_output_file(args.out, "-o/--out", suffixes=(".fmu",))
     from ._fmu import build_fmu
 
-    out = build_fmu(args.scene, args.out)
+    out = build_fmu(args.scene, out)
     print(f"FMI 2.0 co-simulation FMU written to {out}")
     print(f"  runs inside the host's Python: needs winder installed there (built with "
           f"{sys.executable})")
@@ -129,10 +262,19 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
 
 
 def _cmd_modes(args: argparse.Namespace) -> int:
+    from ._files import check_output_file
+
+    csv = check_output_file(args.csv, "--csv", suffixes=(".csv",)) \
+        if args.csv is not None else None
+    plot = check_output_file(args.plot, "--plot", suffixes=(".png",)) \
+        if args.plot is not None else None
+    if csv is not None and plot is not None and csv.resolve() == plot.resolve():
+        raise WinderError(f"--csv and --plot name the same file {csv}")
+
     import numpy as np
 
+    from ._files import atomic_write
     from ._modes import mode_map
-    from ._result import atomic_write
     from ._scene import load_scene
 
     scene = load_scene(args.scene)
@@ -145,14 +287,14 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         crit = mm.critical_radii(k)
         print(f"  {k}x rotation meets the bounce mode at r = "
               + (", ".join(f"{c:.4f} m" for c in crit) if crit else "(no crossing)"))
-    if args.csv:
+    if csv is not None:
         cols = mm.as_columns()
         header = ",".join(cols)
         table = np.column_stack(list(cols.values()))
-        atomic_write(args.csv, lambda p: np.savetxt(p, table, delimiter=",", header=header,
-                                                    comments="", fmt="%.10g"))
-        print(f"  table written to {args.csv}")
-    if args.plot:
+        atomic_write(csv, lambda p: np.savetxt(p, table, delimiter=",", header=header,
+                                               comments="", fmt="%.10g"))
+        print(f"  table written to {csv}")
+    if plot is not None:
         from ._plots import campbell_figure
         from ._simulate import simulate
 
@@ -160,24 +302,35 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         if args.simulate:
             print("  simulating the scene for the normal-force envelope ...", file=sys.stderr)
             result = simulate(scene, progress=sys.stderr.isatty())
-        path = campbell_figure(mm, args.plot, result=result,
+        path = campbell_figure(mm, plot, result=result,
                                title=f"Resonance map of {scene.name}")
         print(f"  figure written to {path}")
     return 0
 
 
 def _build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="winder", description="Paper winder simulation.")
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser = _Parser(prog="winder", description="Paper winder simulation.",
+                     epilog="Exit status: 0 done; 2 bad input or failed run (a message names "
+                     "the file, option or key); 128+N stopped by signal N (130 Ctrl-C, 143 "
+                     "SIGTERM, 129 SIGHUP; no partial file left); 1 internal error.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     run = sub.add_parser("run", help="simulate a scene file and write its result channels")
     run.add_argument("scene", help="scene file (TOML)")
-    run.add_argument("--out", required=True, help="result file (.csv or .npz)")
-    run.add_argument("--t-end", type=_positive, help="end time [s] (default: scene duration)")
+    run.add_argument("--out", required=True, help="result file (.csv or .npz; a .csv gets "
+                     "an .npz twin)")
+    run.add_argument("--t-end", type=_POSITIVE, help="end time [s] (default: scene duration)")
     run.add_argument("--method", help="integrator (auto, DOPRI5, RK4, RK45, DOP853, Radau, "
                      "BDF, LSODA, RK23)")
     run.add_argument("--backend", help="right-hand side: compiled (default) or pinocchio")
-    run.add_argument("--rtol", type=_positive)
-    run.add_argument("--atol", type=_positive)
+    run.add_argument("--rtol", type=_RTOL, help="relative tolerance (1e-14 <= rtol < 1)")
+    run.add_argument("--atol", type=_POSITIVE, help="absolute tolerance (> 0)")
+    run.add_argument("--max-evals", type=_EVALS, metavar="N",
+                     help="budget of right-hand side evaluations (default: [solver] max_rhs)")
+    run.add_argument("--max-wall", type=_POSITIVE, metavar="SECONDS",
+                     help="budget of wall-clock time of the integration [s]")
+    run.add_argument("--keep-partial", action="store_true",
+                     help="when a budget stops the run, write the result up to that time "
+                     "to --out (the exit status stays 2)")
     run.add_argument("--plots", help="directory for the paper's figures (PNG)")
     run.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                      help="progress bar on stderr (default: when stderr is a terminal)")
@@ -186,10 +339,10 @@ def _build_parser() -> argparse.ArgumentParser:
     view.add_argument("source", help="result file (.npz from 'winder run') or scene (.toml)")
     view.add_argument("--html", help="write a standalone HTML animation (no network)")
     view.add_argument("--snapshots", help="directory for PNG snapshots (headless Chromium)")
-    view.add_argument("--every", type=_positive, default=100.0,
+    view.add_argument("--every", type=_POSITIVE, default=100.0,
                       help="snapshot interval [s] (default 100)")
-    view.add_argument("--playback", type=_positive, default=30.0,
-                      help="playback length of the whole run [s] (default 30)")
+    view.add_argument("--playback", type=_PLAYBACK, default=30.0,
+                      help="playback length of the whole run [s] (0 < x <= 3600, default 30)")
     view.set_defaults(func=_cmd_view)
     fmu = sub.add_parser("fmu", help="export a scene as an FMI 2.0 co-simulation FMU")
     fmu.add_argument("scene", help="scene file (TOML)")
@@ -202,26 +355,59 @@ def _build_parser() -> argparse.ArgumentParser:
     modes.add_argument("--plot", nargs="?", const="campbell.png",
                        help="write the Campbell chart (PNG; default name campbell.png)")
     modes.add_argument("--csv", help="write frequencies, damping and critical speeds (CSV)")
-    modes.add_argument("--web-speed", type=_positive,
+    modes.add_argument("--web-speed", type=_POSITIVE,
                        help="operating web speed [m/s] (default: the scene's)")
-    modes.add_argument("--points", type=int, default=150, help="radii (default 150)")
+    modes.add_argument("--points", type=_POINTS, default=150,
+                       help="radii (2 <= points <= 100000, default 150)")
     modes.add_argument("--simulate", action=argparse.BooleanOptionalAction, default=True,
                        help="add the simulated normal-force envelope to the plot")
     modes.set_defaults(func=_cmd_modes)
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    parser = _build_parser()
-    args = parser.parse_args(argv)
+def _say(text: str) -> None:
     try:
-        return int(args.func(args) or 0)
-    except WinderError as exc:
-        print(f"winder: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("winder: interrupted (no partial output written)", file=sys.stderr)
-        return 130
+        sys.stderr.write(text.rstrip("\n") + "\n")
+        sys.stderr.flush()
+    except (OSError, ValueError):  # stderr closed: the exit status still tells
+        pass
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; returns the exit status (see the module text)."""
+    with handling_signals(exiting=argv is None):
+        try:
+            try:
+                args = _build_parser().parse_args(argv)
+            except _UsageError as exc:
+                _say(str(exc))
+                return EXIT_ERROR
+            except _Exit as exc:
+                return exc.status
+            return int(args.func(args) or 0)
+        except WinderError as exc:
+            _say(f"winder: error: {exc}")
+            return EXIT_ERROR
+        except Interrupted as exc:
+            _say(f"winder: stopped by {exc.name} (no partial file left)")
+            return exc.exit_status
+        except KeyboardInterrupt:
+            _say("winder: interrupted (no partial file left)")
+            return 130
+        except BrokenPipeError:  # stdout closed by the reader (winder ... | head)
+            if argv is None:  # keep Python's exit flush from failing on it too
+                with contextlib.suppress(OSError):
+                    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            return 128 + 13  # as if killed by SIGPIPE
+        except MemoryError:
+            _say("winder: error: not enough memory for this run (shorten it or sample it "
+                 "more coarsely)")
+            return EXIT_ERROR
+        except Exception:
+            _say(traceback.format_exc())
+            _say("winder: internal error: this is a bug in winder; please report it with "
+                 "the command line and the traceback above")
+            return EXIT_INTERNAL
 
 
 if __name__ == "__main__":

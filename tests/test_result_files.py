@@ -1,0 +1,148 @@
+"""Result files read back: damaged NPZ and CSV files (truncated at any offset, bytes
+changed) give a ``ResultFileError`` naming the file, or the rows that are intact; a file
+that would need unpickling is refused, never loaded."""
+
+from __future__ import annotations
+
+import pickle
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_corpus import good_result_arrays, write_npz
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import winder
+from winder._result import ResultFileError
+
+HYPO = settings(max_examples=120, deadline=None,
+                suppress_health_check=[HealthCheck.function_scoped_fixture])
+
+
+def _original(tmp_path: Path) -> tuple[winder.Result, bytes, bytes]:
+    arrays = good_result_arrays(40)
+    res = winder.Result(arrays, {"scene": "free_spin"})
+    res.save(tmp_path / "full.csv", tmp_path / "full.npz")
+    return res, (tmp_path / "full.npz").read_bytes(), (tmp_path / "full.csv").read_bytes()
+
+
+def _load(path: Path) -> winder.Result | None:
+    """``load_result``, or ``None`` after checking its error is the clean one."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # no stray warnings either
+            return winder.load_result(path)
+    except ResultFileError as exc:
+        assert isinstance(exc, ValueError) and isinstance(exc, winder.WinderError)
+        assert str(path) in str(exc) and len(str(exc).splitlines()) == 1
+        assert "allow_pickle" not in str(exc)  # never advise unsafe loading
+        return None
+
+
+@HYPO
+@given(data=st.data())
+def test_truncated_npz_is_refused(data, tmp_path: Path) -> None:
+    _, npz, _ = _original(tmp_path)
+    cut = data.draw(st.integers(0, len(npz) - 1))
+    (tmp_path / "cut.npz").write_bytes(npz[:cut])
+    assert _load(tmp_path / "cut.npz") is None  # the archive's directory is at its end
+
+
+@HYPO
+@given(data=st.data())
+def test_npz_with_changed_bytes_is_refused_or_intact(data, tmp_path: Path) -> None:
+    res, npz, _ = _original(tmp_path)
+    raw = bytearray(npz)
+    for _ in range(data.draw(st.integers(1, 4))):
+        i = data.draw(st.integers(0, len(raw) - 1))
+        raw[i] = data.draw(st.integers(0, 255).filter(lambda b, i=i: b != raw[i]))
+    (tmp_path / "bad.npz").write_bytes(bytes(raw))
+    back = _load(tmp_path / "bad.npz")
+    if back is not None:  # a change the archive's checksums allow (names, dates): intact
+        for k in res:
+            np.testing.assert_array_equal(back[k], res[k])
+
+
+@HYPO
+@given(data=st.data())
+def test_truncated_or_changed_csv(data, tmp_path: Path) -> None:
+    """A CSV cut anywhere, or with a byte changed: the clean error, or rows equal to the
+    original's (the last row may be cut inside a number and differ)."""
+    res, _, csv = _original(tmp_path)
+    raw = bytearray(csv[:data.draw(st.integers(0, len(csv)))])
+    if raw and data.draw(st.booleans()):
+        i = data.draw(st.integers(0, len(raw) - 1))
+        raw[i] = data.draw(st.sampled_from(b"\x00\xff,-.e9 \n\r"))
+    (tmp_path / "bad.csv").write_bytes(bytes(raw))
+    back = _load(tmp_path / "bad.csv")
+    if back is not None:
+        assert np.all(np.isfinite(back.t)) and np.all(np.diff(back.t) > 0)
+        if list(back) == list(res):
+            n = len(back.t)
+            assert n <= len(res.t)
+            for k in res:  # every row before the last is intact unless a byte changed in it
+                same = np.isclose(back[k][:n - 1], res[k][:n - 1], rtol=1e-14, atol=0)
+                assert same.sum() >= n - 2, k
+
+
+@HYPO
+@given(blob=st.binary(max_size=2000), suffix=st.sampled_from([".npz", ".csv"]))
+def test_random_bytes_are_refused(blob: bytes, suffix: str, tmp_path: Path) -> None:
+    path = tmp_path / f"junk{suffix}"
+    path.write_bytes(blob)
+    back = _load(path)
+    if back is not None:  # random bytes that happen to be a table of numbers
+        assert suffix == ".csv" and np.all(np.diff(back.t) > 0)
+
+
+def test_pickles_are_never_loaded(tmp_path: Path, monkeypatch) -> None:
+    """A pickle given as a result, and an NPZ with an object member: refused without
+    unpickling (pickle.loads would run the payload)."""
+    ran = []
+
+    class Payload:
+        def __reduce__(self):
+            return (ran.append, ("unpickled",))
+    (tmp_path / "p.npz").write_bytes(pickle.dumps(Payload()))
+    arrays = good_result_arrays()
+    arrays["radius"] = np.array([Payload()] * len(arrays["t"]), dtype=object)
+    with open(tmp_path / "o.npz", "wb") as fh:
+        np.savez(fh, **arrays)
+    monkeypatch.setattr(pickle, "loads", lambda *a, **k: ran.append("pickle.loads"))
+    monkeypatch.setattr(pickle, "load", lambda *a, **k: ran.append("pickle.load"))
+    for name in ("p.npz", "o.npz"):
+        with pytest.raises(ResultFileError, match=name):
+            winder.load_result(tmp_path / name)
+    assert ran == []
+
+
+def test_roundtrip_and_names(tmp_path: Path) -> None:
+    res = winder.Result(good_result_arrays(), {"scene": "s", "x": [1, 2]})
+    for f in (tmp_path / "r.npz", tmp_path / "r.csv"):
+        back = winder.load_result(res.save(f))
+        assert list(back) == list(res)
+        for k in res:
+            np.testing.assert_allclose(back[k], res[k], rtol=5e-15 if f.suffix == ".csv"
+                                       else 0, atol=0)
+        back["radius"][0] = 1.0  # loaded arrays are the caller's to change (CSV: 15 digits)
+    assert winder.load_result(tmp_path / "r.npz").meta == {"scene": "s", "x": [1, 2]}
+    for bad in (tmp_path / "missing.npz", tmp_path, tmp_path / "r.txt"):
+        with pytest.raises(ResultFileError, match=str(bad.name)):
+            winder.load_result(bad)
+
+
+def test_metadata_and_channels_checked(tmp_path: Path) -> None:
+    cases = {
+        "meta_list.npz": (good_result_arrays(), [1, 2], "metadata"),
+        "meta_text.npz": (good_result_arrays(), "{oops", "metadata"),
+        "no_t.npz": ({k: v for k, v in good_result_arrays().items() if k != "t"}, None,
+                     "'t'"),
+        "back.npz": ({**good_result_arrays(), "t": np.linspace(1, 0, 50)}, None,
+                     "not increasing"),
+    }
+    for name, (arrays, meta, message) in cases.items():
+        write_npz(tmp_path / name, arrays, meta)
+        with pytest.raises(ResultFileError, match=message):
+            winder.load_result(tmp_path / name)

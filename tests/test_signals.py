@@ -1,0 +1,267 @@
+"""Stopping the command line with SIGINT, SIGTERM and SIGHUP at different phases (real
+processes, real signals): exit status 128 + signal, one line on stderr, no traceback, no
+temporary file, no partial output, no child process left, the temp directory empty."""
+
+from __future__ import annotations
+
+import functools
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_corpus import FREE_SPIN, good_result_arrays, write_npz
+
+SIGNALS = [signal.SIGINT, signal.SIGTERM, signal.SIGHUP]
+
+
+def _spawn(tmp_path: Path, *args: str) -> subprocess.Popen:
+    (tmp_path / "tmp").mkdir(exist_ok=True)
+    env = dict(os.environ, TMPDIR=str(tmp_path / "tmp"), PYTHONUNBUFFERED="1")
+    return subprocess.Popen([sys.executable, "-m", "winder", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path)
+
+
+def _wait_for(what: Callable[[], object], proc: subprocess.Popen, timeout: float = 60.0,
+              poll: float = 0.002) -> None:
+    end = time.monotonic() + timeout
+    while not what():
+        if proc.poll() is not None:
+            raise AssertionError(f"process ended first: {proc.communicate()}")
+        if time.monotonic() > end:
+            proc.kill()
+            raise AssertionError("timed out")
+        time.sleep(poll)
+
+
+def _finish(proc: subprocess.Popen) -> tuple[int, str]:
+    _, err = proc.communicate(timeout=60)
+    return proc.returncode, err
+
+
+def _assert_stopped(status: int, err: str, sig: int) -> None:
+    assert status == 128 + sig, (status, err)
+    assert "Traceback" not in err, err
+    assert err.strip() == f"winder: stopped by {signal.Signals(sig).name} (no partial file " \
+        "left)", err
+
+
+def _debris(folder: Path) -> list[Path]:
+    return [p for p in folder.rglob("*") if p.name.startswith(".winder-")]
+
+
+def _big_scene(folder: Path) -> Path:
+    """A 6 s free spin sampled every 0.1 ms: 60 001 rows, about 2 s of CSV writing."""
+    p = folder / "big.toml"
+    p.write_text(FREE_SPIN.replace("duration = 300.0", "duration = 6.0")
+                 .replace("output_step = 0.05 ", "output_step = 1e-4"))
+    return p
+
+
+@pytest.mark.parametrize(("sig", "previous"), [
+    (signal.SIGINT, False), (signal.SIGTERM, False), (signal.SIGHUP, False),
+    (signal.SIGTERM, True)], ids=["SIGINT", "SIGTERM", "SIGHUP", "SIGTERM-existing"])
+def test_signal_while_writing(sig: int, previous: bool, tmp_path: Path) -> None:
+    out = tmp_path / "out" / "r.csv"
+    if previous:
+        out.parent.mkdir()
+        out.write_text("previous\n")
+    proc = _spawn(tmp_path, "run", str(_big_scene(tmp_path)), "--out", str(out))
+    _wait_for(lambda: out.parent.is_dir() and _debris(out.parent), proc)
+    proc.send_signal(sig)
+    _assert_stopped(*_finish(proc), sig)
+    assert _debris(tmp_path) == []
+    assert not out.with_suffix(".npz").exists()  # neither the CSV nor its twin
+    if previous:
+        assert out.read_text() == "previous\n"  # untouched
+    else:
+        assert not out.parent.exists()  # the folder it made is gone too
+    assert list((tmp_path / "tmp").iterdir()) == []
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP],
+                         ids=["SIGTERM", "SIGHUP"])
+def test_signal_during_the_run(sig: int, tmp_path: Path) -> None:
+    """Sent 0.3 s after ``main`` installed its handlers: while the scene is integrated."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(FREE_SPIN)
+    out = tmp_path / "r.npz"
+    proc = _spawn(tmp_path, "run", str(scene), "--out", str(out), "--plots",
+                  str(tmp_path / "plots"))
+    _wait_for(lambda: _catches(proc.pid, signal.SIGTERM), proc)
+    time.sleep(0.3)
+    proc.send_signal(sig)
+    _assert_stopped(*_finish(proc), sig)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml", "tmp"]
+    assert list((tmp_path / "tmp").iterdir()) == []
+
+
+def test_second_sigint_while_writing(tmp_path: Path) -> None:
+    out = tmp_path / "r.csv"
+    proc = _spawn(tmp_path, "run", str(_big_scene(tmp_path)), "--out", str(out))
+    _wait_for(lambda: _debris(tmp_path), proc)
+    proc.send_signal(signal.SIGINT)
+    time.sleep(0.005)
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    status, err = _finish(proc)
+    assert status == 130 and "SIGINT" in err and "Traceback" not in err, err
+    assert _debris(tmp_path) == [] and not out.exists() and not out.with_suffix(".npz").exists()
+
+
+_SLOW_CLEANUP = """
+import sys, time, pathlib
+from winder._interrupt import Interrupted, handling_signals, on_abort
+tmp = pathlib.Path(sys.argv[1])
+with handling_signals():
+    tmp.write_text("temporary")
+    try:
+        with on_abort(lambda: tmp.unlink(missing_ok=True)):
+            print("ready", flush=True)
+            time.sleep(60)
+    except Interrupted:
+        print("cleaning up", flush=True)
+        time.sleep(60)  # a slow clean-up, interrupted by the second signal
+"""
+
+
+@pytest.mark.parametrize("second", [signal.SIGINT, signal.SIGTERM],
+                         ids=["SIGINT", "SIGTERM"])
+def test_second_signal_during_cleanup_says_so(second: int, tmp_path: Path) -> None:
+    tmp = tmp_path / "partial.tmp"
+    proc = subprocess.Popen([sys.executable, "-c", _SLOW_CLEANUP, str(tmp)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "ready"
+    proc.send_signal(signal.SIGINT)
+    assert proc.stdout.readline().strip() == "cleaning up"
+    t0 = time.monotonic()
+    proc.send_signal(second)
+    status, err = _finish(proc)
+    assert time.monotonic() - t0 < 10.0  # it stopped, it did not sleep out the clean-up
+    assert status == 128 + second
+    assert err.strip() == (f"winder: {signal.Signals(second).name} again during clean-up: "
+                           "temporary files removed, stopping now")
+    assert not tmp.exists()
+
+
+def _children(pid: int) -> list[tuple[int, str]]:
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+            if int(fields[1]) == pid:
+                cmd = (stat.parent / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+                found.append((int(stat.parent.name), cmd))
+        except (OSError, IndexError, ValueError):
+            continue
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_live_view_stops_its_meshcat_server(sig: int, tmp_path: Path, paper_scene) -> None:
+    arrays = good_result_arrays()
+    src = write_npz(tmp_path / "r.npz", arrays,
+                    {"scene": "paper", "scene_dict": paper_scene.to_dict()})
+    proc = _spawn(tmp_path, "view", str(src))
+    lines = []
+    while not (lines and lines[-1].startswith("live view at")):
+        lines.append(proc.stdout.readline())  # meshcat prints its URL first
+        assert lines[-1], (lines, proc.stderr.read())
+    servers = [p for p, cmd in _children(proc.pid) if "meshcat.servers.zmqserver" in cmd]
+    assert len(servers) == 1
+    proc.send_signal(sig)
+    status, err = _finish(proc)
+    if sig == signal.SIGINT:  # Ctrl-C is how a live view ends
+        assert status == 0 and err.strip() == "live view stopped", err
+    else:
+        _assert_stopped(status, err, sig)
+    assert not _alive(servers[0])
+
+
+def _catches(pid: int, sig: int) -> bool:
+    """Whether process ``pid`` has a handler for ``sig`` (``SigCgt`` in /proc/PID/status):
+    the command line installs its SIGTERM handler first thing in ``main``."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    mask = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("SigCgt")), 16)
+    return bool(mask >> (sig - 1) & 1)
+
+
+@functools.cache
+def _winder_imports_lazily() -> bool:
+    probe = subprocess.run([sys.executable, "-c", "import sys, winder.cli; "
+                            "print('pinocchio' in sys.modules)"], capture_output=True,
+                           text=True, timeout=120)
+    return probe.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("sig", SIGNALS, ids=lambda s: signal.Signals(s).name)
+def test_signal_during_start_up(sig: int, tmp_path: Path) -> None:
+    """Signals as soon as ``main`` has started, while the command imports its modules
+    (only where ``import winder.cli`` is light: otherwise everything is imported before
+    ``main`` runs, and a signal then is Python's own)."""
+    if not _winder_imports_lazily():
+        pytest.skip("'import winder.cli' imports all of winder before the command line "
+                    "starts; a signal during that import is Python's own")
+    proc = _spawn(tmp_path, "run", str(_big_scene(tmp_path)), "--out", str(tmp_path / "r.npz"))
+    _wait_for(lambda: _catches(proc.pid, signal.SIGTERM), proc)  # main() has started
+    proc.send_signal(sig)
+    _assert_stopped(*_finish(proc), sig)
+    assert not (tmp_path / "r.npz").exists()
+
+
+@pytest.fixture(scope="module")
+def fmu_available() -> None:
+    pytest.importorskip("pythonfmu", reason="pythonfmu is installed with winder[fmu]")
+
+
+@pytest.mark.parametrize(("sig", "phase"), [(signal.SIGTERM, "build")])
+def test_fmu_stopped_leaves_no_build_folder(sig: int, phase: str, tmp_path: Path,
+                                            fmu_available) -> None:
+    scene = tmp_path / "s.toml"
+    scene.write_text(FREE_SPIN)
+    out = tmp_path / "out" / "w.fmu"
+    proc = _spawn(tmp_path, "fmu", str(scene), "-o", str(out))
+    if phase == "build":
+        _wait_for(lambda: any((tmp_path / "tmp").iterdir()), proc)
+    else:
+        _wait_for(out.exists, proc)
+    proc.send_signal(sig)
+    status, err = _finish(proc)
+    if phase == "check" and status == 0:  # it had finished: a complete FMU
+        import zipfile
+        assert zipfile.ZipFile(out).testzip() is None
+    else:
+        _assert_stopped(status, err, sig)
+    assert list((tmp_path / "tmp").iterdir()) == []
+    assert _debris(tmp_path) == []
+    if phase == "build":
+        assert not out.parent.exists()
+    else:
+        assert sorted(out.parent.iterdir()) == [out]
+
+
+def test_partial_npz_never_loads(tmp_path: Path) -> None:
+    """What a killed writer of the earlier versions could leave: a prefix of an NPZ."""
+    import winder
+
+    full = write_npz(tmp_path / "full.npz", good_result_arrays()).read_bytes()
+    for cut in np.linspace(0, len(full) - 1, 7).astype(int):
+        (tmp_path / "cut.npz").write_bytes(full[:cut])
+        with pytest.raises(winder.WinderError, match="cut.npz"):
+            winder.load_result(tmp_path / "cut.npz")
