@@ -40,7 +40,7 @@ def _bar(stream: TextIO | None, **kw) -> tqdm:
     tty = bool(getattr(stream, "isatty", lambda: False)())
     return tqdm(file=stream if tty else _Lines(stream),
                 mininterval=_TTY_INTERVAL if tty else _LOG_INTERVAL,
-                ncols=None if tty else 100, dynamic_ncols=tty, leave=True, **kw)
+                dynamic_ncols=tty, leave=True, **kw)
 
 
 class Progress:

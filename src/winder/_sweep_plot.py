@@ -116,7 +116,7 @@ def runnability_map(table: SweepTable, path: str | Path, *, column: str = "vibra
                     ax.plot(2 * r, 2 * math.pi * r * fb / k, "c" + style, lw=1.4,
                             label=f"{k}× rotation = bounce mode")
                 ax.set_ylim(_cell_edges(ys)[0], _cell_edges(ys)[-1])
-                ax.legend(fontsize=7, loc="upper right")
+                ax.legend(fontsize=7, loc="lower right")
         ax.set_xlim(d_edges[0], d_edges[-1])
         ax.set_title(", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
                                for k, v in fixed.items()) or "", fontsize=9)

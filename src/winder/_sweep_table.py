@@ -117,7 +117,7 @@ class RunStore:
         rid = str(row["run_id"])
         if trajectory is not None:
             trajectory.to_npz(self.trajectory_path(rid))
-        table = _table([row], schema)
+        table = _table([row], schema.remove_metadata())  # the metadata lives in the summary
         return atomic_write(self.row_path(rid), lambda p: pq.write_table(table, p))
 
     def write_table(self, rows: Sequence[Mapping[str, Any]], schema: pa.Schema) -> Path:
