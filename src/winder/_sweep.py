@@ -120,6 +120,18 @@ def _edges(bands: int | Sequence[float], grid: Grid, t_end: float | None) -> np.
     return edges
 
 
+def _why_missing(future: Any) -> str:
+    """One line on why a task gave no row (its worker died, it was cancelled, ...)."""
+    if future.status == "cancelled":
+        return "cancelled"
+    exc = future.exception()
+    last = getattr(exc, "last_worker", None)
+    if last is not None:  # distributed's KilledWorker
+        return (f"{type(exc).__name__}: the worker running it died "
+                f"{exc.allowed_failures + 1} time(s), last {last.address}")
+    return f"{type(exc).__name__}: {exc}"
+
+
 @contextmanager
 def _client(scheduler: Any, workers: int | None) -> Iterator[Any]:
     """A Dask client: the one given, one attached to ``scheduler`` (an address), or one
@@ -190,7 +202,9 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
     base = scene if isinstance(scene, Scene) else load_scene(scene)
     if not isinstance(vary, Mapping) or not vary:
         raise ArgumentError(f"vary: give at least one {{key: values}}, got {vary!r}")
-    values = {k: parse_spec(k, v) if isinstance(v, str) else list(v) for k, v in vary.items()}
+    values = {k: parse_spec(k, v) if isinstance(v, str)
+              else [x.item() if isinstance(x, np.generic) else x for x in v]
+              for k, v in vary.items()}
     grid = build_grid(base, values)
     settings = run_settings(t_end=t_end, rtol=rtol, output_step=output_step,
                             max_wall=max_wall, window=window, threshold=threshold)
@@ -246,10 +260,8 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
                         if callback is not None:
                             callback(row)
                     else:
-                        reason = fut.status if fut.status == "cancelled" else \
-                            f"{type(fut.exception()).__name__}: {fut.exception()}"
                         missing.append({"run": i, **grid.points[i], "run_id": ids[i],
-                                        "reason": reason})
+                                        "reason": _why_missing(fut)})
                         failed = True
                     fut.release()
                     if bar is not None:
