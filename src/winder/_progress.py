@@ -6,6 +6,7 @@ pipe each update is one whole line (no carriage returns), at most every 5 s.
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from typing import TextIO
@@ -35,9 +36,17 @@ class _Lines:
         self.stream.flush()
 
 
+def _is_terminal(stream: TextIO) -> bool:
+    """A terminal with a width (a pseudo-terminal of width 0 gets whole lines too)."""
+    try:
+        return stream.isatty() and os.get_terminal_size(stream.fileno()).columns > 0
+    except (AttributeError, OSError, ValueError):
+        return False
+
+
 def _bar(stream: TextIO | None, **kw) -> tqdm:
     stream = sys.stderr if stream is None else stream
-    tty = bool(getattr(stream, "isatty", lambda: False)())
+    tty = _is_terminal(stream)
     return tqdm(file=stream if tty else _Lines(stream),
                 mininterval=_TTY_INTERVAL if tty else _LOG_INTERVAL,
                 dynamic_ncols=tty, leave=True, **kw)
