@@ -151,6 +151,13 @@ def test_bad_specs_rejected_before_anything_is_submitted(base, tmp_path, monkeyp
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "roll.com_offset" in lines[0] and "-0.002" in lines[0]
     assert not out.exists()
+    # a map that cannot be drawn (words on its vertical axis) is refused before the runs
+    code = main(["sweep", str(models_dir / "paper_winding.toml"), "--vary",
+                 "contact.law=linear,hunt_crossley", "--out", str(out), "--plot"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "--plot" in err and "contact.law" in err and "'hunt_crossley'" in err
+    assert not out.exists()
 
 
 # ---- summaries -------------------------------------------------------------------------

@@ -226,10 +226,9 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
     def row_of(i: int, fields: Mapping[str, Any]) -> dict[str, Any]:
         return {**fields, "run": i, **grid.points[i], "run_id": ids[i], "scene_hash": hashes[i]}
 
-    index = {rid: i for i, rid in enumerate(ids)}
     done = store.load_done(ids, trajectories=trajectories)
-    rows = {rid: row_of(index[rid], r) for rid, r in done.items()}
-    todo = [i for i, rid in enumerate(ids) if rid not in done]
+    rows = {i: row_of(i, done[rid]) for i, rid in enumerate(ids) if rid in done}
+    todo = [i for i in range(len(ids)) if i not in rows]
     computed: list[str] = []
     missing: list[dict[str, Any]] = []
     dashboard = None
@@ -240,9 +239,9 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
             dashboard = client.dashboard_link
             bar = None
             if progress:
-                print(f"winder sweep: {len(grid)} runs ({len(done)} already done in {out}), "
+                print(f"winder sweep: {len(grid)} runs ({len(rows)} already done in {out}), "
                       f"Dask dashboard: {dashboard}", file=sys.stderr, flush=True)
-                bar = SweepProgress(len(grid), done=len(done), label=base.name)
+                bar = SweepProgress(len(grid), done=len(rows), label=base.name)
             token = uuid.uuid4().hex[:8]
             futures = {client.submit(run_one, grid.scenes[i], settings, edges, trajectories,
                                      key=f"winder-run-{i}-{ids[i]}-{token}", pure=False): i
@@ -254,7 +253,7 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
                         fields, result = fut.result()
                         row = row_of(i, fields)
                         store.write_run(row, schema, result if trajectories else None)
-                        rows[ids[i]] = row
+                        rows[i] = row
                         computed.append(ids[i])
                         failed = row["status"] != "ok"
                         if callback is not None:

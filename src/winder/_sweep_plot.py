@@ -31,7 +31,7 @@ from ._scene import scene_from_dict  # noqa: E402
 from ._sweep_grid import set_path  # noqa: E402
 from ._sweep_table import SweepTable  # noqa: E402
 
-__all__ = ["runnability_map", "SPEED_KEY"]
+__all__ = ["runnability_map", "map_layout", "SPEED_KEY"]
 
 #: The key path of the web speed: the map's vertical axis when it is swept.
 SPEED_KEY = "drum.drive.web_speed"
@@ -64,6 +64,24 @@ def _critical_lines(table: SweepTable, fixed: dict, speeds: np.ndarray,
     return mm.radius, mm.bounce_frequency
 
 
+def map_layout(vary: dict[str, list]) -> tuple[str, list[str]]:
+    """``(vertical key, panel keys)`` of the map of a sweep over ``vary`` (``{key:
+    values}``); raises :class:`ArgumentError` when it cannot be drawn (checked before a
+    sweep runs): a non-numeric vertical key, or more than 12 panels."""
+    keys = list(vary)
+    ykey = SPEED_KEY if SPEED_KEY in keys else keys[0]
+    if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in vary[ykey]):
+        raise ArgumentError(f"--plot: the runnability map needs numbers on its vertical "
+                            f"axis; {ykey} has values {list(vary[ykey])}")
+    others = [k for k in keys if k != ykey]
+    panels = math.prod(len(set(vary[k])) for k in others)
+    if panels > _MAX_PANELS:
+        raise ArgumentError(f"--plot: the runnability map draws one panel per combination "
+                            f"of {', '.join(others)}: {panels} panels, at most "
+                            f"{_MAX_PANELS}; sweep fewer values")
+    return ykey, others
+
+
 def runnability_map(table: SweepTable, path: str | Path, *, column: str = "vibration_level",
                     title: str = "") -> Path:
     """Draw the runnability map of ``table`` into ``path`` (PNG); returns the path.
@@ -71,20 +89,11 @@ def runnability_map(table: SweepTable, path: str | Path, *, column: str = "vibra
     The vertical axis is the web speed when ``drum.drive.web_speed`` is swept (with the
     critical-speed lines), else the first swept key. ``column``: the per-band column that
     colours the cells (``vibration_level`` by default)."""
-    keys = list(table.keys)
-    ykey = SPEED_KEY if SPEED_KEY in keys else keys[0]
-    others = [k for k in keys if k != ykey]
     frame = table.frame
     if len(frame) == 0:
         raise ArgumentError(f"{table.path}: the sweep has no finished run to draw")
-    if not np.issubdtype(frame[ykey].dtype, np.number):
-        raise ArgumentError(f"the runnability map needs a numeric swept key on its vertical "
-                            f"axis; {ykey!r} has values {sorted(set(frame[ykey]))}")
+    ykey, others = map_layout({k: frame[k].tolist() for k in table.keys})
     combos = list(itertools.product(*(sorted(set(frame[k])) for k in others))) or [()]
-    if len(combos) > _MAX_PANELS:
-        raise ArgumentError(f"the runnability map draws one panel per combination of "
-                            f"{', '.join(others)}: {len(combos)} panels, at most "
-                            f"{_MAX_PANELS}; sweep fewer values")
     level = table.bands(column)
     d_edges = 2 * table.band_edges
     ncol = min(3, len(combos))

@@ -176,6 +176,10 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     vary = parse_vary(args.vary)
+    if args.plot:
+        from ._sweep_plot import map_layout
+
+        map_layout(vary)  # a map that cannot be drawn stops the sweep before it runs
     try:
         table = sweep(scene, vary, args.out, scheduler=args.scheduler, workers=args.workers,
                       t_end=args.t_end, rtol=args.rtol, output_step=args.output_step,
