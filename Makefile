@@ -30,6 +30,7 @@ demo: $(STAMP) chromium
 	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
 	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
 	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
+	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
 	@echo "demo outputs in $(OUT)/"
 
 test: $(STAMP) chromium

@@ -84,6 +84,8 @@ __all__ = [
     "modes_at",
     "scene_from_dict",
     "simulate",
+    "sweep",
+    "SweepTable",
     "FunctionMassLaw",
     "MassLaw",
     "MassProperties",
@@ -95,3 +97,15 @@ __all__ = [
     "WinderError",
 ]
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str) -> object:
+    """``sweep`` and ``SweepTable`` are imported on first use (they pull in Dask, pandas
+    and pyarrow, which plain simulation does not need)."""
+    if name == "sweep":
+        from ._sweep import sweep
+        return sweep
+    if name == "SweepTable":
+        from ._sweep_table import SweepTable
+        return SweepTable
+    raise AttributeError(f"module 'winder' has no attribute {name!r}")

@@ -1,4 +1,4 @@
-"""Command-line interface: ``winder run|view|fmu|modes`` (also ``python -m winder``).
+"""Command-line interface: ``winder run|view|fmu|modes|sweep`` (also ``python -m winder``).
 
 Exit status
 -----------
@@ -11,7 +11,8 @@ Exit status
   stay, no partial file is left. A second signal during that clean-up stops at once, with
   a message.
 - 141 when the reader of stdout went away (``winder modes ... | head``), as for SIGPIPE.
-- 1: an internal error of winder (a bug): the traceback and a line saying so.
+- 1: an internal error of winder (a bug): the traceback and a line saying so; for
+  ``winder sweep``, also: runs are missing (their workers died), listed on stderr.
 """
 
 from __future__ import annotations
@@ -308,6 +309,49 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    """``winder sweep``: the grid on Dask, the summary table, optionally the map. Exit 0
+    when every run is done (failed runs are recorded in the table), 1 when runs are
+    missing (workers died), 130 on Ctrl-C (finished runs are kept: re-run to resume)."""
+    from ._scene import load_scene
+    from ._sweep import sweep
+    from ._sweep_grid import parse_vary
+
+    scene = load_scene(args.scene)
+    vary = parse_vary(args.vary)
+    if args.plot:
+        from ._sweep_plot import map_layout
+
+        map_layout(vary)  # a map that cannot be drawn stops the sweep before it runs
+    try:
+        table = sweep(scene, vary, args.out, scheduler=args.scheduler, workers=args.workers,
+                      t_end=args.t_end, rtol=args.rtol, output_step=args.output_step,
+                      max_wall=args.max_wall, bands=args.bands,
+                      threshold=args.vibration_threshold, trajectories=args.trajectories,
+                      progress=args.progress)
+    except KeyboardInterrupt:
+        print(f"winder: interrupted; finished runs are kept in {args.out}/runs; run the same "
+              "command again to resume", file=sys.stderr)
+        return 130
+    n_bad = int((table.frame["status"] != "ok").sum())
+    print(f"{scene.name}: {len(table)} runs in {table.path} ({len(table.computed)} run now, "
+          f"{len(table.skipped)} already done, {n_bad} failed)")
+    if args.plot:
+        from ._sweep_plot import runnability_map
+
+        png = Path(args.out) / "runnability_map.png" if args.plot is True else args.plot
+        print(f"  runnability map written to "
+              f"{runnability_map(table, png, title=f'Runnability map of {scene.name}')}")
+    if table.missing:
+        print(f"winder: {len(table.missing)} runs missing (their workers died); run the same "
+              "command again to retry them:", file=sys.stderr)
+        for m in table.missing:
+            values = ", ".join(f"{k} = {m[k]!r}" for k in table.keys)
+            print(f"  run {m['run']} ({values}): {m['reason']}", file=sys.stderr)
+        return 1
+    return 0
+
+
 def _build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="winder", description="Paper winder simulation.",
                      epilog="Exit status: 0 done; 2 bad input or failed run (a message names "
@@ -362,6 +406,32 @@ def _build_parser() -> argparse.ArgumentParser:
     modes.add_argument("--simulate", action=argparse.BooleanOptionalAction, default=True,
                        help="add the simulated normal-force envelope to the plot")
     modes.set_defaults(func=_cmd_modes)
+    sweep = sub.add_parser("sweep", help="run a scene over a parameter grid on Dask "
+                           "(runnability map)")
+    sweep.add_argument("scene", help="scene file (TOML)")
+    sweep.add_argument("--vary", action="append", required=True, metavar="KEY=SPEC",
+                       help="scene key path and values: a range START:STOP:COUNT or a list "
+                       "a,b,c (repeat for a grid), e.g. drum.drive.web_speed=15:45:16")
+    sweep.add_argument("--out", required=True, help="output directory (resumes a sweep "
+                       "already there)")
+    sweep.add_argument("--scheduler", help="address of a running Dask scheduler (default: "
+                       "an embedded local cluster)")
+    sweep.add_argument("--workers", type=int, help="local workers (default: one per core)")
+    sweep.add_argument("--plot", nargs="?", const=True, metavar="PNG",
+                       help="draw the runnability map (default OUT/runnability_map.png)")
+    sweep.add_argument("--trajectories", action="store_true",
+                       help="also store each run's full result (OUT/trajectories/*.npz)")
+    sweep.add_argument("--t-end", type=_positive, help="end time of each run [s]")
+    sweep.add_argument("--rtol", type=_positive)
+    sweep.add_argument("--output-step", type=_positive, help="sampling of the runs [s]")
+    sweep.add_argument("--max-wall", type=_positive, help="wall-clock budget per run [s]")
+    sweep.add_argument("--bands", type=int, default=24, help="radius bands (default 24)")
+    sweep.add_argument("--vibration-threshold", type=_positive, default=0.5,
+                       help="vibration level where vibration starts (default 0.5)")
+    sweep.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
+                       help="progress bar and dashboard address on stderr (default on; "
+                       "whole lines every 5 s on a log or pipe)")
+    sweep.set_defaults(func=_cmd_sweep)
     return parser
 
 

@@ -1,0 +1,251 @@
+"""The grid of a parameter sweep: scene key paths, value specs, and the scenes they make.
+
+A key path names one value in a scene's nested tables, dot-separated, e.g.
+``drum.drive.web_speed`` or ``roll.com_offset``. Where a level is an array of tables (TOML
+``[[nip]]``), the next segment selects the element by its ``name``: ``nip.rear.contact.
+stiffness`` is ``stiffness`` in table ``contact`` of the ``[[nip]]`` element whose
+``name = "rear"``. Resolution works on any nested ``dict``/``list`` structure
+(:meth:`Scene.to_dict`), so new scene formats need no change here.
+
+A value spec is a range ``START:STOP:COUNT`` (``COUNT`` values from ``START`` to ``STOP``
+inclusive, evenly spaced) or a comma-separated list (numbers, ``true``/``false``, or
+words such as ``linear,hunt_crossley``).
+
+Every grid point is built into a validated :class:`~winder.Scene` before anything runs:
+an unknown key, an empty range or a value the scene rejects raises
+:class:`~winder.ArgumentError` naming the key.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ._errors import ArgumentError, SceneError
+from ._scene import Scene, scene_from_dict
+
+__all__ = ["Axis", "Grid", "parse_spec", "parse_vary", "resolve", "get_path", "set_path",
+           "scene_hash", "build_grid"]
+
+Value = float | int | bool | str
+
+
+# ---- key paths on nested dicts ---------------------------------------------------------
+
+def _names(node: list) -> list[str]:
+    return [str(e.get("name")) for e in node if isinstance(e, Mapping) and "name" in e]
+
+
+def resolve(data: Any, key: str) -> tuple[Any, str | int]:
+    """``(container, slot)`` of the value that ``key`` names in nested ``data``:
+    ``container[slot]`` is the value (the slot may not exist yet: a key the scene leaves
+    at its default). Dicts are entered by key; lists of tables by the element's ``name``.
+
+    Raises :class:`ArgumentError` naming the key path where a segment does not exist.
+    """
+    parts = key.split(".")
+    if not key or any(p == "" for p in parts):
+        raise ArgumentError(f"key {key!r}: a key path is dot-separated names, e.g. "
+                            "drum.drive.web_speed")
+    node = data
+    for i, part in enumerate(parts):
+        last = i == len(parts) - 1
+        here = ".".join(parts[:i]) or "the scene"
+        if isinstance(node, Mapping):
+            if last:
+                return node, part
+            if part not in node:
+                raise ArgumentError(f"key {key!r}: {here} has no table {part!r}; valid: "
+                                    + ", ".join(k for k in node
+                                                if isinstance(node[k], Mapping | list)))
+            node = node[part]
+        elif isinstance(node, list):
+            names = _names(node)
+            if part not in names:
+                raise ArgumentError(f"key {key!r}: no element named {part!r} in {here}; "
+                                    f"valid names: {', '.join(names) or '(none)'}")
+            idx = names.index(part)
+            if last:
+                raise ArgumentError(f"key {key!r} selects a whole table ({here} named "
+                                    f"{part!r}); name a value inside it")
+            node = node[idx]
+        else:
+            raise ArgumentError(f"key {key!r}: {here} is a value ({node!r}), not a table")
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def get_path(data: Any, key: str) -> Any:
+    """The value at ``key`` in nested ``data`` (``KeyError`` when the key is absent)."""
+    container, slot = resolve(data, key)
+    if slot not in container:
+        raise KeyError(key)
+    return container[slot]
+
+
+def set_path(data: Any, key: str, value: Any) -> None:
+    """Set the value at ``key`` in nested ``data`` in place (the leaf may be new; tables
+    and array elements must exist). Setting a whole table is refused."""
+    container, slot = resolve(data, key)
+    if isinstance(container.get(slot), Mapping | list):
+        sub = container[slot]
+        inner = ", ".join(sub) if isinstance(sub, Mapping) else ", ".join(_names(sub))
+        raise ArgumentError(f"key {key!r} is a table, not a value; name one of its "
+                            f"entries: {inner}")
+    container[slot] = value
+
+
+# ---- value specs -----------------------------------------------------------------------
+
+def _word(text: str) -> Value:
+    t = text.strip()
+    if t.lower() in ("true", "false"):
+        return t.lower() == "true"
+    try:
+        return int(t)
+    except ValueError:
+        pass
+    try:
+        return float(t)
+    except ValueError:
+        return t
+
+
+def parse_spec(key: str, spec: str) -> list[Value]:
+    """Values of one ``--vary`` spec: ``START:STOP:COUNT`` or ``a,b,c``."""
+    text = spec.strip()
+    if ":" in text:
+        parts = text.split(":")
+        if len(parts) != 3:
+            raise ArgumentError(f"--vary {key}={spec}: a range is START:STOP:COUNT, "
+                                "e.g. 15:45:16")
+        try:
+            start, stop = float(parts[0]), float(parts[1])
+            count = int(parts[2])
+        except ValueError:
+            raise ArgumentError(f"--vary {key}={spec}: a range is START:STOP:COUNT with "
+                                "numbers START, STOP and a whole COUNT, e.g. 15:45:16") \
+                from None
+        if not (math.isfinite(start) and math.isfinite(stop)):
+            raise ArgumentError(f"--vary {key}={spec}: range ends must be finite")
+        if count < 1:
+            raise ArgumentError(f"--vary {key}={spec}: empty range (COUNT = {count}); "
+                                "COUNT must be >= 1")
+        if count > 1 and start == stop:
+            raise ArgumentError(f"--vary {key}={spec}: empty range ({count} copies of "
+                                f"{start:g}); give START != STOP or COUNT = 1")
+        return [float(v) for v in np.linspace(start, stop, count)]
+    items = [s for s in text.split(",")]
+    if not text or any(not s.strip() for s in items):
+        raise ArgumentError(f"--vary {key}={spec}: empty value list; give a range "
+                            "START:STOP:COUNT or values a,b,c")
+    values = [_word(s) for s in items]
+    seen = set()
+    for v in values:
+        if (type(v), v) in seen:
+            raise ArgumentError(f"--vary {key}={spec}: value {v!r} is listed twice")
+        seen.add((type(v), v))
+    return values
+
+
+def parse_vary(items: Sequence[str]) -> dict[str, list[Value]]:
+    """``["KEY=SPEC", ...]`` (the ``--vary`` options) → ``{key: values}`` in order."""
+    out: dict[str, list[Value]] = {}
+    for item in items:
+        key, sep, spec = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ArgumentError(f"--vary {item!r}: expected KEY=SPEC, e.g. "
+                                "drum.drive.web_speed=15:45:16")
+        if key in out:
+            raise ArgumentError(f"--vary {key}: the key is given twice")
+        out[key] = parse_spec(key, spec)
+    if not out:
+        raise ArgumentError("--vary: give at least one KEY=SPEC")
+    return out
+
+
+# ---- the grid --------------------------------------------------------------------------
+
+def scene_hash(data: Mapping[str, Any]) -> str:
+    """Hex digest (16 characters) of a scene's nested tables: equal scenes, equal hash."""
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One swept key and its values."""
+
+    key: str
+    values: tuple[Value, ...]
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The full factorial grid of a sweep: ``points[i]`` maps each key to its value in
+    run ``i`` (first axis outermost), ``scenes[i]`` is that run's validated scene."""
+
+    base: Scene
+    axes: tuple[Axis, ...]
+    points: tuple[dict[str, Value], ...]
+    scenes: tuple[Scene, ...]
+
+    @property
+    def keys(self) -> tuple[str, ...]:
+        return tuple(a.key for a in self.axes)
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+
+def _apply(base: dict[str, Any], point: Mapping[str, Value]) -> dict[str, Any]:
+    data = copy.deepcopy(base)
+    for key, value in point.items():
+        set_path(data, key, value)
+    return data
+
+
+def _build(base: Scene, data: dict[str, Any], keys: Sequence[str]) -> Scene:
+    try:
+        return scene_from_dict(data, source=base.source)
+    except SceneError as exc:
+        raise ArgumentError(f"--vary {', '.join(keys)}: {exc}") from None
+
+
+def build_grid(base: Scene, vary: Mapping[str, Sequence[Value]]) -> Grid:
+    """Resolve every key, check every value alone against the base scene (the error names
+    that key and value), then build and validate every grid point."""
+    data = base.to_dict()
+    axes = []
+    for key, values in vary.items():
+        values = tuple(values)
+        if not values:
+            raise ArgumentError(f"--vary {key}: no values")
+        container, slot = resolve(data, key)
+        if slot not in container:  # a key the scene leaves at its default, or a typo
+            try:
+                scene_from_dict(_apply(data, {key: values[0]}), source=base.source)
+            except SceneError as exc:
+                raise ArgumentError(f"--vary {key}: unknown key or bad value ({exc})") \
+                    from None
+        for v in values:
+            try:
+                scene_from_dict(_apply(data, {key: v}), source=base.source)
+            except SceneError as exc:
+                raise ArgumentError(f"--vary {key}: value {v!r} fails scene validation: "
+                                    f"{exc}") from None
+        axes.append(Axis(key, values))
+    points, scenes = [], []
+    for combo in itertools.product(*(a.values for a in axes)):
+        point = {a.key: v for a, v in zip(axes, combo, strict=True)}
+        points.append(point)
+        scenes.append(_build(base, _apply(data, point), list(point)))
+    return Grid(base, tuple(axes), tuple(points), tuple(scenes))
