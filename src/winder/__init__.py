@@ -30,6 +30,7 @@ _LAZY = {
     "CHANNELS": "._system", "EXTRA_CHANNELS": "._system", "WinderSystem": "._system",
     "VariableMassModel": "._variable_mass",
     "EFFECTS": ".effects", "Effect": ".effects",
+    "sweep": "._sweep", "SweepTable": "._sweep_table",  # Dask, pandas, pyarrow
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
@@ -41,6 +42,8 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from ._scene import Scene, load_scene, scene_from_dict
     from ._simulate import DEFAULT_METHOD, simulate
     from ._stepper import Stepper
+    from ._sweep import sweep
+    from ._sweep_table import SweepTable
     from ._system import CHANNELS, EXTRA_CHANNELS, WinderSystem
     from ._variable_mass import VariableMassModel
     from .effects import EFFECTS, Effect
@@ -98,14 +101,3 @@ __all__ = [
 ]
 __version__ = "0.1.0"
 
-
-def __getattr__(name: str) -> object:
-    """``sweep`` and ``SweepTable`` are imported on first use (they pull in Dask, pandas
-    and pyarrow, which plain simulation does not need)."""
-    if name == "sweep":
-        from ._sweep import sweep
-        return sweep
-    if name == "SweepTable":
-        from ._sweep_table import SweepTable
-        return SweepTable
-    raise AttributeError(f"module 'winder' has no attribute {name!r}")

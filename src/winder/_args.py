@@ -10,7 +10,11 @@ from typing import Any
 
 from ._errors import ArgumentError, ArgumentTypeError
 
-__all__ = ["show", "range_text", "check_real", "number", "integer"]
+__all__ = ["show", "range_text", "check_real", "number", "integer", "RTOL_MAX"]
+
+#: The largest relative tolerance a scene, :func:`winder.simulate` or the CLI accepts [-]
+#: (beyond it the integrators' error control means nothing).
+RTOL_MAX = 0.1
 
 
 def show(value: Any, limit: int = 60) -> str:

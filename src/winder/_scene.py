@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from ._args import check_real, show
+from ._args import RTOL_MAX, check_real, show
 from ._errors import ArgumentError, ArgumentTypeError, SceneError
 
 __all__ = ["Scene", "SceneInfo", "Effects", "Drum", "Drive", "Roll", "Paper", "Contact",
@@ -292,7 +292,7 @@ _MAX: dict[tuple[str, str], float] = {
     ("contact", "exponent"): 3.0, ("contact", "hc_damping"): 1e4,
     ("friction", "mu"): 10.0, ("friction", "slip_velocity"): 1e3,
     ("friction", "relaxation_length"): 1e3, ("friction", "min_speed"): 1e3,
-    ("solver", "rtol"): 0.1, ("solver", "atol"): 1.0, ("solver", "max_rhs"): 1e12,
+    ("solver", "rtol"): RTOL_MAX, ("solver", "atol"): 1.0, ("solver", "max_rhs"): 1e12,
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,
             ("solver", "method"): METHODS, ("solver", "backend"): BACKENDS}

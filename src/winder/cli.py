@@ -27,6 +27,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
+from ._args import RTOL_MAX
 from ._errors import WinderError
 from ._interrupt import Interrupted, handling_signals
 
@@ -63,10 +64,11 @@ def _number(lo: float, hi: float = math.inf, *, lo_open: bool = True,
 
 
 _POSITIVE = _number(0.0)
-_RTOL = _number(1e-14, 1.0, lo_open=False, hi_open=True)
+_RTOL = _number(0.0, RTOL_MAX)
 _PLAYBACK = _number(0.0, 3600.0)
 _POINTS = _number(2, 100_000, lo_open=False, integer=True)
 _EVALS = _number(1, 1e15, lo_open=False, integer=True)
+_COUNT = _number(1, 10_000, lo_open=False, integer=True)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -108,7 +110,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
     plots = check_output_dir(args.plots, "--plots") if args.plots is not None else None
 
     from ._errors import BudgetExceeded
-    from ._plots import paper_figures
     from ._scene import load_scene
     from ._simulate import simulate
 
@@ -135,6 +136,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     print(f"{scene.name}: {len(result.t)} samples to {out} ({m['method']}, rtol {m['rtol']:g}, "
           f"{m['rhs_evaluations']} RHS evaluations, {m['wall_time']:.2f} s integration)")
     if plots is not None:
+        from ._plots import paper_figures
+
         for p in paper_figures(result, plots, scene=scene):
             print(f"  figure {p}")
     return 0
@@ -366,7 +369,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--method", help="integrator (auto, DOPRI5, RK4, RK45, DOP853, Radau, "
                      "BDF, LSODA, RK23)")
     run.add_argument("--backend", help="right-hand side: compiled (default) or pinocchio")
-    run.add_argument("--rtol", type=_RTOL, help="relative tolerance (1e-14 <= rtol < 1)")
+    run.add_argument("--rtol", type=_RTOL, help=f"relative tolerance (0 < rtol <= {RTOL_MAX:g})")
     run.add_argument("--atol", type=_POSITIVE, help="absolute tolerance (> 0)")
     run.add_argument("--max-evals", type=_EVALS, metavar="N",
                      help="budget of right-hand side evaluations (default: [solver] max_rhs)")
@@ -416,17 +419,18 @@ def _build_parser() -> argparse.ArgumentParser:
                        "already there)")
     sweep.add_argument("--scheduler", help="address of a running Dask scheduler (default: "
                        "an embedded local cluster)")
-    sweep.add_argument("--workers", type=int, help="local workers (default: one per core)")
+    sweep.add_argument("--workers", type=_COUNT,
+                       help="local workers (default: one per core)")
     sweep.add_argument("--plot", nargs="?", const=True, metavar="PNG",
                        help="draw the runnability map (default OUT/runnability_map.png)")
     sweep.add_argument("--trajectories", action="store_true",
                        help="also store each run's full result (OUT/trajectories/*.npz)")
-    sweep.add_argument("--t-end", type=_positive, help="end time of each run [s]")
-    sweep.add_argument("--rtol", type=_positive)
-    sweep.add_argument("--output-step", type=_positive, help="sampling of the runs [s]")
-    sweep.add_argument("--max-wall", type=_positive, help="wall-clock budget per run [s]")
-    sweep.add_argument("--bands", type=int, default=24, help="radius bands (default 24)")
-    sweep.add_argument("--vibration-threshold", type=_positive, default=0.5,
+    sweep.add_argument("--t-end", type=_POSITIVE, help="end time of each run [s]")
+    sweep.add_argument("--rtol", type=_RTOL)
+    sweep.add_argument("--output-step", type=_POSITIVE, help="sampling of the runs [s]")
+    sweep.add_argument("--max-wall", type=_POSITIVE, help="wall-clock budget per run [s]")
+    sweep.add_argument("--bands", type=_COUNT, default=24, help="radius bands (default 24)")
+    sweep.add_argument("--vibration-threshold", type=_POSITIVE, default=0.5,
                        help="vibration level where vibration starts (default 0.5)")
     sweep.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
                        help="progress bar and dashboard address on stderr (default on; "

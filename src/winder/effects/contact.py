@@ -11,8 +11,6 @@ import math
 from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING
 
-from scipy.optimize import brentq
-
 from .._scene import CONTACT_LAWS, Scene
 from ._base import Context, Effect
 
@@ -42,6 +40,8 @@ class ContactLaw(ABC):
             hi *= 2.0
             if hi > 1e3:
                 raise ValueError(f"no penetration carries a load of {load} N")
+        from scipy.optimize import brentq  # here: scipy costs start-up time elsewhere
+
         return brentq(lambda d: self.force(d, delta_dot) - load, 0.0, hi, xtol=1e-300,
                       rtol=8.9e-16)
 

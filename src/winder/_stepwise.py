@@ -1,0 +1,233 @@
+"""The step-wise paths of :func:`winder.simulate`: scipy's solvers (RK45, DOP853, Radau,
+BDF, LSODA, RK23) and a Python RK4, one step at a time, with the contact events and the
+core events of spec §2 located on each step's interpolant. Imported only by runs that use
+them (scipy's integrators cost a noticeable part of a command's start-up)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, DenseOutput, OdeSolver, Radau
+from scipy.optimize import brentq
+
+from . import _integrators as integ
+from ._planar import AT_CORE, WINDING, PlanarSystem, core_mode_of, pack
+from ._scene import Scene
+from ._simulate import _STEP_OVER, _WALL_EVERY, _Guards, _Stop
+from ._system import WinderSystem
+
+__all__ = ["run_stepwise"]
+
+_SCIPY = {"RK45": RK45, "DOP853": DOP853, "Radau": Radau, "BDF": BDF, "LSODA": LSODA,
+          "RK23": RK23}
+_IMPLICIT = ("Radau", "BDF", "LSODA")
+
+
+class _HermiteDense(DenseOutput):
+    """Cubic Hermite interpolant of one RK4 step."""
+
+    def __init__(self, t_old: float, t: float, y0: np.ndarray, f0: np.ndarray,
+                 y1: np.ndarray, f1: np.ndarray) -> None:
+        super().__init__(t_old, t)
+        self.y0, self.f0, self.y1, self.f1 = y0, f0, y1, f1
+
+    def _call_impl(self, t: np.ndarray) -> np.ndarray:
+        h = self.t - self.t_old
+        s = (np.asarray(t, dtype=float) - self.t_old) / h
+        h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+        h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+        return (np.multiply.outer(self.y0, h00) + np.multiply.outer(h * self.f0, h10)
+                + np.multiply.outer(self.y1, h01) + np.multiply.outer(h * self.f1, h11))
+
+
+class _RK4(OdeSolver):
+    """Classical fixed-step RK4 as a scipy solver: steps of at most ``max_step`` evenly
+    dividing ``[t0, t_bound]``; dense output by cubic Hermite interpolation."""
+
+    def __init__(self, fun: Callable, t0: float, y0: np.ndarray, t_bound: float, *,
+                 max_step: float = 1e-3, **_: Any) -> None:
+        super().__init__(fun, t0, y0, t_bound, vectorized=False)
+        self.n_steps = max(1, math.ceil((t_bound - t0) / max_step - 1e-9))
+        self.h = (t_bound - t0) / self.n_steps
+        self.t_first, self.i = t0, 0
+        self.f = self.fun(self.t, self.y)
+        self._last: tuple[np.ndarray, ...] = ()
+
+    def _step_impl(self) -> tuple[bool, str | None]:
+        t, y, f0 = self.t, self.y, self.f
+        self.i += 1
+        t1 = self.t_bound if self.i >= self.n_steps else self.t_first + self.i * self.h
+        h = t1 - t
+        k2 = self.fun(t + h / 2, y + h / 2 * f0)
+        k3 = self.fun(t + h / 2, y + h / 2 * k2)
+        k4 = self.fun(t + h, y + h * k3)
+        y1 = y + h / 6 * (f0 + 2 * k2 + 2 * k3 + k4)
+        f1 = self.fun(t1, y1)
+        self._last = (y, f0, y1, f1)
+        self.t, self.y, self.f = t1, y1, f1
+        return True, None
+
+    def _dense_output_impl(self) -> DenseOutput:
+        return _HermiteDense(self.t_old, self.t, *self._last)
+
+
+#: An event of a segment: switching function ``g(t, y)`` and which side is new
+#: (``True``: ``g > 0``; ``False``: ``g <= 0``); the step's end on the new side fires it.
+_Event = tuple[Callable[[float, np.ndarray], float], bool]
+
+
+def _on_new_side(g: float, new_pos: bool) -> bool:
+    return g > 0.0 if new_pos else g <= 0.0
+
+
+def _locate(event: _Event, sol: DenseOutput, ta: float, tb: float,
+            y_end: np.ndarray) -> tuple[float, np.ndarray]:
+    """Time and state of an event within a step ``[ta, tb]`` whose end is on the new side:
+    the root of ``g`` on the step's interpolant (the step's end where the interpolant does
+    not change sides)."""
+    g, new_pos = event
+
+    def on_sol(t: float) -> float:
+        return g(t, sol(t))
+
+    ga, gb = on_sol(ta), on_sol(tb)
+    if _on_new_side(ga, new_pos):
+        return ta, sol(ta)
+    if not _on_new_side(gb, new_pos):
+        return tb, y_end
+    eps = np.finfo(float).eps
+    t_ev = brentq(on_sol, ta, tb, xtol=4 * eps * max(1.0, abs(tb)), rtol=4 * eps)
+    return t_ev, sol(t_ev)
+
+
+def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
+             y0: np.ndarray, t_stop: float, events: list[_Event], t_out: np.ndarray,
+             Ys: np.ndarray, filled: int, guards: _Guards, meth: str
+             ) -> tuple[float, np.ndarray, int, int]:
+    """Integrate from ``t0`` until ``t_stop`` or the first event; samples into ``Ys``.
+    Returns ``(t, y, filled, event index or -1)``. A spent budget raises :class:`_Stop`
+    carrying the last accepted ``(t, y, step)``."""
+    while filled < len(t_out) and t_out[filled] <= t0:
+        Ys[:, filled] = y0
+        filled += 1
+    solver = None
+    try:
+        solver = make(t0, y0, t_stop)
+        while True:
+            message = solver.step()
+            if solver.status == "failed":
+                raise guards.error(f"integrator {meth} failed: {message}; try a stiff "
+                                   "method (Radau, BDF) or a looser/tighter rtol",
+                                   float(solver.t), solver.y)
+            guards.steps += 1
+            t_a, t_b, y_b = float(solver.t_old), float(solver.t), solver.y
+            hit, t_lim, y_lim, sol = -1, t_b, y_b, None
+            for i, (g, new_pos) in enumerate(events):
+                if _on_new_side(g(t_b, y_b), new_pos):
+                    sol = sol or solver.dense_output()
+                    t_ev, y_ev = _locate(events[i], sol, t_a, t_b, y_b)
+                    if hit < 0 or t_ev < t_lim:
+                        hit, t_lim, y_lim = i, t_ev, y_ev
+            while filled < len(t_out) and t_out[filled] <= t_lim:
+                if t_out[filled] == t_b:
+                    Ys[:, filled] = y_b
+                else:
+                    sol = sol or solver.dense_output()
+                    Ys[:, filled] = sol(t_out[filled])
+                filled += 1
+            if hit >= 0:
+                return t_lim, np.array(y_lim, dtype=float), filled, hit
+            if solver.status == "finished":
+                return t_b, np.array(y_b, dtype=float), filled, -1
+            guards.tick(t_b)
+    except _Stop as stop:
+        t, y = (float(solver.t), solver.y) if solver is not None else (t0, y0)
+        step = solver.step_size if solver is not None else None
+        stop.at = (t, np.array(y, dtype=float), step, filled)  # type: ignore[attr-defined]
+        raise
+
+
+def run_stepwise(scene: Scene, counter: PlanarSystem | WinderSystem, meth: str,
+                y0: np.ndarray, t_s: float, t_out: np.ndarray, Ys: np.ndarray,
+                breaks: list[float], rtol: float, atol: float, max_step: float | None,
+                events: bool, jacobian: str, guards: _Guards) -> tuple[int, int]:
+    """scipy's solvers and RK4, one step at a time: contact events (restart at lift-off
+    and touch-down, stepping over grazing contacts) and core events (spec §2: land on the
+    core, ``ṙ = 0`` locked until the roll turns forwards). Returns ``(samples, events)``."""
+    rhs, limit = counter.rhs, guards.limit
+    r_core = scene.roll.core_radius
+
+    def fun(t: float, y: np.ndarray) -> np.ndarray:
+        n = counter.nfev
+        if n >= limit:
+            raise _Stop("max_rhs")
+        if n % _WALL_EVERY == 0 and guards.wall_spent():
+            raise _Stop("max_wall")
+        return rhs(t, y)
+
+    options: dict[str, Any] = {"rtol": rtol, "atol": atol}
+    if max_step is not None:
+        options["max_step"] = max_step
+    if meth == "RK4":
+        cls: Any = _RK4
+        options = {"max_step": max_step or 1e-3}
+    else:
+        cls = _SCIPY[meth]
+    if jacobian == "pinocchio" and meth in _IMPLICIT:
+        from ._linearise import jacobian as _jac
+
+        jac_system = WinderSystem(scene)
+
+        def jac(t: float, y: np.ndarray) -> np.ndarray:
+            jac_system.set_core_mode(counter.core)
+            return _jac(jac_system, t, y)
+
+        options["jac"] = jac
+
+    def make(t0: float, y: np.ndarray, t1: float) -> OdeSolver:
+        return cls(fun, t0, y, t1, **options)
+
+    p = counter.params if isinstance(counter, PlanarSystem) else pack(scene)
+
+    def event(which: int) -> Callable[[float, np.ndarray], float]:
+        return lambda t, y: integ.switching(which, t, y, p)
+
+    gap, unwound, forward = event(integ.G_CONTACT), event(integ.G_UNWOUND), \
+        event(integ.G_FORWARD)
+    contact_events = events and scene.effects.contact and meth != "RK4"
+    filled, n_events, t0, y = 0, 0, t_s, np.array(y0, dtype=float)
+    core = core_mode_of(y, p)
+    counter.set_core_mode(core)
+    step_over_until = -math.inf
+    touching: bool | None = None  # contact side; None: read it from the state
+    for tb in breaks:
+        while t0 < tb:
+            stepping_over = t0 < step_over_until
+            t_stop = min(tb, step_over_until) if stepping_over else tb
+            evs: list[_Event] = [(unwound, True) if core == WINDING else (forward, True)]
+            if contact_events and not stepping_over:
+                if touching is None:
+                    touching = gap(t0, y) > 0.0
+                evs.append((gap, not touching))  # the event leaves the current side
+            t1, y, filled, hit = _segment(make, t0, y, t_stop, evs, t_out, Ys, filled,
+                                          guards, meth)
+            if hit == 0:  # core event: land on the core, or leave it turning forwards
+                n_events += 1
+                if core == WINDING:
+                    y[4] = r_core
+                    core = AT_CORE
+                else:
+                    core = WINDING
+                counter.set_core_mode(core)
+            elif hit == 1:  # contact event: restart exactly there
+                n_events += 1
+                touching = not touching  # lift-off is followed by touch-down and vice versa
+                if t1 - t0 <= 1e-10 * max(1.0, abs(t0)):
+                    # grazing: the crossing is back at the restart point; step over a
+                    # short stretch without contact events, then re-arm
+                    step_over_until, touching = t0 + _STEP_OVER, None
+            t0 = t1
+    return filled, n_events
