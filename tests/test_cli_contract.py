@@ -39,7 +39,7 @@ def _as_float(text: str) -> float | None:
 #: option → (subcommand, reference validity predicate of the value)
 OPTIONS = {
     "--t-end": ("run", lambda x: math.isfinite(x) and x > 0),
-    "--rtol": ("run", lambda x: 1e-14 <= x < 1),
+    "--rtol": ("run", lambda x: 0 < x <= 0.1),
     "--atol": ("run", lambda x: math.isfinite(x) and x > 0),
     "--max-evals": ("run", lambda x: 1 <= x <= 1e15 and x == int(x)),
     "--max-wall": ("run", lambda x: math.isfinite(x) and x > 0),
