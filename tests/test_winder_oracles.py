@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 from conftest import random_states, state_regions
+from scipy.optimize import brentq
 
 import winder
 from winder._system import WinderSystem
@@ -203,6 +204,100 @@ def test_energy_conserved_without_dissipation(paper_scene) -> None:
          + m * g * (z + e * np.sin(phi)) + 0.5 * k * delta**2)
     assert np.any(res["normal_force"] == 0.0)  # it really lifts off
     assert np.max(np.abs(E - E[0])) / abs(E[0]) < 1e-8
+
+
+def _kelvin_voigt_bounce(v0: float, m: float, k: float, c: float, g: float):
+    """One bounce of a mass ``m`` [kg] landing at ``v0`` [m/s] on the spring-damper
+    ``F = max(0, k δ + c δ̇)`` under gravity, in closed form: the contact phase solves
+    ``m δ̈ = m g − k δ − c δ̇`` from ``δ = 0, δ̇ = v0``; it ends at lift-off where
+    ``k δ + c δ̇`` falls to 0 (not at δ = 0: the clamp), and the flight that follows is a
+    parabola ``δ̈ = g``. Returns ``s ↦ (δ, F)`` over the bounce, the time of the next
+    touchdown (``s`` from this touchdown) and the landing speed there [SI]."""
+    wn, zeta = math.sqrt(k / m), c / (2 * math.sqrt(k * m))
+    wd, ds = wn * math.sqrt(1 - zeta**2), m * g / k
+    A, B = -ds, (v0 - zeta * wn * ds) / wd
+
+    def contact(s: float) -> tuple[float, float]:
+        ex, co, si = math.exp(-zeta * wn * s), math.cos(wd * s), math.sin(wd * s)
+        return (ds + ex * (A * co + B * si),
+                ex * ((wd * B - zeta * wn * A) * co - (zeta * wn * B + wd * A) * si))
+
+    def law(s: float) -> float:
+        d, dd = contact(s)
+        return k * d + c * dd
+
+    grid = np.linspace(1e-9, 2 * math.pi / wd, 20001)
+    i = int(np.argmax([law(s) < 0 for s in grid]))
+    s_lift = brentq(law, grid[i - 1], grid[i], xtol=1e-16)
+    d1, v1 = contact(s_lift)
+    root = math.sqrt(v1 * v1 - 2 * g * d1)
+    u_gap, u_next = (-v1 - root) / g, (-v1 + root) / g  # δ = 0 going up, coming down
+    # the flight is clean: δ < 0 before the unclamped law k δ + c δ̇ turns positive
+    assert u_gap < -2 * (k * v1 + c * g) / (k * g)
+
+    def delta(s: float) -> tuple[float, float]:
+        if s < s_lift:
+            d, dd = contact(s)
+            return d, max(0.0, k * d + c * dd)
+        u = s - s_lift
+        return d1 + v1 * u + 0.5 * g * u * u, 0.0
+
+    return delta, s_lift + u_next, root
+
+
+def test_impact_and_rebound_closed_form(paper_scene) -> None:
+    """A roll (no imbalance, not turning, drum at rest: no friction, no growth) dropped
+    2 cm onto the linear nip: free fall, a damped contact that lets go where the force
+    reaches zero (the clamp), a flight, a second impact and flight, all in closed form
+    (:func:`_kelvin_voigt_bounce`). Checks the nip law, its clamp, gravity and the
+    located touch-down and lift-off events of the default integrator."""
+    R, rc, m, g, k, c, gap = 0.5, 0.075, 30.0, 9.81, 2e7, 2e4, 0.02
+    scene = paper_scene.replace(roll={"com_offset": 0.0, "initial_height": R + rc + gap},
+                                drum={"drive": {"web_speed": 0.0, "web_acceleration": 0.0}})
+    t_hit = math.sqrt(2 * gap / g)
+    first, s_next, v_next = _kelvin_voigt_bounce(g * t_hit, m, k, c, g)
+    second, s_third, _ = _kelvin_voigt_bounce(v_next, m, k, c, g)
+    t_end = t_hit + s_next + 0.9 * s_third
+
+    res = winder.simulate(scene, t_end=t_end, output_step=1e-5, rtol=1e-10, atol=1e-13)
+    exact = []
+    for t in res.t:
+        if t < t_hit:
+            exact.append((gap - 0.5 * g * t * t, 0.0))
+        else:
+            d, f = first(t - t_hit) if t < t_hit + s_next else second(t - t_hit - s_next)
+            exact.append((-d, f))
+    gap_exact, force_exact = np.array(exact).T
+    assert np.sum(res["normal_force"] > 0) > 100 and res.meta["events"] >= 4
+    # measured 7.6e-13 m of z (the first rebound is 2.5 mm) and 7.1e-10 of the peak force
+    np.testing.assert_allclose(res["z"], R + rc + gap_exact, rtol=0, atol=1e-11)
+    np.testing.assert_allclose(res["normal_force"], force_exact, rtol=0,
+                               atol=7e-9 * force_exact.max())
+
+
+def test_slip_friction_spin_up_closed_form(paper_scene) -> None:
+    """A roll at rest put on a drum running at 20 m/s (no imbalance, growth negligible):
+    it rests at F_n = m g, slips grossly (v_s ≫ v_ref, so tanh = 1) and the friction
+    relaxes to μ m g with the time constant τ = σ / (Ω R + v_min) (spec §4). In closed
+    form F_t = μ m g (1 − e^(−t/τ)), J ω = r μ m g (t − τ (1 − e^(−t/τ))) and the drum
+    torque is τ_d = R F_t (spec §5, Ω̇ = 0)."""
+    scene = paper_scene.replace(effects={"imbalance": False}, paper={"caliper": 1e-15},
+                                drum={"drive": {"web_acceleration": 0.0}},
+                                roll={"initial_speed": 0.0})
+    res = winder.simulate(scene, t_end=2.0, output_step=0.01, rtol=1e-11, atol=1e-13)
+    m, J, r, R, g = 30.0, 0.12, 0.075, 0.5, 9.81
+    mu, sigma, v_min, v = 0.3, 0.01, 0.1, 20.0
+    tau, t = sigma / (v + v_min), res.t
+    f = mu * m * g
+    ft = f * (1 - np.exp(-t / tau))
+    w = r * f / J * (t - tau * (1 - np.exp(-t / tau)))
+    assert np.min(res["slip_velocity"]) > 200 * scene.friction.slip_velocity  # gross slip
+    # measured: ω 1.1e-12 of its final value (the lag τ shifts it by 2.5e-4), F_t and τ_d
+    # 2.7e-11 of μ m g, F_n 1.6e-11 of m g
+    np.testing.assert_allclose(res["roll_speed"], w, rtol=0, atol=1e-11 * w[-1])
+    np.testing.assert_allclose(res["friction_force"], ft, rtol=0, atol=3e-10 * f)
+    np.testing.assert_allclose(res["drum_torque"], R * ft, rtol=0, atol=3e-10 * R * f)
+    np.testing.assert_allclose(res["normal_force"], m * g, rtol=2e-10)
 
 
 def test_progress_in_a_log_is_line_per_report(paper_scene, capsys) -> None:
