@@ -15,7 +15,8 @@ unmutated copy. Numba's on-disk cache: mutants that edit a compiled module get a
 private cache directory; the others share one cache of the unmutated copy (never the
 project's own cache).
 
-Usage: ``python tests/mutants/run.py [--jobs N] [--only SUBSTRING ...] [--list]``
+Usage: ``python tests/mutants/run.py [--jobs N] [--only SUBSTRING ...] [--list]
+[--catalogue FILE]``
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ COMPILED = ("src/winder/_planar.py", "src/winder/_integrators.py")  # numba-cach
 KINDS = {"drop": lambda x: "0.0", "double": lambda x: f"2.0 * ({x})",
          "flip": lambda x: f"-({x})"}
 TIMEOUT = 900.0  # [s] per mutant
+RUNNING: set[subprocess.Popen] = set()  # pytest processes, killed if the run is interrupted
 
 
 @dataclass
@@ -124,12 +126,18 @@ class Worker:
         cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-rfE", "--no-header",
                "-p", "no:cacheprovider", *tests]
         t0 = time.perf_counter()
+        p = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, text=True)
+        RUNNING.add(p)
         try:
-            p = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True,
-                               timeout=TIMEOUT)
-            rc, out = p.returncode, p.stdout + p.stderr
-        except subprocess.TimeoutExpired as e:
-            rc, out = -1, f"timed out after {TIMEOUT:.0f} s\n{e.stdout or ''}"
+            out, _ = p.communicate(timeout=TIMEOUT)
+            rc = p.returncode
+        except subprocess.TimeoutExpired:
+            p.kill()
+            out, _ = p.communicate()
+            rc, out = -1, f"timed out after {TIMEOUT:.0f} s\n{out}"
+        finally:
+            RUNNING.discard(p)
         return rc, out, time.perf_counter() - t0
 
     def mutate(self, m: Mutant, suites: dict[str, list[str]]) -> None:
@@ -163,8 +171,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", nargs="*", default=[], help="run mutants whose name contains "
                     "one of these strings")
     ap.add_argument("--list", action="store_true", help="list the mutants and exit")
+    ap.add_argument("--catalogue", type=Path, default=CATALOGUE, help="the mutants "
+                    "(default: %(default)s)")
     args = ap.parse_args(argv)
-    suites, mutants = load()
+    suites, mutants = load(args.catalogue)
     if args.only:
         mutants = [m for m in mutants if any(s in m.name for s in args.only)]
     if args.list:
@@ -177,12 +187,12 @@ def main(argv: list[str] | None = None) -> int:
     used = sorted({m.suite for m in todo})
     jobs = max(1, min(args.jobs, len(todo)))
     base = Path(tempfile.mkdtemp(prefix="winder-mutants-"))
+    pool = ThreadPoolExecutor(jobs)
     try:
         workers = [Worker(base, i) for i in range(jobs)]
         # the suites must pass without a mutant (this also fills each worker's clean cache)
         tests = list(dict.fromkeys(t for s in used for t in suites[s]))
-        with ThreadPoolExecutor(jobs) as pool:
-            base_runs = list(pool.map(lambda w: w.run(tests, w.clean_cache), workers))
+        base_runs = list(pool.map(lambda w: w.run(tests, w.clean_cache), workers))
         for rc, out, _ in base_runs:
             if rc != 0:
                 print(out)
@@ -192,17 +202,22 @@ def main(argv: list[str] | None = None) -> int:
         print(f"baseline: suites {', '.join(used)} pass unmutated ({base_runs[0][2]:.0f} s)",
               flush=True)
         free = list(workers)
-        with ThreadPoolExecutor(jobs) as pool:
-            def one(m: Mutant) -> Mutant:
-                w = free.pop()
-                try:
-                    w.mutate(m, suites)
-                finally:
-                    free.append(w)
-                print(f"  {m.name:36s} {m.status:8s} {m.seconds:6.1f} s", flush=True)
-                return m
-            list(pool.map(one, todo))
-    finally:
+
+        def one(m: Mutant) -> Mutant:
+            w = free.pop()
+            try:
+                w.mutate(m, suites)
+            finally:
+                free.append(w)
+            print(f"  {m.name:36s} {m.status:8s} {m.seconds:6.1f} s", flush=True)
+            return m
+
+        list(pool.map(one, todo))
+    finally:  # also on Ctrl-C / SIGTERM: stop the tests, drop the copies
+        pool.shutdown(wait=False, cancel_futures=True)
+        for p in list(RUNNING):
+            p.kill()
+        pool.shutdown(wait=True)
         shutil.rmtree(base, ignore_errors=True)
     total = time.perf_counter() - t_start
     print()
