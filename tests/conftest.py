@@ -82,7 +82,7 @@ def state_regions(system, states: list[tuple[float, np.ndarray]]) -> dict[str, i
                else c.stiffness * abs(delta) ** c.exponent * (1 + c.hc_damping * ddot))
         if delta <= 0:
             out["out"] += 1
-            out["out_law_positive"] += law > 0
+            out["out_law_positive"] += int(law > 0)
         else:
             out["pulling" if law <= 0 else "pressing"] += 1
         out["closing" if ddot > 0 else "opening"] += 1

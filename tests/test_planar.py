@@ -50,10 +50,8 @@ def _systems(paper_scene: winder.Scene, variant: str | None, n: int, seed: int):
         planar.set_drum_torque(-75.0)
     states = list(random_states(system, np.random.default_rng(seed), n))
     regions = state_regions(system, states)
-    # a tenth of the draw at least in each region (measured 11/200 to 110/200 at seed 11)
+    # at least 1/40 of the draw in each region (measured: 10/200 to 110/200 at seed 11)
     assert min(regions.values()) >= n // 40, regions
-    if scene.contact.law == "linear":
-        assert regions["out_law_positive"] >= n // 40, regions
     return scene, system, planar, states
 
 
