@@ -40,6 +40,11 @@ test: $(STAMP) chromium
 test-slow: $(STAMP) chromium
 	$(PY) -m pytest -q -m slow
 
+# The fixed physics mutants (tests/mutants/catalogue.toml): every one must be killed.
+.PHONY: mutants
+mutants: $(STAMP)
+	$(PY) tests/mutants/run.py
+
 bench: $(STAMP)
 	$(PY) benchmarks/rhs_speed.py
 	$(PY) benchmarks/work_precision.py

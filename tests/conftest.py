@@ -1,13 +1,25 @@
 from __future__ import annotations
 
+import math
+import os
+from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import winder
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
+
+# `make mutants` runs the suite against a mutated copy of the sources: make sure the copy,
+# not the installed package, is what the tests import.
+_MUTANT_SRC = os.environ.get("WINDER_MUTANT_SRC")
+if _MUTANT_SRC and not Path(winder.__file__).resolve().is_relative_to(
+        Path(_MUTANT_SRC).resolve()):
+    raise pytest.UsageError(f"WINDER_MUTANT_SRC={_MUTANT_SRC} but winder was imported from "
+                            f"{winder.__file__}")
 
 
 @pytest.fixture(scope="session")
@@ -20,18 +32,61 @@ def models_dir() -> Path:
     return MODELS
 
 
-def random_states(system, rng, n: int):
-    """``n`` random ``(t, y)`` around the initial state of a ``WinderSystem``: in and out
-    of contact, any angle, speeds up to 300 rad/s, radii over the whole cycle."""
-    import math
+def _signed_log(rng: np.random.Generator, lo: float, hi: float) -> float:
+    """A magnitude log-uniform in ``[lo, hi]`` with a random sign."""
+    return float(rng.choice((-1.0, 1.0)) * 10.0 ** rng.uniform(math.log10(lo), math.log10(hi)))
 
+
+def random_states(system, rng: np.random.Generator, n: int) -> Iterator[tuple[float, np.ndarray]]:
+    """``n`` random ``(t, y)`` for a ``WinderSystem`` that reach every branch of the nip and
+    the drive: penetration ``δ`` and its rate ``δ̇`` of both signs over five decades each
+    (so out of contact, in contact, and where ``δ > 0`` but the law would pull), slip
+    ``v_s = Ω R − ω r`` of both signs from creep to gross slip, any angle, radii over the
+    whole cycle, times on the ramp and after it, any relaxed friction. Use
+    :func:`state_regions` to count what was drawn."""
+    names = system.state_names
+    scene = system.scene
+    R, rc, h2pi = system.drum_radius, scene.roll.core_radius, system.h_over_2pi
     y0 = system.initial_state()
     for _ in range(n):
+        t = float(rng.uniform(0.0, 60.0))
         y = y0.copy()
-        y[0] += rng.uniform(-2e-4, 5e-5)
-        y[1] = rng.uniform(-math.pi, math.pi)
-        y[2] = rng.normal(0, 0.05)
-        y[3] = rng.uniform(-10, 300)
-        y[4] = rng.uniform(0.075, 0.85)
-        y[5:] = rng.normal(0, 200, len(y) - 5)
-        yield rng.uniform(0, 60), y
+        r = float(rng.uniform(rc, 0.85))
+        if "drum_speed" in names:
+            y[names.index("drum_angle")] = rng.uniform(-10.0, 10.0)
+            y[names.index("drum_speed")] = rng.uniform(-5.0, 45.0)
+            Om = y[names.index("drum_speed")]
+        else:
+            Om = system.drive.kinematics(t, [])[1]
+        w = (Om * R - _signed_log(rng, 1e-4, 3.0)) / r
+        delta, ddot = _signed_log(rng, 1e-7, 3e-3), _signed_log(rng, 1e-4, 30.0)
+        y[:5] = (R + r - delta, rng.uniform(-math.pi, math.pi), h2pi * w - ddot, w, r)
+        if "friction_force" in names:
+            y[names.index("friction_force")] = rng.normal(0.0, 300.0)
+        yield t, y
+
+
+def state_regions(system, states: list[tuple[float, np.ndarray]]) -> dict[str, int]:
+    """How many of ``states`` lie in each region of the nip law (spec §4), from the scene's
+    parameters: ``out`` (δ ≤ 0), ``pulling`` (δ > 0 but the unclamped law < 0: the clamp
+    acts), ``pressing`` (F_n > 0), ``out_law_positive`` (δ ≤ 0 where the unclamped linear
+    law would push), the signs of ``δ̇`` and of the slip."""
+    c, R = system.scene.contact, system.drum_radius
+    names = system.state_names
+    out = dict.fromkeys(("out", "pulling", "pressing", "out_law_positive", "closing",
+                         "opening", "slip+", "slip-"), 0)
+    for t, y in states:
+        z, zd, w, r = y[0], y[2], y[3], y[4]
+        delta, ddot = R + r - z, system.h_over_2pi * w - zd
+        law = (c.stiffness * delta + c.damping * ddot if c.law == "linear"
+               else c.stiffness * abs(delta) ** c.exponent * (1 + c.hc_damping * ddot))
+        if delta <= 0:
+            out["out"] += 1
+            out["out_law_positive"] += int(law > 0)
+        else:
+            out["pulling" if law <= 0 else "pressing"] += 1
+        out["closing" if ddot > 0 else "opening"] += 1
+        Om = (y[names.index("drum_speed")] if "drum_speed" in names
+              else system.drive.kinematics(t, [])[1])
+        out["slip+" if Om * R - w * r > 0 else "slip-"] += 1
+    return out

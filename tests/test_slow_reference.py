@@ -17,9 +17,13 @@ def test_full_smooth_cycle_both_backends(models_dir) -> None:
     fast = winder.simulate(scene, output_step=1.0)
     ref = winder.simulate(scene, output_step=1.0, method="LSODA", backend="pinocchio",
                           rtol=1e-9, atol=1e-11)
-    for k in ("radius", "roll_speed", "z", "normal_force", "drum_torque"):
+    # largest difference relative to the channel's largest value, measured: radius 6.3e-14,
+    # roll_speed 5.8e-11, z 1.0e-11, normal_force 3.2e-8, drum_torque 8.0e-8
+    tolerances = {"radius": 1e-12, "roll_speed": 6e-10, "z": 1e-10, "normal_force": 3e-7,
+                  "drum_torque": 8e-7}
+    for k, tol in tolerances.items():
         err = np.max(np.abs(fast[k] - ref[k])) / np.max(np.abs(ref[k]))
-        assert err < 1e-5, (k, err)
+        assert err < tol, (k, err)
 
 
 def test_full_paper_cycle_converges(models_dir) -> None:
@@ -29,7 +33,8 @@ def test_full_paper_cycle_converges(models_dir) -> None:
     scene = winder.load_scene(models_dir / "paper_winding.toml")
     a = winder.simulate(scene, output_step=1.0)
     b = winder.simulate(scene, output_step=1.0, rtol=1e-10, atol=1e-12)
-    for k in ("radius", "mass"):
-        np.testing.assert_allclose(a[k], b[k], rtol=1e-5)
+    # measured relative differences: radius 5.9e-7, mass 1.2e-6, late roll speed 4.1e-8
+    np.testing.assert_allclose(a["radius"], b["radius"], rtol=6e-6)
+    np.testing.assert_allclose(a["mass"], b["mass"], rtol=1.2e-5)
     late = a.t > 200  # after the bouncing phase the roll rides the drum smoothly
-    np.testing.assert_allclose(a["roll_speed"][late], b["roll_speed"][late], rtol=1e-5)
+    np.testing.assert_allclose(a["roll_speed"][late], b["roll_speed"][late], rtol=4e-7)
