@@ -138,8 +138,10 @@ class _Progress:
         self.t_end, self.label = t_end, label
         self.start = self.last = time.perf_counter()
         self.tty = sys.stderr.isatty()
+        self.t = 0.0  # the last time shown or passed
 
     def update(self, t: float) -> None:
+        self.t = t
         now = time.perf_counter()
         if now - self.last < (0.2 if self.tty else 5.0):
             return
@@ -151,9 +153,10 @@ class _Progress:
         sys.stderr.write(f"\r{line}" if self.tty else f"{line}\n")
         sys.stderr.flush()
 
-    def close(self) -> None:
+    def close(self, t: float | None = None) -> None:
+        """The final line: at ``t`` [s] (default: the last time passed to :meth:`update`)."""
         self.last = -1e9
-        self.update(self.t_end)
+        self.update(self.t if t is None else t)
         if self.tty:
             sys.stderr.write("\n")
 
@@ -424,8 +427,12 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                 partial = Result(counter.channels(t_out[:filled], Ys[:, :filled]),
                                  _meta(scene, meth, be, rtol, atol, counter.nfev, wall, 0,
                                        t_s, T, partial=True))
+            if bar is not None:
+                bar.update(t_at)
             raise guards.exceeded(stop.kind, t_at, y_at, h_at, counter.nfev,
                                   partial) from None
+        if bar is not None:
+            bar.update(T)
     finally:
         if bar is not None:
             bar.close()
