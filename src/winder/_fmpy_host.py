@@ -3,6 +3,7 @@ CLI's run-check, the FMU tests and the real-time benchmark (needs ``winder[fmu]`
 
 from __future__ import annotations
 
+import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -10,7 +11,6 @@ from pathlib import Path
 import fmpy
 from fmpy.fmi2 import FMU2Slave
 
-from ._files import scratch_dir
 from ._fmu import FmuError
 
 __all__ = ["loaded_fmu", "start_fmu"]
@@ -26,12 +26,14 @@ def loaded_fmu(path: str | Path, *, instance_name: str = "winder"
         md = fmpy.read_model_description(str(path))
     except Exception as exc:  # fmpy's ValidationError lists the problems
         raise FmuError(f"{path}: invalid model description: {exc}") from exc
-    with scratch_dir("winder_fmpy_") as unzip:
-        fmpy.extract(str(path), unzipdir=str(unzip))
-        fmu = FMU2Slave(guid=md.guid, unzipDirectory=str(unzip),
+    unzip = fmpy.extract(str(path))
+    try:
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip,
                         modelIdentifier=md.coSimulation.modelIdentifier,
                         instanceName=instance_name)
-        yield fmu, {v.name: v.valueReference for v in md.modelVariables}, unzip
+        yield fmu, {v.name: v.valueReference for v in md.modelVariables}, Path(unzip)
+    finally:
+        shutil.rmtree(unzip, ignore_errors=True)
 
 
 def start_fmu(fmu: FMU2Slave, refs: dict[str, int], *, logging: bool = True,

@@ -28,7 +28,6 @@ from pathlib import Path
 from typing import Any
 
 from ._errors import WinderError
-from ._files import atomic_write, scratch_dir
 from ._scene import Scene, load_scene
 
 __all__ = ["build_fmu", "FMU_PARAMETERS", "scene_with_parameters", "FmuError"]
@@ -95,6 +94,11 @@ def build_fmu(scene_path: str | Path, out: str | Path) -> Path:
     """Build ``out`` (an ``.fmu``) from a scene file, atomically: the complete FMU or
     nothing at ``out``, and no build folder left in the temporary directory, on an error
     or a signal. Raises :class:`FmuError` when pythonfmu is missing or the build fails."""
+    # imported here, not at the top: FMU hosts import this module (the slave, FMPy hosts),
+    # and with more modules loaded there pythonfmu 0.7's heap corruption (see
+    # winder._fmu_slave) showed again: 1-3 of the 7 FMU host tests aborted per run
+    from ._files import atomic_write, scratch_dir
+
     try:
         from pythonfmu import FmuBuilder
     except ImportError as exc:
