@@ -116,7 +116,10 @@ def main(argv: list[str] | None = None) -> int:
         f"Machine: {os.cpu_count()} cores, {platform.machine()}, Python "
         f"{platform.python_version()}. Load average (1 min) at the start / end: "
         f"{load0[0]:.1f} / {load1[0]:.1f}. Other processes shared these cores: a load "
-        "above 1 slows the 2-worker sweep more than the 1-worker one.",
+        "above 1 slows the 2-worker sweep more than the 1-worker one. The load column is "
+        "the 1-minute load average after each sweep and counts the sweep's own workers "
+        "(1 or 2); the best pair is the one where the cores were free (task times equal "
+        "on 1 and 2 workers).",
         "",
         "| | wall [s] | runs/s | sum of task times [s] | mean task [s] | load (1 min) |",
         "|---|---|---|---|---|---|",
