@@ -49,6 +49,8 @@ bench: $(STAMP)
 	$(PY) benchmarks/rhs_speed.py
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_realtime.py
+	$(PY) benchmarks/cli_speed.py
+	$(PY) benchmarks/sweep_scaling.py
 
 # Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
 peers: $(STAMP)

@@ -368,7 +368,7 @@ def test_progress_on_a_pipe_is_whole_lines(monkeypatch) -> None:
     monkeypatch.setattr(_progress, "_LOG_INTERVAL", 0.0)
     stream = io.StringIO()
     bar = _progress.Progress(10.0, "scene", stream=stream)
-    for t in (2.5, 5.0, 7.5):
+    for t in (2.5, 5.0, 7.5, 10.0):
         bar.update(t)
     bar.close()
     sweep = _progress.SweepProgress(4, done=1, stream=stream)

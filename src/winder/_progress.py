@@ -54,7 +54,8 @@ def _bar(stream: TextIO | None, **kw) -> tqdm:
 
 class Progress:
     """Progress of one simulation: ``update(t)`` with the simulated time [s] reached,
-    ``close()`` at the end (draws the finished bar). ``t_end`` [s] is the run's end time."""
+    ``close()`` at the end (draws the bar as last updated: at ``t_end`` for a finished run,
+    at the time reached for a run a budget stopped). ``t_end`` [s] is the run's end time."""
 
     def __init__(self, t_end: float, label: str, *, stream: TextIO | None = None) -> None:
         self.t_end = float(t_end)
@@ -68,7 +69,6 @@ class Progress:
             self.bar.update(t - self.bar.n)
 
     def close(self) -> None:
-        self.update(self.t_end)
         self.bar.close()
 
 

@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 import numbers
 import os
-import sys
 import time
 from collections.abc import Callable
 from types import MappingProxyType
@@ -18,6 +17,7 @@ from . import _integrators as integ
 from ._args import RTOL_MAX
 from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError
 from ._planar import CORE_AUTO, PlanarSystem
+from ._progress import Progress
 from ._result import Result
 from ._scene import BACKENDS, METHODS, Scene, load_scene
 from ._system import WinderSystem
@@ -130,37 +130,6 @@ def _output_grid(t_s: float, T: float, dt: float, t_key: str, dt_key: str) -> np
 
 # ---- progress and budgets -------------------------------------------------------------
 
-class _Progress:
-    """Progress on stderr: a one-line bar redrawn at most every 0.2 s on a terminal;
-    one line every 5 s when stderr is a log file or pipe (no carriage returns there)."""
-
-    def __init__(self, t_end: float, label: str) -> None:
-        self.t_end, self.label = t_end, label
-        self.start = self.last = time.perf_counter()
-        self.tty = sys.stderr.isatty()
-        self.t = 0.0  # the last time shown or passed
-
-    def update(self, t: float) -> None:
-        self.t = t
-        now = time.perf_counter()
-        if now - self.last < (0.2 if self.tty else 5.0):
-            return
-        self.last = now
-        frac = min(max(t / self.t_end, 0.0), 1.0)
-        bar = "#" * int(30 * frac)
-        line = (f"{self.label} [{bar:<30}] {100 * frac:5.1f}%  t = {t:8.2f} s"
-                f"  {now - self.start:6.1f} s wall")
-        sys.stderr.write(f"\r{line}" if self.tty else f"{line}\n")
-        sys.stderr.flush()
-
-    def close(self, t: float | None = None) -> None:
-        """The final line: at ``t`` [s] (default: the last time passed to :meth:`update`)."""
-        self.last = -1e9
-        self.update(self.t if t is None else t)
-        if self.tty:
-            sys.stderr.write("\n")
-
-
 #: How to raise each budget, from :func:`~winder.simulate` (``how`` of :func:`budget_error`).
 RAISE_SIMULATE = {"max_rhs": "simulate(max_rhs=...), [solver] max_rhs, or --max-evals on the "
                              "command line",
@@ -227,7 +196,7 @@ class _Guards:
     shared by the scipy and the compiled paths."""
 
     def __init__(self, names: tuple[str, ...], meth: str, *, limit: int, max_wall: float,
-                 bar: _Progress | None, t_start: float, t_end: float) -> None:
+                 bar: Progress | None, t_start: float, t_end: float) -> None:
         self.names, self.meth = names, meth
         self.limit, self.max_wall, self.bar = limit, max_wall, bar
         self.t_start, self.t_end = t_start, t_end
@@ -391,7 +360,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                                 f"({', '.join(system.state_names)}) with radius >= the core "
                                 f"radius {r_core:g} m")
     planar = PlanarSystem(scene, system) if be == "compiled" else None
-    bar = _Progress(T, scene.name) if progress else None
+    bar = Progress(T, scene.name) if progress else None
     guards = _Guards(system.state_names, meth, limit=limit, max_wall=wall_limit, bar=bar,
                      t_start=t_s, t_end=T)
     counter: PlanarSystem | WinderSystem = planar if planar is not None else system
