@@ -22,6 +22,27 @@ if _MUTANT_SRC and not Path(winder.__file__).resolve().is_relative_to(
                             f"{winder.__file__}")
 
 
+# Scene variants of the paper scene, shared by the path comparisons and the oracles.
+HUNT_CROSSLEY = {"law": "hunt_crossley", "stiffness": 5e9, "exponent": 1.5, "hc_damping": 0.3}
+TORQUE_DRIVE = {"drive": {"kind": "torque", "web_speed": 5.0, "torque": 120.0}}
+
+
+def scene_variant(paper_scene: winder.Scene, name: str | None) -> winder.Scene:
+    """The paper scene (``None``), with the Hunt–Crossley nip, the torque drive, both, no
+    nip (``no_contact``), or one effect (its ``[effects]`` name) switched off."""
+    if name is None:
+        return paper_scene
+    if name == "no_contact":
+        return paper_scene.replace(effects={"contact": False, "slip_relaxation": False})
+    if name == "hunt_crossley":
+        return paper_scene.replace(contact=HUNT_CROSSLEY)
+    if name == "torque":
+        return paper_scene.replace(drum=TORQUE_DRIVE)
+    if name == "hunt_crossley_torque":
+        return paper_scene.replace(contact=HUNT_CROSSLEY, drum=TORQUE_DRIVE)
+    return paper_scene.replace(effects={name: False})
+
+
 @pytest.fixture(scope="session")
 def paper_scene() -> winder.Scene:
     return winder.load_scene(MODELS / "paper_winding.toml")

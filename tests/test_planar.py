@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import random_states, state_regions
+from conftest import random_states, scene_variant, state_regions
 
 import winder
 from winder import _integrators as integ
@@ -15,8 +15,6 @@ from winder._system import WinderSystem
 
 VARIANTS = [None, "variable_mass", "web_momentum", "imbalance", "slip_relaxation", "gravity",
             "no_contact", "hunt_crossley", "torque", "hunt_crossley_torque"]
-HUNT_CROSSLEY = {"law": "hunt_crossley", "stiffness": 5e9, "exponent": 1.5, "hc_damping": 0.3}
-TORQUE_DRIVE = {"drive": {"kind": "torque", "web_speed": 5.0, "torque": 120.0}}
 # Largest |compiled − Pinocchio| of one component (state derivative or channel) over the
 # random states of a variant, relative to that component's largest |value|: measured
 # 1.3e-13 (roll acceleration without contact; 4e-14 with the torque drive, ≤ 1e-14
@@ -24,25 +22,11 @@ TORQUE_DRIVE = {"drive": {"kind": "torque", "web_speed": 5.0, "torque": 120.0}}
 PATH_TOL = 1.5e-12
 
 
-def _variant(paper_scene: winder.Scene, name: str | None) -> winder.Scene:
-    if name is None:
-        return paper_scene
-    if name == "no_contact":
-        return paper_scene.replace(effects={"contact": False, "slip_relaxation": False})
-    if name == "hunt_crossley":
-        return paper_scene.replace(contact=HUNT_CROSSLEY)
-    if name == "torque":
-        return paper_scene.replace(drum=TORQUE_DRIVE)
-    if name == "hunt_crossley_torque":
-        return paper_scene.replace(contact=HUNT_CROSSLEY, drum=TORQUE_DRIVE)
-    return paper_scene.replace(effects={name: False})
-
-
 def _systems(paper_scene: winder.Scene, variant: str | None, n: int, seed: int):
     """Both paths of a variant (a free drum gets an input torque) and ``n`` random states
     that cover every region of the nip (checked here, so a change of the draw that loses
     a region fails instead of silently testing less)."""
-    scene = _variant(paper_scene, variant)
+    scene = scene_variant(paper_scene, variant)
     system = WinderSystem(scene)
     planar = PlanarSystem(scene, system)
     if scene.drum.drive.kind == "torque":

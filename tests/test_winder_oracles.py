@@ -6,29 +6,13 @@ import math
 
 import numpy as np
 import pytest
-from conftest import random_states, state_regions
+from conftest import random_states, scene_variant, state_regions
 from scipy.optimize import brentq
 
 import winder
 from winder._system import WinderSystem
 
-HUNT_CROSSLEY = {"law": "hunt_crossley", "stiffness": 5e9, "exponent": 1.5, "hc_damping": 0.3}
-TORQUE_DRIVE = {"drive": {"kind": "torque", "web_speed": 5.0, "torque": 120.0}}
 DRUM_TORQUE = -75.0  # input torque of the free drum in these tests [N·m]
-
-
-def _scene(paper_scene: winder.Scene, variant: str | None) -> winder.Scene:
-    if variant is None:
-        return paper_scene
-    if variant == "hunt_crossley":
-        return paper_scene.replace(contact=HUNT_CROSSLEY)
-    if variant == "torque":
-        return paper_scene.replace(drum=TORQUE_DRIVE)
-    if variant == "hunt_crossley_torque":
-        return paper_scene.replace(contact=HUNT_CROSSLEY, drum=TORQUE_DRIVE)
-    if variant == "no_contact":
-        return paper_scene.replace(effects={"contact": False, "slip_relaxation": False})
-    return paper_scene.replace(effects={variant: False})
 
 
 def _spec_rhs(scene: winder.Scene, t: float, y: np.ndarray) -> tuple[np.ndarray, float]:
@@ -90,7 +74,7 @@ def test_pinocchio_equals_spec_equations(paper_scene, variant) -> None:
     """The Pinocchio path (ABA with −Ẏv, RNEA for the drum torque) against spec §§2-5
     written out by hand, on states in and out of contact, pulling and pressing, slipping
     both ways, with either drive and either contact law."""
-    scene = _scene(paper_scene, variant)
+    scene = scene_variant(paper_scene, variant)
     sys_ = WinderSystem(scene)
     if scene.drum.drive.kind == "torque":
         sys_.set_drum_torque(DRUM_TORQUE)
