@@ -13,8 +13,8 @@ import time
 from pathlib import Path
 
 import winder
+from winder._files import atomic_write
 from winder._fmu import build_fmu
-from winder._result import atomic_write
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 import winder
-from winder._result import atomic_write
+from winder._files import atomic_write
 from winder._sweep import run_one, run_settings
 
 ROOT = Path(__file__).resolve().parents[1]

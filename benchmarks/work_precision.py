@@ -29,7 +29,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 import winder
-from winder._result import atomic_write
+from winder._files import atomic_write
 from winder._system import WinderSystem
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -126,3 +126,26 @@ def test_max_wall_scene_key(paper_scene) -> None:
     scene = paper_scene.replace(solver={"max_wall": 1e-3})
     with pytest.raises(winder.BudgetExceeded, match="max_wall = 0.001 s"):
         winder.simulate(scene, method="RK45", rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("kwargs", [{"max_rhs": 10**400}, {"atol": 10**400},
+                                    {"max_wall": -10**400}])
+def test_integer_beyond_the_float_range_is_named(paper_scene, kwargs) -> None:
+    """A 400-digit integer is an argument error naming the argument, shown short."""
+    (name,) = kwargs
+    with pytest.raises(winder.ArgumentError, match=rf"{name} = .*characters as text\) is out "
+                                                   "of range"):
+        winder.simulate(paper_scene, **kwargs)
+
+
+def test_scene_and_simulate_count_samples_alike(paper_scene) -> None:
+    """duration / output_step + 1 samples (both ends): one more than the limit is refused by
+    the scene already, not first by simulate after the scene loaded."""
+    from winder._scene import MAX_SAMPLES
+
+    with pytest.raises(winder.SceneError, match="output_step"):
+        paper_scene.replace(scene={"duration": 1e6, "output_step": 1e6 / MAX_SAMPLES})
+    ok = paper_scene.replace(scene={"duration": 1e6, "output_step": 1e6 / (MAX_SAMPLES - 1)})
+    from winder._simulate import _output_grid
+
+    assert len(_output_grid(0.0, 1e6, ok.scene.output_step, "d", "s")) == MAX_SAMPLES

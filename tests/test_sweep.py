@@ -397,3 +397,17 @@ def test_unreachable_scheduler_is_an_argument_error(base, tmp_path) -> None:
         winder.sweep(base, {"roll.com_offset": [1e-3]}, tmp_path / "x",
                      scheduler="nonsense::", **RUN)
     assert not (tmp_path / "x").exists()
+
+
+def test_sweep_output_locations_are_checked_before_anything_runs(tmp_path, models_dir,
+                                                                 capsys) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    for argv, named in (([ "--out", str(blocker / "sweep")], "--out"),
+                        (["--out", str(tmp_path / "s"), "--plot", str(tmp_path / "m.txt")],
+                         "--plot")):
+        code = main(["sweep", str(models_dir / "paper_winding.toml"), "--vary",
+                     "drum.drive.web_speed=10:20:2", *argv])
+        err = capsys.readouterr().err
+        assert code == 2 and named in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]

@@ -19,7 +19,7 @@ import numpy as np
 from ._errors import WinderError
 from ._files import atomic_write, atomic_write_all
 
-__all__ = ["Result", "ResultFileError", "load_result", "atomic_write"]
+__all__ = ["Result", "ResultFileError", "load_result"]
 
 #: Most members an NPZ result may have (channels and ``__meta__``).
 _MAX_MEMBERS = 1000

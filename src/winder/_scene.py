@@ -179,7 +179,6 @@ class Solver:
     max_rhs: int = 50_000_000
     max_wall: float = 600.0
     backend: str = "compiled"
-    max_wall: float = 600.0
 
 
 @dataclass(frozen=True)
@@ -378,7 +377,7 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
     if info.output_step > info.duration:
         raise _fail(source, "scene", "output_step",
                     f"{info.output_step!r} is longer than duration {info.duration!r}")
-    samples = info.duration / info.output_step
+    samples = info.duration / info.output_step + 1.0  # both ends, as simulate counts
     if samples > MAX_SAMPLES:
         raise _fail(source, "scene", "output_step",
                     f"{info.output_step!r} s over duration {info.duration!r} s gives "

@@ -14,12 +14,12 @@ from typing import Any
 import numpy as np
 
 from . import _integrators as integ
-from ._args import RTOL_MAX
+from ._args import RTOL_MAX, show
 from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError
 from ._planar import CORE_AUTO, PlanarSystem
 from ._progress import Progress
 from ._result import Result
-from ._scene import BACKENDS, METHODS, Scene, load_scene
+from ._scene import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
 from ._system import WinderSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
@@ -30,7 +30,6 @@ DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
 #: Methods that run entirely compiled (planar backend only).
 COMPILED_METHODS = ("DOPRI5",)
 #: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
-MAX_SAMPLES = 10_000_000
 _WALL_EVERY = 256  # evaluations between wall-clock checks on the Python paths
 _STEP_OVER = 1e-6  # [s] integrated without contact events after a grazing contact
 JACOBIANS = ("fd", "pinocchio")
@@ -45,9 +44,12 @@ def check_real(name: str, value: Any, ok: Callable[[float], bool], valid: str) -
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
         raise ArgumentTypeError(f"{name} must be a real number ({valid}), got {value!r} of "
                                 f"type {type(value).__name__}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # an integer beyond the float range
+        v = math.inf if value > 0 else -math.inf
     if not ok(v):
-        raise ArgumentError(f"{name} = {value!r} is out of range; valid: {valid}")
+        raise ArgumentError(f"{name} = {show(value)} is out of range; valid: {valid}")
     return v
 
 

@@ -47,7 +47,7 @@ class Stepper:
     scene: the scene (drive kind ``torque`` for a torque input; its ``[drum.drive]
         torque`` is the input until :meth:`set_input` changes it).
     rtol, atol: tolerances of the internal integrator (default ``1e-8``, ``1e-10``): rtol
-        finite in (0, 1), atol finite > 0.
+        finite in (0, 0.1], atol finite > 0.
     max_rhs, max_wall: budget of each :meth:`step`: evaluations and wall-clock seconds
         (default ``[solver] max_rhs`` and ``max_wall``).
     """

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from ._args import RTOL_MAX
 from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, WinderError
 from ._progress import SweepProgress
 from ._result import Result
@@ -61,6 +62,8 @@ def run_settings(*, t_end: float | None = None, rtol: float | None = None,
                                     f"({type(value).__name__})")
         if not (math.isfinite(value) and value > 0):
             raise ArgumentError(f"{name}: must be finite and > 0, got {value!r}")
+        if name == "rtol" and value > RTOL_MAX:
+            raise ArgumentError(f"rtol: must be > 0 and <= {RTOL_MAX:g}, got {value!r}")
         out[name] = float(value)
     return out
 

@@ -25,8 +25,8 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import LogNorm  # noqa: E402
 
 from ._errors import ArgumentError, WinderError  # noqa: E402
+from ._files import atomic_write  # noqa: E402
 from ._modes import mode_map  # noqa: E402
-from ._result import atomic_write  # noqa: E402
 from ._scene import scene_from_dict  # noqa: E402
 from ._sweep_grid import set_path  # noqa: E402
 from ._sweep_table import SweepTable  # noqa: E402

@@ -95,7 +95,7 @@ def empty_summary(n_bands: int) -> dict[str, Any]:
 
 
 def summarise(result: Result, edges: np.ndarray, *, window: float = 0.5,
-              threshold: float = 0.25) -> dict[str, Any]:
+              threshold: float = 0.5) -> dict[str, Any]:
     """The summary of ``result`` over the radius bands ``edges`` [m] (module docstring).
 
     ``window`` [s]: length of the windows for bounce amplitude and vibration level;

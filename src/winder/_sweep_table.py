@@ -27,7 +27,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from ._errors import WinderError
-from ._result import Result, atomic_write
+from ._files import atomic_write
+from ._result import Result
 from ._sweep_grid import Axis
 from ._sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS
 

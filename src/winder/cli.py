@@ -315,11 +315,16 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     """``winder sweep``: the grid on Dask, the summary table, optionally the map. Exit 0
     when every run is done (failed runs are recorded in the table), 1 when runs are
-    missing (workers died), 130 on Ctrl-C (finished runs are kept: re-run to resume)."""
+    missing (workers died), 128 + N on signal N (130 Ctrl-C; finished runs are kept: re-run
+    to resume)."""
+    from ._files import check_output_dir, check_output_file
     from ._scene import load_scene
     from ._sweep import sweep
     from ._sweep_grid import parse_vary
 
+    check_output_dir(args.out, "--out")  # every output location, before anything runs
+    if args.plot not in (None, True):
+        check_output_file(args.plot, "--plot", suffixes=(".png",))
     scene = load_scene(args.scene)
     vary = parse_vary(args.vary)
     if args.plot:
@@ -332,10 +337,10 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                       max_wall=args.max_wall, bands=args.bands,
                       threshold=args.vibration_threshold, trajectories=args.trajectories,
                       progress=args.progress)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM/SIGHUP as Interrupted
         print(f"winder: interrupted; finished runs are kept in {args.out}/runs; run the same "
               "command again to resume", file=sys.stderr)
-        return 130
+        return exc.exit_status if isinstance(exc, Interrupted) else 130
     n_bad = int((table.frame["status"] != "ok").sum())
     print(f"{scene.name}: {len(table)} runs in {table.path} ({len(table.computed)} run now, "
           f"{len(table.skipped)} already done, {n_bad} failed)")
