@@ -176,12 +176,17 @@ def test_live_view_stops_its_meshcat_server(sig: int, tmp_path: Path, paper_scen
     src = write_npz(tmp_path / "r.npz", arrays,
                     {"scene": "paper", "scene_dict": paper_scene.to_dict()})
     proc = _spawn(tmp_path, "view", str(src))
-    lines = []
-    while not (lines and lines[-1].startswith("live view at")):
-        lines.append(proc.stdout.readline())  # meshcat prints its URL first
-        assert lines[-1], (lines, proc.stderr.read())
-    servers = [p for p, cmd in _children(proc.pid) if "meshcat.servers.zmqserver" in cmd]
-    assert len(servers) == 1
+    try:
+        lines = []
+        while not (lines and lines[-1].startswith("live view at")):
+            lines.append(proc.stdout.readline())  # meshcat prints its URL first
+            assert lines[-1], (lines, proc.stderr.read())
+        servers = [p for p, cmd in _children(proc.pid) if "meshcat.servers.zmqserver" in cmd]
+        assert len(servers) == 1
+    except BaseException:
+        proc.terminate()  # the live view would run forever
+        proc.wait(timeout=30)
+        raise
     proc.send_signal(sig)
     status, err = _finish(proc)
     if sig == signal.SIGINT:  # Ctrl-C is how a live view ends
