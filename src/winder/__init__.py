@@ -23,7 +23,8 @@ _LAZY = {
     "FunctionMassLaw": "._mass_law", "MassLaw": "._mass_law", "MassProperties": "._mass_law",
     "PaperRollLaw": "._mass_law",
     "Mode": "._modes", "ModeMap": "._modes", "mode_map": "._modes", "modes_at": "._modes",
-    "Result": "._result", "load_result": "._result",
+    "Result": "._result", "load_result": "._result", "ResultFileError": "._result",
+    "OutputError": "._files",
     "Scene": "._scene", "load_scene": "._scene", "scene_from_dict": "._scene",
     "DEFAULT_METHOD": "._simulate", "simulate": "._simulate",
     "Stepper": "._stepper",
@@ -34,11 +35,12 @@ _LAZY = {
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
+    from ._files import OutputError
     from ._fmu import build_fmu
     from ._linearise import jacobian
     from ._mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
     from ._modes import Mode, ModeMap, mode_map, modes_at
-    from ._result import Result, load_result
+    from ._result import Result, ResultFileError, load_result
     from ._scene import Scene, load_scene, scene_from_dict
     from ._simulate import DEFAULT_METHOD, simulate
     from ._stepper import Stepper
@@ -93,6 +95,8 @@ __all__ = [
     "MassLaw",
     "MassProperties",
     "ModelError",
+    "OutputError",
+    "ResultFileError",
     "PaperRollLaw",
     "SceneError",
     "SimulationError",
