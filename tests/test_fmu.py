@@ -63,10 +63,22 @@ def test_interface(fmu_path, paper_scene) -> None:
     assert by["speed_profile"].start in (True, "true")
 
 
+# pythonfmu 0.7's binary now and then corrupts the heap of a host that loads and unloads
+# many FMU copies (seen once in about 30 full runs of the suite: glibc aborts with
+# "corrupted double-linked list"; PythonFMU issue #228 is the same family). Such an abort
+# of pythonfmu's is retried once in a fresh process; a second one, or any other failure,
+# fails the test.
+_PYTHONFMU_HEAP_ABORT = "corrupted"
+
+
 def _host(case: str, fmu_path: Path, tmp_path: Path) -> dict:
     out = tmp_path / f"{case}.json"
-    proc = subprocess.run([sys.executable, str(HOST), case, str(fmu_path), str(out)],
-                          capture_output=True, text=True, timeout=600)
+    for attempt in (1, 2):
+        proc = subprocess.run([sys.executable, str(HOST), case, str(fmu_path), str(out)],
+                              capture_output=True, text=True, timeout=600)
+        aborted = proc.returncode == -6 and _PYTHONFMU_HEAP_ABORT in proc.stderr
+        if not (aborted and attempt == 1):
+            break
     assert proc.returncode == 0, proc.stderr[-3000:]
     return json.loads(out.read_text())
 

@@ -9,7 +9,7 @@ import os
 import time
 from collections.abc import Callable
 from types import MappingProxyType
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -17,7 +17,6 @@ from . import _integrators as integ
 from ._args import RTOL_MAX, show
 from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError
 from ._planar import CORE_AUTO, PlanarSystem
-from ._progress import Progress
 from ._result import Result
 from ._scene import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
 from ._system import WinderSystem
@@ -130,6 +129,14 @@ def _output_grid(t_s: float, T: float, dt: float, t_key: str, dt_key: str) -> np
     return t_out
 
 
+class _Bar(Protocol):
+    """A progress bar (:class:`winder._progress.Progress`)."""
+
+    def update(self, t: float) -> None: ...
+
+    def close(self) -> None: ...
+
+
 # ---- progress and budgets -------------------------------------------------------------
 
 #: How to raise each budget, from :func:`~winder.simulate` (``how`` of :func:`budget_error`).
@@ -198,7 +205,7 @@ class _Guards:
     shared by the scipy and the compiled paths."""
 
     def __init__(self, names: tuple[str, ...], meth: str, *, limit: int, max_wall: float,
-                 bar: Progress | None, t_start: float, t_end: float) -> None:
+                 bar: _Bar | None, t_start: float, t_end: float) -> None:
         self.names, self.meth = names, meth
         self.limit, self.max_wall, self.bar = limit, max_wall, bar
         self.t_start, self.t_end = t_start, t_end
@@ -362,7 +369,11 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                                 f"({', '.join(system.state_names)}) with radius >= the core "
                                 f"radius {r_core:g} m")
     planar = PlanarSystem(scene, system) if be == "compiled" else None
-    bar = Progress(T, scene.name) if progress else None
+    bar = None
+    if progress:  # tqdm only where a bar is drawn (FMU hosts never import it)
+        from ._progress import Progress
+
+        bar = Progress(T, scene.name)
     guards = _Guards(system.state_names, meth, limit=limit, max_wall=wall_limit, bar=bar,
                      t_start=t_s, t_end=T)
     counter: PlanarSystem | WinderSystem = planar if planar is not None else system
