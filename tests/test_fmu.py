@@ -64,8 +64,9 @@ def test_interface(fmu_path, paper_scene) -> None:
 
 
 # pythonfmu 0.7's binary now and then corrupts the heap of a host that loads and unloads
-# many FMU copies (seen once in about 30 full runs of the suite: glibc aborts with
-# "corrupted double-linked list"; PythonFMU issue #228 is the same family). Such an abort
+# many FMU copies (glibc aborts with "corrupted double-linked list"; seen in one full CI
+# run of the suite, and in most runs while the slave imported more modules; PythonFMU
+# issue #228 is the same family). Such an abort
 # of pythonfmu's is retried once in a fresh process; a second one, or any other failure,
 # fails the test.
 _PYTHONFMU_HEAP_ABORT = "corrupted"
