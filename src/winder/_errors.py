@@ -42,6 +42,11 @@ class SimulationError(WinderError, RuntimeError):
         self.state = dict(state or {})
 
 
+def state_text(state: dict[str, float]) -> str:
+    """``z=0.575, roll_angle=0, …``: a state for an error message (6 significant digits)."""
+    return ", ".join(f"{name}={value:.6g}" for name, value in state.items())
+
+
 class BudgetExceeded(SimulationError):
     """A run hit its evaluation or wall-clock budget (``max_rhs``, ``max_wall``).
 

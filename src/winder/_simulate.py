@@ -15,7 +15,7 @@ import numpy as np
 
 from . import _integrators as integ
 from ._args import RTOL_MAX, show
-from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError
+from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError, state_text
 from ._planar import CORE_AUTO, PlanarSystem
 from ._result import Result
 from ._scene import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
@@ -166,7 +166,7 @@ def budget_error(kind: str, limit: float, *, meth: str, t: float, t_start: float
     value = f"{int(limit)} evaluations" if kind == "max_rhs" else f"{limit:g} s"
     raise_it = f"raise {kind} ({how[kind]})"
     span, done = t_end - t_start, t - t_start
-    where = ", ".join(f"{n}={v:.6g}" for n, v in state.items())
+    where = state_text(state)
     h = f"{step:.3g} s" if step is not None else "none yet"
     msg = (f"{name} budget {kind} = {value} reached at t = {t:.6g} s of t_end = {t_end:g} s "
            f"with method {meth!r} after {nfev} evaluations and {wall:.3g} s (last step {h}; "
@@ -218,8 +218,8 @@ class _Guards:
 
     def error(self, msg: str, t: float, y: np.ndarray) -> SimulationError:
         state = self.state(y)
-        where = ", ".join(f"{n}={v:.6g}" for n, v in state.items())
-        return SimulationError(f"{msg} at t = {t:.6g} s (state: {where})", time=t, state=state)
+        return SimulationError(f"{msg} at t = {t:.6g} s (state: {state_text(state)})", time=t,
+                               state=state)
 
     def wall_spent(self) -> bool:
         return time.perf_counter() - self.wall0 > self.max_wall

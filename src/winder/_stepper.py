@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from . import _integrators as integ
-from ._errors import ArgumentError, SimulationError
+from ._errors import ArgumentError, SimulationError, state_text
 from ._planar import PlanarSystem
 from ._result import Result
 from ._scene import Scene
@@ -124,7 +124,7 @@ class Stepper:
                                                budget, self._stats)
                 if status in (integ.NON_FINITE, integ.STEP_UNDERFLOW) or \
                         not np.all(np.isfinite(self.y)):
-                    where = ", ".join(f"{k}={v:.6g}" for k, v in self.state.items())
+                    where = state_text(self.state)
                     what = ("the state went non-finite" if status == integ.NON_FINITE
                             else "the step size underflowed (too stiff or discontinuous)")
                     raise SimulationError(f"integration failed at t = {t:.6g} s: {what} "

@@ -12,7 +12,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._drive import SpeedProfile, TorqueDrive, make_drive
-from ._errors import ArgumentError, SimulationError
+from ._errors import ArgumentError, SimulationError, state_text
 from ._model import DRUM, ROLL, ROLL_Z, WinderModel
 from ._planar import AT_CORE, CORE_AUTO, WINDING
 from ._scene import Scene
@@ -197,7 +197,7 @@ class WinderSystem:
         return SimulationError(
             f"non-finite state or derivative at t = {t:.6g} s in {bad or 'accelerations'} "
             f"(active effects: {effects}); the state was "
-            + ", ".join(f"{n}={v:.6g}" for n, v in state.items())
+            + state_text(state)
             + ". Try a stiff method (method='Radau' or 'BDF') or a tighter rtol.",
             time=t, state=state)
 

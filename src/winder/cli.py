@@ -272,8 +272,6 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         if args.csv is not None else None
     plot = check_output_file(args.plot, "--plot", suffixes=(".png",)) \
         if args.plot is not None else None
-    if csv is not None and plot is not None and csv.resolve() == plot.resolve():
-        raise WinderError(f"--csv and --plot name the same file {csv}")
 
     import numpy as np
 
