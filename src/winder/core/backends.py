@@ -1,0 +1,96 @@
+"""Where the machine's rigid-body algorithms run: Pinocchio on numbers, or Pinocchio's
+algorithms on CasADi symbols (for the generated code)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from .mathns import NUMERIC, SYMBOLIC, MathNamespace
+
+__all__ = ["NumericBackend", "SymbolicBackend"]
+
+
+class NumericBackend:
+    """``pin.aba``/``pin.rnea`` with ``fext`` on a :class:`pinocchio.Model` (the numeric
+    Pinocchio path: the cross-check of the generated code, and the fallback without a C
+    compiler)."""
+
+    M: MathNamespace = NUMERIC
+
+    def __init__(self, model: pin.Model) -> None:
+        self.model = model
+        self.data = model.createData()
+        nj = model.njoints
+        self._fext = pin.StdVec_Force()
+        for _ in range(nj):
+            self._fext.append(pin.Force.Zero())
+
+    def _load(self, dyn: list[float], fext: list[float], g: list[float]) -> None:
+        m = self.model
+        for i in range(1, m.njoints):
+            d = np.array(dyn[10 * (i - 1):10 * i], dtype=float)
+            Y = pin.Inertia.Zero()  # a rate inertia may be indefinite: set attributes
+            mass = d[0]
+            Y.mass = mass
+            com = d[1:4] / mass if mass != 0.0 else np.zeros(3)
+            Y.lever = com
+            Io = np.array([[d[4], d[5], d[7]], [d[5], d[6], d[8]], [d[7], d[8], d[9]]])
+            Y.inertia = Io - mass * (np.dot(com, com) * np.eye(3) - np.outer(com, com))
+            m.inertias[i] = Y
+            self._fext[i] = pin.Force(np.array(fext[6 * (i - 1):6 * i], dtype=float))
+        m.gravity = pin.Motion(np.array([*g, 0.0, 0.0, 0.0], dtype=float))
+
+    def velocity(self, ev: Any, joint: int) -> list[float]:
+        pin.forwardKinematics(self.model, self.data, np.array(ev.q, float),
+                              np.array(ev.v, float))
+        return list(self.data.v[joint + 1].vector)
+
+    def aba(self, q: list[Any], v: list[Any], tau: list[Any], dyn: list[Any],
+            fext: list[Any], g: list[Any]) -> list[float]:
+        self._load(dyn, fext, g)
+        return list(pin.aba(self.model, self.data, np.array(q, float), np.array(v, float),
+                            np.array(tau, float), self._fext))
+
+    def rnea(self, q: list[Any], v: list[Any], a: list[Any], dyn: list[Any],
+             fext: list[Any], g: list[Any]) -> list[float]:
+        self._load(dyn, fext, g)
+        return list(pin.rnea(self.model, self.data, np.array(q, float), np.array(v, float),
+                             np.array(a, float), self._fext))
+
+
+class SymbolicBackend:
+    """Pinocchio's ABA/RNEA/kinematics on CasADi ``SX`` (:mod:`winder.core.spatial`)."""
+
+    def __init__(self, model: pin.Model) -> None:
+        from .spatial import SpatialFunctions
+
+        self.M = SYMBOLIC
+        self.f = SpatialFunctions(model)
+        self._vel: Any = None
+
+    @staticmethod
+    def _vec(values: list[Any]) -> Any:
+        import casadi as ca
+
+        return ca.vertcat(*[ca.SX(v) if isinstance(v, float | int) else v for v in values])
+
+    def velocity(self, ev: Any, joint: int) -> list[Any]:
+        if self._vel is None or self._vel[0] is not ev:
+            self._vel = (ev, self.f.vel(self._vec(ev.q), self._vec(ev.v)))
+        V = self._vel[1][joint]
+        return [V[k] for k in range(6)]
+
+    def aba(self, q: list[Any], v: list[Any], tau: list[Any], dyn: list[Any],
+            fext: list[Any], g: list[Any]) -> list[Any]:
+        v6 = self._vec
+        out = self.f.aba(v6(q), v6(v), v6(tau), v6(dyn), v6(fext), v6(g))
+        return [out[k] for k in range(out.shape[0])]
+
+    def rnea(self, q: list[Any], v: list[Any], a: list[Any], dyn: list[Any],
+             fext: list[Any], g: list[Any]) -> list[Any]:
+        v6 = self._vec
+        out = self.f.rnea(v6(q), v6(v), v6(a), v6(dyn), v6(fext), v6(g))
+        return [out[k] for k in range(out.shape[0])]

@@ -1,0 +1,186 @@
+"""Generated C for a machine: its right-hand side, exact Jacobian, channels and switching
+functions, compiled once per structure and cached on disk.
+
+The machine's dynamics (:meth:`~winder.core.machine.Machine.evaluate`) runs once on CasADi
+symbols; four functions of ``(t, x, p, m)`` (time, state, parameters, locked modes) are
+generated as C, wrapped with flat entry points ``int NAME(const double* t, const double*
+x, const double* p, const double* m, double* out)`` and compiled with the system C
+compiler. The cache key is everything that changes the generated code: the machine's
+structure (:meth:`~winder.core.machine.Machine.structure_key`), the source of the physics
+(:mod:`winder.core`, :mod:`winder.forces`), the CasADi version and the compiler flags.
+Writes are atomic (a temporary file, then ``os.replace``), so processes building the same
+model at once all succeed. Parameter values are run-time inputs: changing one compiles
+nothing.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .machine import Machine
+
+__all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "FUNCTIONS", "stats"]
+
+#: The generated functions, in the order of :attr:`Generated.addresses`.
+FUNCTIONS = ("rhs", "jac", "out", "sw")
+CFLAGS = ("-O3", "-shared", "-fPIC")
+#: Counters of this process: models compiled, and loaded from the cache.
+stats = {"compiled": 0, "cached": 0}
+
+
+class CompilerMissing(RuntimeError):
+    """No C compiler: the generated path is unavailable (the numeric path remains)."""
+
+
+def cache_dir() -> Path:
+    """``$WINDER_CACHE_DIR`` or ``$XDG_CACHE_HOME/winder`` (``~/.cache/winder``)."""
+    env = os.environ.get("WINDER_CACHE_DIR")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "winder"
+
+
+def _source_hash() -> str:
+    h = hashlib.sha256()
+    root = Path(__file__).resolve().parent.parent
+    for sub in ("core", "forces"):
+        for f in sorted((root / sub).glob("*.py")):
+            h.update(f.name.encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+_SOURCE: str | None = None
+
+
+def _compiler() -> str:
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    if cc is None:
+        raise CompilerMissing("no C compiler (cc or gcc) on PATH")
+    return cc
+
+
+@dataclass
+class Generated:
+    """A compiled machine: function addresses and sizes (keep it alive while in use)."""
+
+    key: str
+    path: Path
+    n_states: int
+    n_params: int
+    n_modes: int
+    n_switches: int
+    n_channels: int
+    addresses: np.ndarray  # int64 addresses of FUNCTIONS
+    build_seconds: float = 0.0
+    from_cache: bool = False
+    _lib: Any = field(default=None, repr=False)
+
+    def call(self, which: str, t: float, x: np.ndarray, p: np.ndarray,
+             m: np.ndarray) -> np.ndarray:
+        """Evaluate one generated function from Python (slow path, for tests/outputs)."""
+        size = {"rhs": self.n_states, "jac": self.n_states ** 2, "out": self.n_channels,
+                "sw": self.n_switches}[which]
+        out = np.empty(size)
+        tb = np.array([t], float)
+        xs, ps, ms = (np.ascontiguousarray(a, dtype=float) for a in (x, p, m))
+        fn = getattr(self._lib, f"{self.symbol}_{which}_flat")
+        dp = ctypes.POINTER(ctypes.c_double)
+        fn(*(a.ctypes.data_as(dp) for a in (tb, xs, ps, ms, out)))
+        if which == "jac":
+            return out.reshape(self.n_states, self.n_states, order="F")
+        return out
+
+    @property
+    def symbol(self) -> str:
+        return f"w{self.key}"
+
+
+def _c_source(machine: Machine, symbol: str, directory: Path) -> Path:
+    import casadi as ca
+
+    from .backends import SymbolicBackend
+
+    t = ca.SX.sym("t")
+    x = ca.SX.sym("x", machine.n_states)
+    p = ca.SX.sym("p", len(machine.param_names))
+    m = ca.SX.sym("m", len(machine.mode_names))
+    ev = machine.evaluate(SymbolicBackend(machine.model), t, x, p, m)
+    xdot = ca.vertcat(*[ev.rates[n] for n in machine.state_names])
+    outs = {
+        "rhs": xdot,
+        "jac": ca.densify(ca.jacobian(xdot, x)),
+        "out": ca.vertcat(*[ev.channels[n] for n in machine.channel_names]),
+        "sw": ca.vertcat(*[ev.switches[n] for n in machine.switch_names]),
+    }
+    funcs = {k: ca.Function(f"{symbol}_{k}", [t, x, p, m], [ca.densify(v)], {"cse": True})
+             for k, v in outs.items()}
+    name = f"{symbol}.c"
+    cg = ca.CodeGenerator(name, {"with_header": False})
+    for f in funcs.values():
+        cg.add(f)
+    cg.generate(str(directory) + os.sep)
+    path = directory / name
+    wrap = ["", "/* flat, reentrant entry points */"]
+    for k, f in funcs.items():
+        wrap.append(
+            f"int {symbol}_{k}_flat(const double* t, const double* x, const double* p, "
+            f"const double* m, double* out) {{\n"
+            f"  const casadi_real* arg[{max(f.sz_arg(), 4)}] = {{t, x, p, m}};\n"
+            f"  casadi_real* res[{max(f.sz_res(), 1)}] = {{out}};\n"
+            f"  casadi_int iw[{f.sz_iw() + 1}];\n  casadi_real w[{f.sz_w() + 1}];\n"
+            f"  return {symbol}_{k}(arg, res, iw, w, 0);\n}}")
+    with open(path, "a") as fh:
+        fh.write("\n".join(wrap) + "\n")
+    return path
+
+
+def generate(machine: Machine, *, directory: Path | None = None) -> Generated:
+    """The compiled functions of ``machine``: from the cache, or generated and compiled
+    (and cached). Raises :class:`CompilerMissing` without a C compiler."""
+    import casadi as ca
+
+    global _SOURCE
+    if _SOURCE is None:
+        _SOURCE = _source_hash()
+    key = hashlib.sha256("|".join((machine.structure_key(), _SOURCE, ca.__version__,
+                                   " ".join(CFLAGS))).encode()).hexdigest()[:20]
+    symbol = f"w{key}"
+    root = Path(directory) if directory is not None else cache_dir() / "generated"
+    lib = root / f"{symbol}.so"
+    t0 = time.perf_counter()
+    from_cache = lib.exists()
+    if not from_cache:
+        cc = _compiler()
+        root.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
+            src = _c_source(machine, symbol, Path(tmp))
+            tmp_lib = Path(tmp) / f"{symbol}.so"
+            proc = subprocess.run([cc, *CFLAGS, str(src), "-o", str(tmp_lib), "-lm"],
+                                  capture_output=True, text=True)
+            if proc.returncode != 0:
+                raise RuntimeError(f"compiling the generated model failed ({cc}):\n"
+                                   + proc.stderr[-2000:])
+            os.replace(tmp_lib, lib)
+        stats["compiled"] += 1
+    else:
+        stats["cached"] += 1
+    handle = ctypes.CDLL(str(lib))
+    addrs = np.array([ctypes.cast(getattr(handle, f"{symbol}_{k}_flat"), ctypes.c_void_p).value
+                      for k in FUNCTIONS], dtype=np.int64)
+    return Generated(key, lib, machine.n_states, len(machine.param_names),
+                     len(machine.mode_names), len(machine.switch_names),
+                     len(machine.channel_names), addrs, time.perf_counter() - t0, from_cache,
+                     handle)

@@ -1,0 +1,59 @@
+"""The force-element interface: what an effect adds to the machine's dynamics.
+
+Every effect of ``[effects]`` is one :class:`ForceElement` in its own module, written over
+a math namespace (:mod:`winder.core.mathns`) so that the same code builds the generated C
+and runs on the numeric Pinocchio path.
+"""
+
+from __future__ import annotations
+
+from abc import ABC
+from typing import TYPE_CHECKING, Any, ClassVar
+
+if TYPE_CHECKING:
+    from ..core.machine import Evaluation, Machine
+
+__all__ = ["ForceElement"]
+
+
+class ForceElement(ABC):
+    """Base class of the physical effects a scene switches on (``[effects]``).
+
+    To add an effect (nothing else is touched: not the integrators, the code generator,
+    the channels or the CLI):
+
+    1. Subclass :class:`ForceElement` in its own module under ``winder/forces/``; set
+       ``name`` (the ``[effects]`` key) and ``order`` (lower runs first; an effect that
+       reads what another wrote runs after it).
+    2. In :meth:`declare`, register with the :class:`~winder.core.machine.Machine` what it
+       needs: run-time parameters (``machine.parameter(name, value)``, values from the
+       scene's parts), states (``machine.state(name, initial)``), result channels
+       (``machine.channel(name)``).
+    3. In :meth:`apply`, read the :class:`~winder.core.machine.Evaluation` (``ev.M`` is
+       the math namespace; ``ev.p(name)`` a parameter, ``ev.x(name)`` a state,
+       ``ev.bodies``/``ev.nips`` the kinematics), add forces with ``ev.add_force``, write
+       state derivatives with ``ev.set_rate`` and channels with ``ev.set_channel``. Branch
+       on states only through ``ev.M.if_else``/``fmax`` (the generated code is
+       branch-free).
+    4. Register the class in ``winder/forces/__init__.py`` (``FORCES``, one line) and add
+       the key to ``[effects]`` in the scene schema.
+
+    An effect that is off is never instantiated, so it costs nothing.
+    """
+
+    name: ClassVar[str]
+    order: ClassVar[int] = 50
+
+    def declare(self, machine: Machine) -> None:  # noqa: B027 - optional hook
+        """Register parameters, states and channels (once, when the machine is built)."""
+
+    def apply(self, ev: Evaluation) -> None:  # noqa: B027 - optional hook
+        """Per evaluation: add forces, write state derivatives and channels."""
+
+    def static(self, ev: Evaluation) -> Any:  # noqa: B027 - optional hook
+        """Like :meth:`apply` for the static balance of the initial state (default: the
+        same)."""
+        self.apply(ev)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"

@@ -1,0 +1,88 @@
+"""Nip contact (machines.md §2, winder-model §4): compliant normal force and slip friction.
+
+``F_n`` acts on ``b`` along ``+n`` and on ``a`` along ``−n`` through the centres, never
+negative, zero for ``δ ≤ 0``: linear ``k δ + c δ̇`` or Hunt–Crossley
+``k δ^p (1 + α δ̇)``. Friction ``F_ss = μ F_n tanh(v_s / v_ref)`` acts on ``b`` along
+``+t`` at ``p_b = c_b − r_b n`` and on ``a`` along ``−t`` at ``p_a = c_a + r_a n``; with the
+``slip_relaxation`` effect the friction is that effect's state instead.
+
+Each nip has a locked contact mode (``AUTO`` the clamped law, ``FREE`` no force,
+``IN_CONTACT`` the unclamped law, smoothly extended to ``δ < 0``) and a switching function
+``min(δ, F_unclamped/k)`` [m], > 0 exactly where the clamped law gives ``F_n > 0``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ..core.machine import FREE, IN_CONTACT
+from ._base import ForceElement
+
+if TYPE_CHECKING:
+    from ..core.machine import Evaluation, Machine, NipState
+
+__all__ = ["Contact", "unclamped_force", "normal_force", "push"]
+
+
+def unclamped_force(M: Any, law: str, par: Any, delta: Any, delta_dot: Any) -> Any:
+    """The contact law without its clamp [N]; ``par(key)`` reads the nip's parameters."""
+    if law == "linear":
+        return par("stiffness") * delta + par("damping") * delta_dot
+    return par("stiffness") * delta * M.power_abs(delta, par("exponent") - 1.0) \
+        * (1.0 + par("hc_damping") * delta_dot)
+
+
+def normal_force(M: Any, mode: Any, delta: Any, f_unclamped: Any) -> Any:
+    """``F_n`` [N] in the locked ``mode``."""
+    auto = M.if_else(delta > 0.0, M.fmax(f_unclamped, 0.0), 0.0)
+    return M.if_else(mode == IN_CONTACT, f_unclamped,
+                     M.if_else(mode == FREE, 0.0, auto))
+
+
+class Contact(ForceElement):
+    """Normal force and slip friction at every nip."""
+
+    name = "contact"
+    order = 20
+    relaxed = False
+
+    def declare(self, machine: Machine) -> None:
+        self.relaxed = machine.scene.effects.slip_relaxation
+        for nip in machine.nips:
+            c, f = nip.part.contact, nip.part.friction
+            keys = ("stiffness", "damping") if c.law == "linear" else \
+                ("stiffness", "exponent", "hc_damping")
+            for key in keys:
+                machine.parameter(f"{nip.name}.{key}", getattr(c, key))
+            machine.parameter(f"{nip.name}.mu", f.mu)
+            machine.parameter(f"{nip.name}.slip_velocity", f.slip_velocity)
+            machine.mode(f"{nip.name}.contact", (f"{nip.name}.contact",))
+
+    def apply(self, ev: Evaluation) -> None:
+        M = ev.M
+        for ns in ev.nips.values():
+            nip = ns.nip
+            law = nip.part.contact.law
+
+            def par(key: str, nip: Any = nip) -> Any:
+                return ev.p(f"{nip.name}.{key}")
+
+            fu = unclamped_force(M, law, par, ns.delta, ns.delta_dot)
+            ev.switches[f"{nip.name}.contact"] = M.fmin(ns.delta, fu / par("stiffness"))
+            fn = normal_force(M, ev.mode(f"{nip.name}.contact"), ns.delta, fu)
+            ns.normal_force = fn
+            ns.steady_friction = par("mu") * fn * M.tanh(ns.v_s / par("slip_velocity"))
+            push(ev, ns, fn, 0.0)
+            if not self.relaxed:
+                ns.friction_force = ns.steady_friction
+                push(ev, ns, 0.0, ns.friction_force)
+
+
+def push(ev: Evaluation, ns: NipState, fn: Any, ft: Any) -> None:
+    """``F_n`` [N] along ``+n`` and ``F_t`` [N] along ``+t`` on ``b`` at ``p_b``, the
+    reaction on ``a`` at ``p_a`` (machines.md §2)."""
+    a, b = ev.bodies[ns.nip.a.name], ev.bodies[ns.nip.b.name]
+    fx = fn * ns.nx + ft * ns.tx
+    fz = fn * ns.nz + ft * ns.tz
+    ev.add_force(b.body.name, fx, fz, -b.r * ns.nx, -b.r * ns.nz)
+    ev.add_force(a.body.name, -fx, -fz, a.r * ns.nx, a.r * ns.nz)

@@ -1,0 +1,50 @@
+"""Rider load (machines.md §4): a vertical force ``−L · q(r_w)`` [N] at each rider's
+centre; ``q`` [N/m] the line-load schedule over the ridden roll's radius (linear between
+its points, constant beyond them), ``L`` the ridden roll's width."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ._base import ForceElement
+
+if TYPE_CHECKING:
+    from ..core.machine import Evaluation, Machine
+
+__all__ = ["RiderLoad", "line_load"]
+
+
+def line_load(M: Any, r: Any, points: list[tuple[Any, Any]]) -> Any:
+    """``q(r)`` [N/m]: piecewise linear through ``points`` ``(radius, load)``, held
+    constant beyond the first and the last."""
+    q = points[-1][1]
+    for (r0, q0), (r1, q1) in reversed(list(zip(points[:-1], points[1:], strict=True))):
+        q = M.if_else(r < r1, q0 + (q1 - q0) * (r - r0) / (r1 - r0), q)
+    return M.if_else(r < points[0][0], points[0][1], q)
+
+
+class RiderLoad(ForceElement):
+    """The applied load of every rider roll with a load schedule."""
+
+    name = "rider_load"
+    order = 40
+
+    def declare(self, machine: Machine) -> None:
+        for b in machine.bodies:
+            if b.kind == "rider":
+                for i, (r, q) in enumerate(b.part.load):
+                    machine.parameter(f"{b.name}.load_radius_{i}", r)
+                    machine.parameter(f"{b.name}.line_load_{i}", q)
+                machine.channel(f"{b.name}_load")
+
+    def apply(self, ev: Evaluation) -> None:
+        for b in ev.machine.bodies:
+            if b.kind != "rider":
+                continue
+            n = b.name
+            pts = [(ev.p(f"{n}.load_radius_{i}"), ev.p(f"{n}.line_load_{i}"))
+                   for i in range(len(b.part.load))]
+            roll = ev.bodies[b.part.rides]
+            f = ev.p(f"{roll.body.name}.width") * line_load(ev.M, roll.r, pts) if pts else 0.0
+            ev.add_force(n, 0.0, -f)
+            ev.set_channel(f"{n}_load", f)

@@ -1,0 +1,242 @@
+"""A scene's machine as one ODE system: generated code (or Pinocchio on numbers), its
+parameters, locked modes, initial state and result channels.
+
+``MachineSystem(scene)`` builds the :class:`~winder.core.machine.Machine`, compiles its
+generated functions (cached; see :mod:`winder.core.codegen`) and serves the integrators:
+``rhs``/``jac`` for scipy's methods, the function addresses ``fns``, the mode ``table``
+and the parameter vector ``params`` for the compiled ones, ``channels`` for the result.
+``backend="pinocchio"`` evaluates the same dynamics through ``pin.aba``/``pin.rnea`` on
+numbers (the cross-check, and the fallback where no C compiler exists, with a warning).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+import numpy as np
+
+from .._errors import ArgumentError, SimulationError, state_text
+from .._jit import njit
+from ..core.backends import NumericBackend
+from ..core.codegen import CompilerMissing, Generated, generate
+from ..core.equilibrium import Equilibrium, static_state
+from ..core.machine import AT_CORE, AUTO, CORE_AUTO, WINDING, Machine
+from . import integrators as integ
+
+__all__ = ["MachineSystem", "LEGACY_CHANNELS", "NoCompilerWarning"]
+
+#: Channel names of a scene in the single-drum format (winder-model §8 and winder's
+#: extras), from the machine's channels of drum "drum", roll "roll" and nip "nip".
+LEGACY_CHANNELS = {
+    "drum_speed": "drum_speed", "drum_torque": "drum_torque", "roll_speed": "roll_speed",
+    "roll_accel": "roll_accel", "roll_angle": "roll_angle", "radius": "roll_radius",
+    "mass": "roll_mass", "inertia": "roll_inertia", "mass_rate": "roll_mass_rate",
+    "inertia_rate": "roll_inertia_rate", "z": "roll_z", "z_dot": "roll_z_dot",
+    "normal_force": "nip_normal_force", "friction_force": "nip_friction_force",
+    "slip_velocity": "nip_slip_velocity", "drum_angle": "drum_angle",
+    "web_speed": "web_speed", "z_accel": "roll_z_accel", "web_force": "web_force",
+    "penetration": "nip_penetration",
+}
+
+
+class NoCompilerWarning(UserWarning):
+    """The generated path is unavailable (no C compiler): the numeric Pinocchio path runs."""
+
+
+@njit
+def _channels_into(fns: np.ndarray, table: np.ndarray, t: np.ndarray, Y: np.ndarray,
+                   p: np.ndarray, out: np.ndarray) -> None:
+    n = Y.shape[0]
+    y = np.empty(n)
+    m = np.empty(table.shape[0])
+    tb = np.empty(1)
+    g = np.empty(max(1, int(table[:, 1:3].max()) + 1 if table.shape[0] else 1))
+    col = np.empty(out.shape[0])
+    for i in range(t.shape[0]):
+        for j in range(n):
+            y[j] = Y[j, i]
+        integ.modes_of(fns, table, tb, t[i], y, p, m, g, True)
+        integ.evaluate(fns, integ.F_OUT, tb, t[i], y, p, m, col)
+        for j in range(out.shape[0]):
+            out[j, i] = col[j]
+
+
+class MachineSystem:
+    """Right-hand side, Jacobian and outputs of a scene's machine. Build once, evaluate
+    many times.
+
+    Parameters
+    ----------
+    scene: a validated :class:`~winder.Scene`.
+    backend: ``compiled`` (generated C) or ``pinocchio`` (``pin.aba`` on numbers).
+    """
+
+    def __init__(self, scene: Any, *, backend: str = "compiled") -> None:
+        self.scene = scene
+        self.machine = m = Machine(scene)
+        self.state_names = tuple(m.state_names)
+        self.params = m.parameters()
+        self.backend = backend
+        self.generated: Generated | None = None
+        if backend == "compiled":
+            try:
+                self.generated = generate(m)
+            except CompilerMissing as exc:
+                warnings.warn(f"{exc}: the generated code cannot be built; running the "
+                              "numeric Pinocchio path (much slower)", NoCompilerWarning,
+                              stacklevel=2)
+                self.backend = "pinocchio"
+        self._numeric = NumericBackend(m.model) if self.generated is None else None
+        self.fns = self.generated.addresses if self.generated is not None else None
+        rows = []
+        for name in m.mode_names:
+            if name.endswith(".contact"):
+                rows.append((integ.K_CONTACT, m.switch_names.index(name), 0, 0, 0))
+            else:
+                roll = name[:-len(".core")]
+                rows.append((integ.K_CORE, m.switch_names.index(f"{roll}.unwound"),
+                             m.switch_names.index(f"{roll}.forward"),
+                             m.index(f"{roll}.radius"), m.param_index(f"{roll}.core_radius")))
+        self.table = np.array(rows, dtype=np.int64).reshape(len(rows), 5)
+        self.modes = np.array([AUTO if r[0] == integ.K_CONTACT else CORE_AUTO for r in rows],
+                              dtype=float)
+        self.radii = [(m.index(f"{b.name}.radius"), b.part.core_radius) for b in m.rolls]
+        self.breakpoints = sorted({b.part.drive.web_speed / b.part.drive.web_acceleration
+                                   for b in m.bodies if b.prescribed
+                                   and b.part.drive.web_acceleration > 0})
+        self.nfev = 0
+        self._eq: Equilibrium | None = None
+
+    # ---- state --------------------------------------------------------------------------
+    @property
+    def n_states(self) -> int:
+        return len(self.state_names)
+
+    @property
+    def equilibrium(self) -> Equilibrium:
+        """The static balance of the initial state (machines.md §7)."""
+        if self._eq is None:
+            self._eq = static_state(self.machine, self.params)
+        return self._eq
+
+    def initial_state(self) -> np.ndarray:
+        """The initial state of machines.md §7."""
+        return self.equilibrium.state.copy()
+
+    def index(self, name: str) -> int:
+        """Position of state ``name``."""
+        return self.machine.index(name)
+
+    def set_input(self, name: str, value: float) -> None:
+        """Set a run-time parameter, e.g. ``DRUM.torque`` [N·m] of a torque-driven drum."""
+        self.params[self.machine.param_index(name)] = value
+
+    def torque_inputs(self) -> list[str]:
+        """Names of the torque inputs (``DRUM.torque``, one per torque-driven drum)."""
+        return [f"{b.name}.torque" for b in self.machine.bodies if b.torque_input]
+
+    def set_drum_torque(self, torque: float) -> None:
+        """Input torque [N·m] of the torque-driven drum (scenes with exactly one)."""
+        names = self.torque_inputs()
+        if len(names) != 1:
+            raise ArgumentError("drum_torque is an input only with one drum of drive kind "
+                                f"'torque'; this scene has {len(names)}")
+        self.set_input(names[0], torque)
+
+    def set_core_mode(self, core: int) -> None:
+        """Lock the core mode of every wound roll (``CORE_AUTO``, ``WINDING``,
+        ``AT_CORE``) for :meth:`rhs`."""
+        if core not in (CORE_AUTO, WINDING, AT_CORE):
+            raise ArgumentError(f"core mode must be one of {CORE_AUTO}, {WINDING}, {AT_CORE}, "
+                                f"got {core!r}")
+        self.modes[self.table[:, 0] == integ.K_CORE] = core
+
+    def clamp_radii(self, Y: np.ndarray) -> None:
+        """Samples interpolated between a step's start and its core event may dip below
+        ``r_c`` by round-off; the state never does."""
+        for i, rc in self.radii:
+            np.maximum(Y[i], rc, out=Y[i])
+
+    # ---- evaluation -----------------------------------------------------------------------
+    def evaluate_numeric(self, t: float, y: np.ndarray, modes: np.ndarray | None = None,
+                         *, outputs: bool = True) -> Any:
+        """The dynamics on the numeric Pinocchio path (an :class:`Evaluation`)."""
+        be = self._numeric or NumericBackend(self.machine.model)
+        self._numeric = be
+        return self.machine.evaluate(be, t, y, self.params,
+                                     self.modes if modes is None else modes, outputs=outputs)
+
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """``dy/dt`` (clamped nip laws; core modes as locked)."""
+        self.nfev += 1
+        if self.generated is not None:
+            dy = self.generated.call("rhs", t, y, self.params, self.modes)
+        else:
+            ev = self.evaluate_numeric(t, y, outputs=False)
+            dy = np.array([float(ev.rates[n]) for n in self.state_names])
+        if not np.all(np.isfinite(dy)):
+            raise self.blowup_error(t, y, dy)
+        return dy
+
+    def jac(self, t: float, y: np.ndarray) -> np.ndarray:
+        """The exact Jacobian ``∂(dy/dt)/∂y`` (generated), or central differences on the
+        numeric path."""
+        if self.generated is not None:
+            return self.generated.call("jac", t, y, self.params, self.modes)
+        n = len(y)
+        J = np.empty((n, n))
+        for k in range(n):
+            h = 1e-7 * max(1.0, abs(y[k]))
+            a, b = np.array(y, float), np.array(y, float)
+            a[k] += h
+            b[k] -= h
+            J[:, k] = (self.rhs(t, a) - self.rhs(t, b)) / (2 * h)
+        return J
+
+    def switches(self, t: float, y: np.ndarray) -> np.ndarray:
+        """The switching functions (``machine.switch_names``)."""
+        if self.generated is not None:
+            return self.generated.call("sw", t, y, self.params, self.modes)
+        ev = self.evaluate_numeric(t, y, outputs=False)
+        return np.array([float(ev.switches[n]) for n in self.machine.switch_names])
+
+    def blowup_error(self, t: float, y: np.ndarray, dy: np.ndarray) -> SimulationError:
+        """The error for a non-finite derivative: which states, which effects, the state."""
+        bad = [n for n, v, d in zip(self.state_names, y, dy, strict=False)
+               if not (math.isfinite(v) and math.isfinite(d))]
+        effects = ", ".join(f.name for f in self.machine.forces) or "none"
+        state = dict(zip(self.state_names, map(float, y), strict=True))
+        return SimulationError(
+            f"non-finite state or derivative at t = {t:.6g} s in {bad or 'accelerations'} "
+            f"(active effects: {effects}); the state was " + state_text(state)
+            + ". Try a stiff method (method='Radau' or 'BDF') or a tighter rtol.",
+            time=t, state=state)
+
+    # ---- outputs ----------------------------------------------------------------------------
+    def channels(self, t: np.ndarray, Y: np.ndarray) -> dict[str, np.ndarray]:
+        """All result channels at times ``t`` for states ``Y`` (``(n_states, len(t))``):
+        machines.md §9 names, or winder-model §8 names for a single-drum scene."""
+        t = np.ascontiguousarray(t, dtype=float)
+        Y = np.ascontiguousarray(Y, dtype=float)
+        names = self.machine.channel_names
+        if self.generated is not None:
+            out = np.empty((len(names), len(t)))
+            _channels_into(self.fns, self.table, t, Y, self.params, out)
+        else:
+            out = np.empty((len(names), len(t)))
+            modes = self.modes.copy()
+            for i, ti in enumerate(t):
+                g = self.switches(float(ti), Y[:, i])
+                for s, row in enumerate(self.table):
+                    modes[s] = AUTO if row[0] == integ.K_CONTACT else (
+                        AT_CORE if g[row[1]] >= 0.0 and g[row[2]] <= 0.0 else WINDING)
+                ev = self.evaluate_numeric(float(ti), Y[:, i], modes)
+                out[:, i] = [float(ev.channels.get(n, 0.0)) for n in names]
+        ch = {"t": t.copy()}
+        ch.update(zip(names, out, strict=True))
+        if getattr(self.scene, "legacy", False):
+            ch = {"t": ch["t"], **{old: ch.get(new, np.zeros(len(t)))
+                                   for old, new in LEGACY_CHANNELS.items()}}
+        return ch
