@@ -13,25 +13,27 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from . import _integrators as integ
 from ._args import RTOL_MAX, show
 from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError, state_text
-from ._planar import CORE_AUTO, PlanarSystem
 from ._result import Result
 from ._scene import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
-from ._system import WinderSystem
+from .core.machine import CORE_AUTO
+from .solve import integrators as integ
+from .solve.system import MachineSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
            "check_real", "check_tolerances", "check_budgets", "budget_error"]
 
 #: What ``method="auto"`` picks (chosen from the work–precision study, docs/), per backend.
 DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
-#: Methods that run entirely compiled (planar backend only).
+#: Methods that run entirely compiled (generated code only).
 COMPILED_METHODS = ("DOPRI5",)
 #: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
 _WALL_EVERY = 256  # evaluations between wall-clock checks on the Python paths
 _STEP_OVER = 1e-6  # [s] integrated without contact events after a grazing contact
-JACOBIANS = ("fd", "pinocchio")
+#: Jacobians for scipy's implicit methods: ``exact`` (generated; ``pinocchio`` is its old
+#: name) or ``fd`` (the integrator's finite differences).
+JACOBIANS = ("exact", "fd", "pinocchio")
 
 
 # ---- arguments ----------------------------------------------------------------------
@@ -243,7 +245,7 @@ class _Guards:
 
 # ---- the compiled paths ----------------------------------------------------------------
 
-def _run_compiled(meth: str, p: np.ndarray, y: np.ndarray, t_out: np.ndarray,
+def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.ndarray,
                   Ys: np.ndarray, breaks: list[float], rtol: float, atol: float,
                   max_step: float | None, guards: _Guards, stats: np.ndarray,
                   at: list[Any]) -> int:
@@ -253,20 +255,22 @@ def _run_compiled(meth: str, p: np.ndarray, y: np.ndarray, t_out: np.ndarray,
     (for a budget error)."""
     t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
+    fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
     for tb in breaks:
         while t < tb:
             budget = min(integ.CHUNK, guards.limit - int(stats[0]))
             if budget <= 0:
                 raise _Stop("max_rhs")
             if meth == "DOPRI5":
-                status, t, h, k = integ.dopri5(t, tb, y, p, rtol, atol, h, hmax, t_out, Ys,
-                                               k, budget, stats)
+                status, t, h, k = integ.dopri5(fns, table, t, tb, y, p, modes, rtol, atol, h,
+                                               hmax, t_out, Ys, k, budget, stats)
             else:  # RK4: chunks of budget/4 steps
                 step = max_step or 1e-3
                 t_next = min(tb, t + step * budget / 4)
                 if tb - t_next < 1e-9 * step:
                     t_next = tb
-                status, t, h, k = integ.rk4(t, t_next, y, p, step, t_out, Ys, k, stats)
+                status, t, h, k = integ.rk4(fns, table, t, t_next, y, p, modes, step, t_out,
+                                            Ys, k, stats)
             at[:] = [t, h, k]
             guards.steps = int(stats[1])
             if meth == "DOPRI5":
@@ -292,7 +296,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
              max_step: float | None = None, max_rhs: int | None = None,
              max_wall: float | None = None, backend: str | None = None,
              t_start: float = 0.0, initial_state: np.ndarray | None = None,
-             jacobian: str = "fd") -> Result:
+             jacobian: str = "exact") -> Result:
     """Simulate a scene and return its result channels.
 
     Every argument is checked before any work: a bad one raises
@@ -317,12 +321,12 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     max_rhs, max_wall: budgets: right-hand side evaluations (default ``[solver] max_rhs``)
         and wall-clock seconds (default ``[solver] max_wall``); reaching one raises
         :class:`~winder.BudgetExceeded` with the samples so far in ``.partial``.
-    backend: ``compiled`` (planar equations in numba, default) or ``pinocchio`` (ABA
-        with the variable-mass terms); default ``[solver] backend``.
+    backend: ``compiled`` (the machine's generated C, default) or ``pinocchio``
+        (``pin.aba`` on numbers with the same force elements); default ``[solver] backend``.
     t_start, initial_state: start the run at ``t_start`` [s] from a full state vector
-        (order of ``WinderSystem.state_names``) instead of spec §6's initial state.
-    jacobian: for Radau, BDF and LSODA: ``fd`` (the integrator's finite differences) or
-        ``pinocchio`` (ABA derivatives and the chain rule, :mod:`winder._linearise`).
+        (order of ``MachineSystem.state_names``) instead of the static initial state.
+    jacobian: for Radau, BDF and LSODA: ``exact`` (the generated Jacobian, default) or
+        ``fd`` (the integrator's finite differences).
 
     Raises
     ------
@@ -352,8 +356,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     t_s = check_real("t_start", t_start, lambda v: math.isfinite(v) and 0.0 <= v < T,
                      f"finite, >= 0 and < {t_key} = {T:g} [s]")
     t_out = _output_grid(t_s, T, dt, t_key, dt_key)
-    system = WinderSystem(scene)
-    r_core = scene.roll.core_radius
+    system = MachineSystem(scene, backend=be)
     if initial_state is None:
         y0 = system.initial_state()
     else:
@@ -362,13 +365,14 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         except (TypeError, ValueError):
             raise ArgumentTypeError(f"initial_state must be {system.n_states} numbers, got "
                                     f"{initial_state!r:.200}") from None
-        if y0.shape != (system.n_states,) or not np.all(np.isfinite(y0)) or y0[4] < r_core:
+        if y0.shape != (system.n_states,) or not np.all(np.isfinite(y0)) \
+                or any(y0[i] < rc for i, rc in system.radii):
             given = ", ".join(f"{v:.9g}" for v in y0.ravel()[:20])
+            cores = ", ".join(f"{system.state_names[i]} >= {rc:g} m" for i, rc in system.radii)
             raise ArgumentError(f"initial_state = [{given}] is not valid: valid are "
                                 f"{system.n_states} finite values "
-                                f"({', '.join(system.state_names)}) with radius >= the core "
-                                f"radius {r_core:g} m")
-    planar = PlanarSystem(scene, system) if be == "compiled" else None
+                                f"({', '.join(system.state_names)}) with radii at or above "
+                                f"their cores ({cores})")
     bar = None
     if progress:  # tqdm only where a bar is drawn (FMU hosts never import it)
         from ._progress import Progress
@@ -376,42 +380,41 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         bar = Progress(T, scene.name)
     guards = _Guards(system.state_names, meth, limit=limit, max_wall=wall_limit, bar=bar,
                      t_start=t_s, t_end=T)
-    counter: PlanarSystem | WinderSystem = planar if planar is not None else system
-    breaks = sorted({b for b in system.drive.breakpoints if t_s < b < T} | {T})
+    breaks = sorted({b for b in system.breakpoints if t_s < b < T} | {T})
     Ys = np.empty((len(y0), len(t_out)))
-    compiled_run = planar is not None and meth in (*COMPILED_METHODS, "RK4")
+    compiled_run = system.generated is not None and meth in (*COMPILED_METHODS, "RK4")
     stats = np.zeros(5, dtype=np.int64)
     at: list[Any] = [t_s, None, 0]
     try:
         try:
             if compiled_run:
                 y = np.array(y0)
-                filled = _run_compiled(meth, planar.params, y, t_out, Ys, breaks, rtol, atol,
+                filled = _run_compiled(meth, system, y, t_out, Ys, breaks, rtol, atol,
                                        max_step, guards, stats, at)
-                planar.nfev, n_events = int(stats[0]), int(stats[3])
+                system.nfev, n_events = int(stats[0]), int(stats[3])
             else:
                 from ._stepwise import run_stepwise
 
-                filled, n_events = run_stepwise(scene, counter, meth, y0, t_s, t_out, Ys, breaks,
-                                               rtol, atol, max_step, events, jacobian, guards)
+                filled, n_events = run_stepwise(system, meth, y0, t_s, t_out, Ys, breaks,
+                                                rtol, atol, max_step, events, jacobian, guards)
         except _Stop as stop:
-            counter.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
+            system.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
             if compiled_run:
-                planar.nfev = int(stats[0])
+                system.nfev = int(stats[0])
                 t_at, h_at, filled = at
                 y_at = y
             else:
                 t_at, y_at, h_at, filled = stop.at  # type: ignore[attr-defined]
             partial = None
             if filled:
-                np.maximum(Ys[4, :filled], r_core, out=Ys[4, :filled])
+                system.clamp_radii(Ys[:, :filled])
                 wall = time.perf_counter() - guards.wall0
-                partial = Result(counter.channels(t_out[:filled], Ys[:, :filled]),
-                                 _meta(scene, meth, be, rtol, atol, counter.nfev, wall, 0,
-                                       t_s, T, partial=True))
+                partial = Result(system.channels(t_out[:filled], Ys[:, :filled]),
+                                 _meta(scene, system, meth, rtol, atol, wall, 0, t_s, T,
+                                       partial=True))
             if bar is not None:
                 bar.update(t_at)
-            raise guards.exceeded(stop.kind, t_at, y_at, h_at, counter.nfev,
+            raise guards.exceeded(stop.kind, t_at, y_at, h_at, system.nfev,
                                   partial) from None
         if bar is not None:
             bar.update(T)
@@ -421,25 +424,25 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     if filled != len(t_out):
         raise SimulationError(f"internal error: {filled} of {len(t_out)} output samples")
     wall = time.perf_counter() - guards.wall0
-    counter.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
-    # interpolated samples between a step's start and its core event may dip below r_c
-    # by round-off; the state never does
-    np.maximum(Ys[4], r_core, out=Ys[4])
-    channels = counter.channels(t_out, Ys)
+    system.set_core_mode(CORE_AUTO)  # channels: the core mode by the state
+    system.clamp_radii(Ys)
+    channels = system.channels(t_out, Ys)
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
     if bad:
         raise SimulationError(f"non-finite values in result channels {bad}")
-    return Result(channels, _meta(scene, meth, be, rtol, atol, counter.nfev, wall, n_events,
-                                  t_s, T))
+    return Result(channels, _meta(scene, system, meth, rtol, atol, wall, n_events, t_s, T))
 
 
-def _meta(scene: Scene, meth: str, be: str, rtol: float, atol: float, nfev: int,
+def _meta(scene: Scene, system: MachineSystem, meth: str, rtol: float, atol: float,
           wall: float, n_events: int, t_s: float, T: float, *,
           partial: bool = False) -> dict[str, Any]:
     """The ``meta`` of a result; ``wall`` [s] is the integration's wall time."""
-    return {"scene": scene.name, "source": scene.source, "method": meth, "backend": be,
-            "rtol": rtol, "atol": atol, "rhs_evaluations": nfev,
-            "wall_time": wall, "events": n_events,
+    eq = system.equilibrium if t_s == 0.0 else None
+    return {"scene": scene.name, "source": scene.source, "method": meth,
+            "backend": system.backend, "rtol": rtol, "atol": atol,
+            "rhs_evaluations": system.nfev, "wall_time": wall, "events": n_events,
             "t_start": t_s, "t_end": T, "effects": list(scene.effects.enabled()),
-            "drum_radius": scene.drum.radius, "scene_dict": scene.to_dict(),
+            "drum_radius": scene.drums[0].radius, "scene_dict": scene.to_dict(),
+            "static_residual": None if eq is None else eq.residual,
+            "static_scale": None if eq is None else eq.scale,
             "partial": partial}

@@ -8,20 +8,35 @@ from typing import Any
 
 import numpy as np
 
-from . import _integrators as integ
 from ._errors import ArgumentError, SimulationError, state_text
-from ._planar import PlanarSystem
 from ._result import Result
 from ._scene import Scene
 from ._simulate import budget_error, check_budgets, check_real, check_tolerances
-from ._system import CHANNELS, EXTRA_CHANNELS, WinderSystem
+from .solve import integrators as integ
+from .solve.system import LEGACY_CHANNELS, MachineSystem
 
-__all__ = ["Stepper", "INPUTS", "OUTPUTS"]
+__all__ = ["Stepper", "INPUTS", "OUTPUTS", "inputs_of", "outputs_of"]
 
-#: Inputs of a :class:`Stepper`: ``drum_torque`` [N·m] (drive kind ``torque`` only).
+#: Input of a single-drum scene's :class:`Stepper`: ``drum_torque`` [N·m] (drive kind
+#: ``torque`` only). A machine from parts has ``DRUM_torque`` per torque-driven drum.
 INPUTS = ("drum_torque",)
-#: Outputs: every result channel but ``t``.
-OUTPUTS = CHANNELS[1:] + EXTRA_CHANNELS
+#: Outputs of a single-drum scene: every result channel but ``t``.
+OUTPUTS = tuple(LEGACY_CHANNELS)
+
+
+def inputs_of(system: MachineSystem) -> dict[str, str]:
+    """The inputs of a scene: input name → run-time parameter (``DRUM.torque``)."""
+    names = system.torque_inputs()
+    if getattr(system.scene, "legacy", False):
+        return {"drum_torque": n for n in names}
+    return {n.replace(".", "_"): n for n in names}
+
+
+def outputs_of(system: MachineSystem) -> tuple[str, ...]:
+    """The outputs of a scene: its result channels but ``t``."""
+    if getattr(system.scene, "legacy", False):
+        return OUTPUTS
+    return tuple(system.machine.channel_names)
 _RAISE = {"max_rhs": "Stepper(max_rhs=...) or [solver] max_rhs; it is the budget of one step",
           "max_wall": "Stepper(max_wall=...) or [solver] max_wall; it is the budget of one "
                       "step"}
@@ -44,8 +59,10 @@ class Stepper:
 
     Parameters
     ----------
-    scene: the scene (drive kind ``torque`` for a torque input; its ``[drum.drive]
-        torque`` is the input until :meth:`set_input` changes it).
+    scene: the scene (a drum of drive kind ``torque`` for a torque input; its drive's
+        ``torque`` is the input until :meth:`set_input` changes it). Inputs:
+        :attr:`inputs` (``drum_torque`` for a single-drum scene, ``DRUM_torque`` per
+        torque-driven drum of a machine from parts); outputs: :attr:`output_names`.
     rtol, atol: tolerances of the internal integrator (default ``1e-8``, ``1e-10``): rtol
         finite in (0, 0.1], atol finite > 0.
     max_rhs, max_wall: budget of each :meth:`step`: evaluations and wall-clock seconds
@@ -59,14 +76,18 @@ class Stepper:
             scene.solver.max_rhs if max_rhs is None else max_rhs,
             scene.solver.max_wall if max_wall is None else max_wall)
         self.scene = scene
-        self.system = WinderSystem(scene)
-        self._planar = PlanarSystem(scene, self.system)
-        self.free_drum = scene.drum.drive.kind == "torque"
-        self._breaks = tuple(self.system.drive.breakpoints)
+        self.system = MachineSystem(scene)
+        if self.system.generated is None:
+            raise SimulationError("the Stepper needs the generated code: no C compiler")
+        self.inputs = inputs_of(self.system)
+        self.output_names = outputs_of(self.system)
+        self.free_drum = bool(self.inputs)
+        self._breaks = tuple(self.system.breakpoints)
         self.reset()
 
     def reset(self) -> None:
-        """Back to ``t = 0`` and the initial state of spec §6 (inputs keep their values)."""
+        """Back to ``t = 0`` and the initial state of machines.md §7 (inputs keep their
+        values)."""
         self.t = 0.0
         self.y = self.system.initial_state()
         self._h = 0.0
@@ -84,10 +105,11 @@ class Stepper:
 
     def set_input(self, name: str, value: float) -> None:
         """Set an input (held constant over the next steps)."""
-        if name not in INPUTS:
-            raise ArgumentError(f"unknown input {name!r}; valid: {', '.join(INPUTS)}")
+        if name not in self.inputs:
+            valid = ", ".join(self.inputs) or "none (no drum of drive kind 'torque')"
+            raise ArgumentError(f"unknown input {name!r}; valid: {valid}")
         v = check_real(name, value, math.isfinite, "a finite number [N·m]")
-        self._planar.set_drum_torque(v)
+        self.system.set_input(self.inputs[name], v)
         self._outputs = None
 
     def step(self, dt: float) -> None:
@@ -108,7 +130,7 @@ class Stepper:
         t_start, t_end = self.t, self.t + dt
         stops = [b for b in self._breaks if self.t < b < t_end] + [t_end]
         empty_t, empty_y = np.empty(0), np.empty((len(self.y), 0))
-        p = self._planar.params
+        sy = self.system
         nfev0, steps0, stiff0 = (int(x) for x in self._stats[[0, 1, 4]])
         wall0 = time.perf_counter()
         for tb in stops:
@@ -119,7 +141,8 @@ class Stepper:
                 if over is not None:
                     raise self._over(over, t_start, t_end, spent, steps0, stiff0, wall0)
                 budget = min(integ.CHUNK, self.max_rhs - spent)
-                status, t, h, _ = integ.dopri5(self.t, tb, self.y, p, self.rtol, self.atol,
+                status, t, h, _ = integ.dopri5(sy.fns, sy.table, self.t, tb, self.y,
+                                               sy.params, sy.modes, self.rtol, self.atol,
                                                self._h, math.inf, empty_t, empty_y, 0,
                                                budget, self._stats)
                 if status in (integ.NON_FINITE, integ.STEP_UNDERFLOW) or \
@@ -148,14 +171,15 @@ class Stepper:
                             partial=partial, how=_RAISE, alternatives="a looser rtol")
 
     def outputs(self) -> dict[str, float]:
-        """All outputs (:data:`OUTPUTS`) at the current time."""
+        """All outputs (:attr:`output_names`) at the current time."""
         if self._outputs is None:
-            ch = self._planar.channels(np.array([self.t]), self.y[:, None])
-            self._outputs = {k: float(ch[k][0]) for k in OUTPUTS}
+            ch = self.system.channels(np.array([self.t]), self.y[:, None])
+            self._outputs = {k: float(ch[k][0]) for k in self.output_names}
         return self._outputs
 
     def output(self, name: str) -> float:
         """One output at the current time."""
-        if name not in OUTPUTS:
-            raise ArgumentError(f"unknown output {name!r}; valid: {', '.join(OUTPUTS)}")
+        if name not in self.output_names:
+            raise ArgumentError(f"unknown output {name!r}; valid: "
+                                f"{', '.join(self.output_names)}")
         return self.outputs()[name]

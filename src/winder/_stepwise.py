@@ -13,11 +13,10 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, DenseOutput, OdeSolver, Radau
 from scipy.optimize import brentq
 
-from . import _integrators as integ
-from ._planar import AT_CORE, WINDING, PlanarSystem, core_mode_of, pack
-from ._scene import Scene
 from ._simulate import _STEP_OVER, _WALL_EVERY, _Guards, _Stop
-from ._system import WinderSystem
+from .core.machine import AT_CORE, WINDING
+from .solve import integrators as integ
+from .solve.system import MachineSystem
 
 __all__ = ["run_stepwise"]
 
@@ -150,18 +149,18 @@ def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
         raise
 
 
-def run_stepwise(scene: Scene, counter: PlanarSystem | WinderSystem, meth: str,
-                y0: np.ndarray, t_s: float, t_out: np.ndarray, Ys: np.ndarray,
-                breaks: list[float], rtol: float, atol: float, max_step: float | None,
-                events: bool, jacobian: str, guards: _Guards) -> tuple[int, int]:
-    """scipy's solvers and RK4, one step at a time: contact events (restart at lift-off
-    and touch-down, stepping over grazing contacts) and core events (spec §2: land on the
-    core, ``ṙ = 0`` locked until the roll turns forwards). Returns ``(samples, events)``."""
-    rhs, limit = counter.rhs, guards.limit
-    r_core = scene.roll.core_radius
+def run_stepwise(system: MachineSystem, meth: str, y0: np.ndarray, t_s: float,
+                 t_out: np.ndarray, Ys: np.ndarray, breaks: list[float], rtol: float,
+                 atol: float, max_step: float | None, events: bool, jacobian: str,
+                 guards: _Guards) -> tuple[int, int]:
+    """scipy's solvers and RK4, one step at a time: contact events of every nip (restart
+    at lift-off and touch-down, stepping over grazing contacts) and core events of every
+    wound roll (spec §2: land on the core, ``ṙ = 0`` locked until the roll turns
+    forwards). Returns ``(samples, events)``."""
+    rhs, limit = system.rhs, guards.limit
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
-        n = counter.nfev
+        n = system.nfev
         if n >= limit:
             raise _Stop("max_rhs")
         if n % _WALL_EVERY == 0 and guards.wall_spent():
@@ -176,58 +175,59 @@ def run_stepwise(scene: Scene, counter: PlanarSystem | WinderSystem, meth: str,
         options = {"max_step": max_step or 1e-3}
     else:
         cls = _SCIPY[meth]
-    if jacobian == "pinocchio" and meth in _IMPLICIT:
-        from ._linearise import jacobian as _jac
-
-        jac_system = WinderSystem(scene)
-
-        def jac(t: float, y: np.ndarray) -> np.ndarray:
-            jac_system.set_core_mode(counter.core)
-            return _jac(jac_system, t, y)
-
-        options["jac"] = jac
+    if jacobian != "fd" and meth in _IMPLICIT:
+        options["jac"] = system.jac
 
     def make(t0: float, y: np.ndarray, t1: float) -> OdeSolver:
         return cls(fun, t0, y, t1, **options)
 
-    p = counter.params if isinstance(counter, PlanarSystem) else pack(scene)
+    def switch(gi: int) -> Callable[[float, np.ndarray], float]:
+        return lambda t, y: float(system.switches(t, y)[gi])
 
-    def event(which: int) -> Callable[[float, np.ndarray], float]:
-        return lambda t, y: integ.switching(which, t, y, p)
-
-    gap, unwound, forward = event(integ.G_CONTACT), event(integ.G_UNWOUND), \
-        event(integ.G_FORWARD)
-    contact_events = events and scene.effects.contact and meth != "RK4"
+    table = system.table
+    cores = [s for s in range(len(table)) if table[s, 0] == integ.K_CORE]
+    contacts = [s for s in range(len(table)) if table[s, 0] == integ.K_CONTACT]
+    contact_events = events and system.scene.effects.contact and meth != "RK4"
     filled, n_events, t0, y = 0, 0, t_s, np.array(y0, dtype=float)
-    core = core_mode_of(y, p)
-    counter.set_core_mode(core)
+    g = system.switches(t0, y)
+    for s in cores:
+        system.modes[s] = AT_CORE if g[table[s, 1]] >= 0.0 and g[table[s, 2]] <= 0.0 \
+            else WINDING
     step_over_until = -math.inf
-    touching: bool | None = None  # contact side; None: read it from the state
+    touching: dict[int, bool] = {}  # contact side per nip slot; empty: read from the state
     for tb in breaks:
         while t0 < tb:
             stepping_over = t0 < step_over_until
             t_stop = min(tb, step_over_until) if stepping_over else tb
-            evs: list[_Event] = [(unwound, True) if core == WINDING else (forward, True)]
+            evs: list[_Event] = []
+            slots: list[int] = []
+            for s in cores:
+                gi = table[s, 1] if system.modes[s] == WINDING else table[s, 2]
+                evs.append((switch(gi), True))
+                slots.append(s)
             if contact_events and not stepping_over:
-                if touching is None:
-                    touching = gap(t0, y) > 0.0
-                evs.append((gap, not touching))  # the event leaves the current side
+                if not touching:
+                    g = system.switches(t0, y)
+                    touching = {s: bool(g[table[s, 1]] > 0.0) for s in contacts}
+                for s in contacts:  # the event leaves the current side
+                    evs.append((switch(table[s, 1]), not touching[s]))
+                    slots.append(s)
             t1, y, filled, hit = _segment(make, t0, y, t_stop, evs, t_out, Ys, filled,
                                           guards, meth)
-            if hit == 0:  # core event: land on the core, or leave it turning forwards
+            if hit >= 0:
                 n_events += 1
-                if core == WINDING:
-                    y[4] = r_core
-                    core = AT_CORE
-                else:
-                    core = WINDING
-                counter.set_core_mode(core)
-            elif hit == 1:  # contact event: restart exactly there
-                n_events += 1
-                touching = not touching  # lift-off is followed by touch-down and vice versa
-                if t1 - t0 <= 1e-10 * max(1.0, abs(t0)):
-                    # grazing: the crossing is back at the restart point; step over a
-                    # short stretch without contact events, then re-arm
-                    step_over_until, touching = t0 + _STEP_OVER, None
+                s = slots[hit]
+                if table[s, 0] == integ.K_CORE:  # land on the core, or leave it
+                    if system.modes[s] == WINDING:
+                        y[table[s, 3]] = system.params[table[s, 4]]
+                        system.modes[s] = AT_CORE
+                    else:
+                        system.modes[s] = WINDING
+                else:  # contact event: restart exactly there
+                    touching[s] = not touching[s]  # lift-off is followed by touch-down
+                    if t1 - t0 <= 1e-10 * max(1.0, abs(t0)):
+                        # grazing: the crossing is back at the restart point; step over a
+                        # short stretch without contact events, then re-arm
+                        step_over_until, touching = t0 + _STEP_OVER, {}
             t0 = t1
     return filled, n_events
