@@ -102,9 +102,11 @@ def test_inline_tables_and_sub_tables_are_the_same(tmp_path) -> None:
         winder.load_scene(TWO_DRUM)
 
 
-def test_parts_round_trip_replace_and_sweep_keys() -> None:
+def test_parts_round_trip_replace_and_sweep_keys(tmp_path) -> None:
     s = winder.load_scene(TWO_DRUM)
     assert winder.scene_from_dict(s.to_dict(), source=s.source) == s
+    written = _load(tmp_path, s.to_dict())  # TOML text again
+    assert dataclasses.replace(written, source=s.source) == s
     r = s.replace(nip={"front_nip": {"contact": {"stiffness": 1e8}}},
                   drum={"rear": {"drive": {"web_speed": 30.0}}}, web={"tension": 0.0})
     assert r.nips[0].contact.stiffness == 1e8 and r.nips[1:] == s.nips[1:]
