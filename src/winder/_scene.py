@@ -1,6 +1,14 @@
-"""Scene files (TOML, spec section 7): frozen dataclasses that validate on construction.
+"""Scene files (TOML, spec section 7; machines spec §8): frozen dataclasses that validate
+on construction.
 
-Every error names the file, the table and the key, and the offending value.
+Two formats load: the single-drum format (tables ``[drum]``, ``[roll]``, ``[contact]``,
+``[friction]``; :attr:`Scene.legacy`) and scenes of parts (arrays of tables ``[[drum]]``,
+``[[roll]]``, ``[[rider]]``, ``[[nip]]`` and ``[web]``). A single-drum scene is also
+converted to parts (drum "drum", roll "roll", nip "nip", web entering at "nip"), so code
+written for parts reads both.
+
+Every error names the file, the table (an element of an array by its name, ``[drum
+'front']``) and the key, and the offending value.
 """
 
 from __future__ import annotations
@@ -8,23 +16,37 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import re
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from ._args import RTOL_MAX, check_real, show
 from ._errors import ArgumentError, ArgumentTypeError, SceneError
+from .parts import (
+    AXES,
+    CONTACT_LAWS,
+    ROLL_KINDS,
+    ContactLaw,
+    DrumPart,
+    FrictionLaw,
+    NipPart,
+    RiderPart,
+    RollPart,
+    SpeedProfileDrive,
+    TorqueDrive,
+    WebPart,
+)
 
 __all__ = ["Scene", "SceneInfo", "Effects", "Drum", "Drive", "Roll", "Paper", "Contact",
            "Friction", "Solver", "load_scene", "scene_from_dict", "EFFECT_NAMES",
            "DRIVE_KINDS", "CONTACT_LAWS", "METHODS", "BACKENDS"]
 
-EFFECT_NAMES = ("variable_mass", "web_momentum", "gravity", "imbalance", "contact",
-                "slip_relaxation")
+EFFECT_NAMES = ("variable_mass", "web_momentum", "web_tension", "gravity", "imbalance",
+                "contact", "slip_relaxation", "rider_load")
 DRIVE_KINDS = ("speed_profile", "torque")
-CONTACT_LAWS = ("linear", "hunt_crossley")
 METHODS = ("auto", "DOPRI5", "RK4", "RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
 #: Right-hand side backends: the compiled planar equations, or Pinocchio's ABA.
 BACKENDS = ("compiled", "pinocchio")
@@ -79,10 +101,12 @@ class Effects:
 
     variable_mass: bool = True
     web_momentum: bool = True
+    web_tension: bool = True
     gravity: bool = True
     imbalance: bool = True
     contact: bool = True
     slip_relaxation: bool = True
+    rider_load: bool = True
 
     def enabled(self) -> tuple[str, ...]:
         """Names of the effects that are on, in spec order."""
@@ -144,27 +168,16 @@ class Paper:
 
 
 @dataclass(frozen=True)
-class Contact:
-    """``[contact]``: law (``linear`` | ``hunt_crossley``), stiffness (0, 1e18] [N/m or
-    N/m^p], damping [0, 1e12] [N·s/m] (linear), exponent ``p`` [1, 3] [-] and hc_damping
-    ``α`` [0, 1e4] [s/m] (Hunt–Crossley)."""
-
-    law: str = "linear"
-    stiffness: float = 1e7
-    damping: float = 0.0
-    exponent: float = 1.5
-    hc_damping: float = 0.0
+class Contact(ContactLaw):
+    """``[contact]`` of the single-drum format: the nip's :class:`~winder.parts.ContactLaw`
+    (law, stiffness, damping, exponent, hc_damping; same keys and bounds)."""
 
 
 @dataclass(frozen=True)
-class Friction:
-    """``[friction]``: mu [0, 10] [-], slip_velocity ``v_ref`` (0, 1000] [m/s],
-    relaxation_length ``σ`` (0, 1000] [m], min_speed ``v_min`` (0, 1000] [m/s]."""
-
-    mu: float = 0.3
-    slip_velocity: float = 0.05
-    relaxation_length: float = 0.01
-    min_speed: float = 0.1
+class Friction(FrictionLaw):
+    """``[friction]`` of the single-drum format: the nip's
+    :class:`~winder.parts.FrictionLaw` (mu, slip_velocity, relaxation_length, min_speed;
+    same keys and bounds)."""
 
 
 @dataclass(frozen=True)
@@ -183,17 +196,38 @@ class Solver:
 
 @dataclass(frozen=True)
 class Scene:
-    """A complete winder scene. Build one with :func:`load_scene` or :func:`scene_from_dict`."""
+    """A complete winder scene. Build one with :func:`load_scene` or :func:`scene_from_dict`.
+
+    The parts (``drums``, ``rolls``, ``riders``, ``nips``, ``web``) describe every scene.
+    A scene in the single-drum format (``legacy``) also has ``drum``, ``roll``,
+    ``contact`` and ``friction``, and its parts are derived from them (machines spec §8):
+    drum "drum" at the origin, sense +1; roll "roll" free in ``z`` at ``(0, R + r0)``,
+    sense −1; nip "nip" (a = drum, b = roll); web entering at "nip" with tension 0. In a
+    scene of parts those four are None, and ``paper`` is None unless ``[paper]`` is given.
+    """
 
     scene: SceneInfo
     effects: Effects
-    drum: Drum
-    roll: Roll
-    paper: Paper
-    contact: Contact
-    friction: Friction
+    drum: Drum | None
+    roll: Roll | None
+    paper: Paper | None
+    contact: Contact | None
+    friction: Friction | None
     solver: Solver
     source: str = "<scene>"
+    drums: tuple[DrumPart, ...] = ()
+    rolls: tuple[RollPart, ...] = ()
+    riders: tuple[RiderPart, ...] = ()
+    nips: tuple[NipPart, ...] = ()
+    web: WebPart | None = None
+    legacy: bool = field(init=False)
+
+    def __post_init__(self) -> None:
+        legacy = self.drum is not None
+        object.__setattr__(self, "legacy", legacy)
+        if legacy:  # the parts always follow the single-drum tables
+            for name, value in _legacy_parts(self).items():
+                object.__setattr__(self, name, value)
 
     @property
     def name(self) -> str:
@@ -203,12 +237,15 @@ class Scene:
         """A copy with some tables' keys changed: ``scene.replace(roll={"com_offset": 0})``.
 
         Each keyword is a table (``drum={"drive": {...}}`` reaches ``[drum.drive]``) and
-        its value a mapping of that table's keys to new values. The result is validated
+        its value a mapping of that table's keys to new values; sub-tables merge the same
+        way. For an array of tables (a scene of parts) the mapping selects elements by
+        name: ``nip={"front": {"contact": {"stiffness": 1e8}}}``. The result is validated
         like a file (:class:`SceneError` naming the key).
 
         Raises
         ------
-        ArgumentError: a keyword that is not a table of the scene.
+        ArgumentError: a keyword that is not a table of the scene, or an element name
+            that is not in the array.
         ArgumentTypeError: a table given as something other than a mapping of keys.
         """
         data = self.to_dict()
@@ -216,34 +253,105 @@ class Scene:
             if table not in data:
                 raise ArgumentError(f"Scene.replace: {table} is not a table of the scene; "
                                     f"valid tables: {', '.join(data)}")
-            if not isinstance(values, Mapping):
-                raise ArgumentTypeError(
-                    f"Scene.replace: {table} must be a mapping of [{table}] keys to values, "
-                    f"e.g. {table}={{{next(iter(data[table]))!r}: ...}}; got {show(values)} "
-                    f"({type(values).__name__})")
-            values = dict(values)
-            if table == "drum" and "drive" in values:
-                drive = values.pop("drive")
-                if not isinstance(drive, Mapping):
-                    raise ArgumentTypeError(
-                        f"Scene.replace: drum['drive'] must be a mapping of [drum.drive] keys "
-                        f"to values, e.g. drum={{'drive': {{'web_speed': 5.0}}}}; got "
-                        f"{show(drive)} ({type(drive).__name__})")
-                data["drum"]["drive"].update(drive)
-            data[table].update(values)
+            _merge(data[table], values, table, ())
         return scene_from_dict(data, source=self.source)
 
-    def to_dict(self) -> dict[str, dict[str, Any]]:
-        """The scene as nested dictionaries (TOML tables)."""
-        out: dict[str, dict[str, Any]] = {}
-        for f in fields(self):
-            if f.name == "source":
-                continue
-            table = dataclasses.asdict(getattr(self, f.name))
-            if f.name == "drum":
-                table["drive"] = {k: v for k, v in table["drive"].items() if v is not None}
-            out[f.name] = {k: v for k, v in table.items() if v is not None}
+    def to_dict(self) -> dict[str, Any]:
+        """The scene as nested dictionaries (TOML tables; arrays of tables as lists of
+        dictionaries with their ``name``). A roll's density or caliper equal to
+        ``[paper]``'s is left to ``[paper]``; tuples become lists."""
+        if self.legacy:
+            names = ("scene", "effects", "drum", "roll", "paper", "contact", "friction",
+                     "solver")
+            return {n: _table_dict(getattr(self, n)) for n in names}
+        out: dict[str, Any] = {"scene": _table_dict(self.scene),
+                               "effects": _table_dict(self.effects)}
+        if self.paper is not None:
+            out["paper"] = _table_dict(self.paper)
+        for key, parts in (("drum", self.drums), ("roll", self.rolls), ("rider", self.riders),
+                           ("nip", self.nips)):
+            if parts:
+                out[key] = [_table_dict(p) for p in parts]
+        for roll in out.get("roll", ()):
+            for key in ("density", "caliper"):
+                if self.paper is not None and roll[key] == getattr(self.paper, key):
+                    del roll[key]
+        if self.web is not None:
+            out["web"] = _table_dict(self.web)
+        out["solver"] = _table_dict(self.solver)
         return out
+
+
+def _table_dict(obj: Any) -> dict[str, Any]:
+    """A dataclass as a TOML table: None values left out, tuples as lists."""
+    def plain(v: Any) -> Any:
+        if isinstance(v, tuple | list):
+            return [plain(x) for x in v]
+        if isinstance(v, dict):
+            return {k: plain(x) for k, x in v.items() if x is not None}
+        return v
+    return plain(dataclasses.asdict(obj))
+
+
+def _merge(node: Any, values: Any, table: str, path: tuple[str, ...]) -> None:
+    """Merge ``values`` into ``node`` (a table or an array of named tables) in place, for
+    :meth:`Scene.replace`; ``table`` and ``path`` place it in messages."""
+    where = table + "".join(f"[{p!r}]" for p in path)
+    dotted = ".".join((table, *path))
+    if not isinstance(values, Mapping):
+        inner = (f"{next(iter(node))!r}: ..." if isinstance(node, dict) and node else "...")
+        if isinstance(node, list):
+            names = [str(e.get("name")) for e in node]
+            inner = f"{names[0]!r}: {{...}}" if names else "..."
+        example = "{" + inner + "}"
+        for p in reversed(path):
+            example = f"{{{p!r}: {example}}}"
+        what = (f"[[{dotted}]] names to mappings of keys" if isinstance(node, list)
+                else f"[{dotted}] keys")
+        raise ArgumentTypeError(
+            f"Scene.replace: {where} must be a mapping of {what} to values, e.g. "
+            f"{table}={example}; got {show(values)} ({type(values).__name__})")
+    if isinstance(node, list):
+        names = [str(e.get("name")) for e in node]
+        for name, sub in values.items():
+            if name not in names:
+                raise ArgumentError(f"Scene.replace: {where} has no element named "
+                                    f"{show(name)}; valid names: {', '.join(names)}")
+            _merge(node[names.index(name)], sub, table, (*path, name))
+        return
+    for key, value in values.items():
+        if isinstance(node.get(key), dict | list):
+            _merge(node[key], value, table, (*path, key))
+        else:
+            node[key] = value
+
+
+def _legacy_parts(scene: Scene) -> dict[str, Any]:
+    """The parts of a single-drum scene (machines spec §8, last paragraph)."""
+    drum, roll, paper = scene.drum, scene.roll, scene.paper
+    assert drum is not None and roll is not None and paper is not None
+    assert scene.contact is not None and scene.friction is not None
+    d = drum.drive
+    drive: SpeedProfileDrive | TorqueDrive = (
+        TorqueDrive(torque=d.torque, web_speed=d.web_speed) if d.kind == "torque" else
+        SpeedProfileDrive(web_acceleration=d.web_acceleration, web_speed=d.web_speed))
+    return {
+        "drums": (DrumPart(name="drum", radius=drum.radius, inertia=drum.inertia,
+                           mass=drum.mass, centre=(0.0, 0.0), sense=1, drive=drive),),
+        "rolls": (RollPart(name="roll", kind="wound",
+                           centre=(0.0, drum.radius + roll.initial_radius), free=("z",),
+                           sense=-1, core_radius=roll.core_radius, core_mass=roll.core_mass,
+                           core_inertia=roll.core_inertia, width=roll.width,
+                           initial_radius=roll.initial_radius,
+                           initial_speed=roll.initial_speed, com_offset=roll.com_offset,
+                           density=paper.density, caliper=paper.caliper,
+                           initial_height=roll.initial_height),),
+        "riders": (),
+        "nips": (NipPart(name="nip", a="drum", b="roll",
+                         contact=ContactLaw(**dataclasses.asdict(scene.contact)),
+                         friction=FrictionLaw(**dataclasses.asdict(scene.friction))),),
+        "web": WebPart(entry_nip="nip", tension=0.0),
+    }
 
 
 # ---- parsing --------------------------------------------------------------------------
@@ -297,6 +405,62 @@ _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAW
             ("solver", "method"): METHODS, ("solver", "backend"): BACKENDS}
 _REQUIRED_TABLES = ("scene", "drum", "roll", "paper")
 
+# Scenes of parts (machines spec §8). Extra kinds: "name" (a part's name), "ref" (the name
+# of another part, checked once all are read), "pair" (centre [x, z]), "sense" (±1),
+# "axes" (free), "load" (rider schedule), "table" (a sub-table, parsed on its own).
+#: Largest coordinate of a centre or a rider's x [m].
+MAX_COORD = 1e3
+_PART_SPEC: dict[str, dict[str, tuple]] = {
+    "drum[]": {"name": ("name", True, None), **_SPEC["drum"],
+               "centre": ("pair", True, None), "sense": ("sense", False, None),
+               "drive": ("table", True, None)},
+    "drum[].drive": {"kind": ("str", True, None),
+                     "web_acceleration": ("num", False, _NONNEG),
+                     "web_speed": ("num", False, _NONNEG), "ratio": ("num", False, _POS),
+                     "torque": ("num", False, None)},
+    "roll[]": {"name": ("name", True, None), "kind": ("str", False, None),
+               "centre": ("pair", True, None), "free": ("axes", False, None),
+               "sense": ("sense", False, None),
+               **{k: v for k, v in _SPEC["roll"].items() if k != "initial_height"},
+               **_SPEC["paper"], "drive": ("table", False, None)},
+    "rider[]": {"name": ("name", True, None), "rides": ("ref", True, None),
+                "radius": ("num", True, _POS), "mass": ("num", True, _POS),
+                "inertia": ("num", True, _POS), "x": ("num", True, None),
+                "load": ("load", False, None)},
+    "nip[]": {"name": ("name", True, None), "a": ("ref", True, None),
+              "b": ("ref", True, None), "contact": ("table", False, None),
+              "friction": ("table", False, None)},
+    "nip[].contact": _SPEC["contact"],
+    "nip[].friction": _SPEC["friction"],
+    "web": {"entry_nip": ("ref", True, None), "tension": ("num", False, _NONNEG),
+            "span": ("table", False, None)},
+}
+_PART_SPEC["roll[]"]["density"] = ("num", False, _NONNEG)  # default: [paper]
+_PART_SPEC["roll[]"]["caliper"] = ("num", False, _POS)
+#: Keys of each drive kind of a drum.
+_DRIVE_KEYS = {"speed_profile": ("kind", "web_acceleration", "web_speed", "ratio"),
+               "torque": ("kind", "torque", "web_speed")}
+_MAX.update({("drum[]", k): _MAX[("drum", k)] for k in _SPEC["drum"]})
+_MAX.update({("drum[].drive", k): _MAX[("drum.drive", k)]
+             for k in ("web_acceleration", "web_speed", "torque")})
+_MAX.update({("roll[]", k): v for (t, k), v in _MAX.items() if t in ("roll", "paper")})
+_MAX.update({("nip[]." + t, k): v for (t, k), v in _MAX.items()
+             if t in ("contact", "friction")})
+_MAX.update({("drum[].drive", "ratio"): 100.0, ("rider[]", "radius"): 10.0,
+             ("rider[]", "mass"): 1e6, ("rider[]", "inertia"): 1e7,
+             ("rider[]", "x"): MAX_COORD, ("web", "tension"): 1e7})
+_CHOICES.update({("drum[].drive", "kind"): DRIVE_KINDS, ("roll[]", "kind"): ROLL_KINDS,
+                 ("nip[].contact", "law"): CONTACT_LAWS})
+#: Arrays of tables of a scene of parts, and the tables of each format.
+_ARRAYS = ("drum", "roll", "rider", "nip")
+_PART_TABLES = ("scene", "effects", "paper", *_ARRAYS, "web", "solver")
+_LEGACY_TABLES = tuple(t for t in _SPEC if t != "drum.drive")
+#: A part's name: a letter or underscore, then letters, digits, ``_`` or ``-`` (it names
+#: result channels and sweep key paths, so no dots or spaces).
+_PART_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]{0,39}")
+#: Bounds of a rider's load schedule: radius (0, 10] [m], line load [0, 1e7] [N/m].
+MAX_LOAD_RADIUS, MAX_LINE_LOAD = 10.0, 1e7
+
 
 def _check_name(source: str, value: str) -> str:
     if not value or len(value) > MAX_NAME or not value.isprintable():
@@ -305,40 +469,112 @@ def _check_name(source: str, value: str) -> str:
     return value
 
 
-def _parse_table(source: str, table: str, raw: Any) -> dict[str, Any]:
-    spec = _SPEC[table]
+def _check_part_name(source: str, table: str, value: Any) -> str:
+    if not isinstance(value, str) or not _PART_NAME.fullmatch(value):
+        raise _fail(source, table, "name", f"{show(value)} is not a part name; valid: 1 to 40 "
+                    "letters, digits, '_' or '-', starting with a letter or '_' (names make "
+                    "channel names and sweep key paths)")
+    return value
+
+
+def _parse_table(source: str, table: str, raw: Any, *, spec_name: str | None = None,
+                 specs: Mapping[str, Mapping[str, tuple]] = _SPEC) -> dict[str, Any]:
+    """The keys of one table, each checked for type, finiteness and bounds; ``table``
+    names it in messages (``drum 'front'``), ``spec_name`` selects its schema in
+    ``specs`` (default: ``table``). Sub-tables (kind "table") are left out."""
+    spec_name = spec_name or table
+    spec = specs[spec_name]
     if not isinstance(raw, dict):
         raise SceneError(f"{source}: [{table}] must be a table of keys, got {show(raw)} "
                          f"({type(raw).__name__})")
     out: dict[str, Any] = {}
     for key, value in raw.items():
-        if table == "drum" and key == "drive":
+        if spec_name == "drum" and key == "drive":
             continue
         if key not in spec:
             raise _fail(source, table, key, f"unknown key; valid keys: {', '.join(spec)}")
         kind, _, bound = spec[key]
+        if kind == "table":
+            continue
         if kind == "bool":
             if not isinstance(value, bool):
                 raise _fail(source, table, key, f"expected true or false, got {show(value)}")
             out[key] = value
-        elif kind == "str":
+        elif kind in ("str", "ref", "name"):
             if not isinstance(value, str):
                 raise _fail(source, table, key, f"expected a string, got {show(value)} "
                                                  f"({type(value).__name__})")
-            choices = _CHOICES.get((table, key))
+            choices = _CHOICES.get((spec_name, key))
             if choices and value not in choices:
                 raise _fail(source, table, key, f"{show(value)} is not one of: "
                                                  f"{', '.join(repr(c) for c in choices)}")
+            if kind == "name":
+                _check_part_name(source, table, value)
             out[key] = _check_name(source, value) if (table, key) == ("scene", "name") \
                 else value
+        elif kind == "pair":
+            out[key] = _parse_pair(source, table, key, value, ("x", "z"),
+                                   ((None, False, MAX_COORD),) * 2)
+        elif kind == "sense":
+            if isinstance(value, bool) or value not in (1, -1):
+                raise _fail(source, table, key, f"{show(value)} is not a sense; valid: 1 or "
+                                                 "-1 (the operation direction, spec §1)")
+            out[key] = int(value)
+        elif kind == "axes":
+            out[key] = _parse_axes(source, table, key, value)
+        elif kind == "load":
+            out[key] = _parse_load(source, table, key, value)
         else:
             lo, lo_open = bound if bound else (None, False)
             out[key] = _check_number(source, table, key, value, lo=lo, lo_open=lo_open,
-                                     hi=_MAX.get((table, key)))
+                                     hi=_MAX.get((spec_name, key)))
     for key, (_, required, _) in spec.items():
-        if required and key not in out:
+        if required and key not in raw:
             raise _fail(source, table, key, "missing required key")
     return out
+
+
+def _parse_pair(source: str, table: str, key: str, value: Any, names: tuple[str, str],
+                bounds: tuple[tuple[float | None, bool, float], ...]) -> tuple[float, float]:
+    """Two numbers ``[u, v]`` named ``names``, each within its ``(lo, lo_open, hi)`` of
+    ``bounds`` (as :func:`check_real`)."""
+    form = f"[{', '.join(names)}]"
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        raise _fail(source, table, key, f"expected a list of two numbers {form}, got "
+                                         f"{show(value)} ({type(value).__name__})")
+    out = []
+    for part, item, (lo, lo_open, hi) in zip(names, value, bounds, strict=True):
+        x, problem, _ = check_real(item, lo=lo, lo_open=lo_open, hi=hi)
+        if problem is not None:
+            raise _fail(source, table, key, f"{part} {problem}")
+        out.append(x)
+    return out[0], out[1]
+
+
+def _parse_axes(source: str, table: str, key: str, value: Any) -> tuple[str, ...]:
+    valid = "[], [\"z\"], [\"x\"] or [\"x\", \"z\"]"
+    if not isinstance(value, list | tuple) or any(a not in AXES for a in value) \
+            or len(set(value)) != len(value):
+        raise _fail(source, table, key, f"{show(value)} is not a set of axes; valid: {valid}")
+    return tuple(a for a in AXES if a in value)
+
+
+def _parse_load(source: str, table: str, key: str, value: Any
+                ) -> tuple[tuple[float, float], ...]:
+    """A rider's line-load schedule: ``[[radius, line_load], ...]``, radii strictly
+    increasing."""
+    if not isinstance(value, list | tuple):
+        raise _fail(source, table, key, f"expected a list of [radius, line_load] pairs "
+                                         f"[m, N/m], got {show(value)} ({type(value).__name__})")
+    points = [_parse_pair(source, table, f"{key}[{i}]", p, ("radius", "line_load"),
+                          ((0.0, True, MAX_LOAD_RADIUS), (0.0, False, MAX_LINE_LOAD)))
+              for i, p in enumerate(value)]
+    for i in range(1, len(points)):
+        if not points[i][0] > points[i - 1][0]:
+            raise _fail(source, table, f"{key}[{i}]",
+                        f"radius {points[i][0]!r} m does not follow {points[i - 1][0]!r} m; "
+                        "valid: strictly increasing radii")
+    return tuple(points)
 
 
 def max_com_offset(core_radius: float, core_mass: float, core_inertia: float) -> float:
@@ -351,26 +587,67 @@ def max_com_offset(core_radius: float, core_mass: float, core_inertia: float) ->
     return min(core_radius, math.sqrt(core_inertia / core_mass))
 
 
+def _check_roll_core(source: str, table: str, roll: dict[str, Any]) -> None:
+    """A roll's initial radius (>= core) and centre-of-mass offset (inside the core, core
+    inertia about it positive); ``roll`` holds its parsed keys with initial_radius."""
+    r0, rc = roll["initial_radius"], roll["core_radius"]
+    if r0 < rc:
+        raise _fail(source, table, "initial_radius",
+                    f"{r0!r} m is below core_radius {rc!r} m; valid: >= core_radius")
+    e, mc, jc = roll.get("com_offset", 0.0), roll["core_mass"], roll["core_inertia"]
+    e_max = max_com_offset(rc, mc, jc)
+    if not e < e_max:
+        raise _fail(source, table, "com_offset",
+                    f"{e!r} m puts the centre of mass outside the core or "
+                    f"makes the core's inertia about it, core_inertia − core_mass "
+                    f"com_offset², non-positive (core_radius {rc!r} m, "
+                    f"core_inertia {jc!r} kg·m², core_mass "
+                    f"{mc!r} kg); valid: com_offset < min(core_radius, "
+                    f"√(core_inertia/core_mass)) = {e_max:.6g} m")
+
+
+def _is_parts(source: str, data: Mapping[str, Any]) -> bool:
+    """Whether ``data`` is a scene of parts, else the single-drum format: a single-table
+    ``[drum]`` or ``[roll]`` makes it single-drum, else any ``[[drum]]``, ``[[roll]]``,
+    ``[[rider]]``, ``[[nip]]`` or ``[web]`` makes it of parts. A table of the other format
+    is an error."""
+    legacy = any(isinstance(data.get(t), dict) for t in ("drum", "roll"))
+    parts = not legacy and (any(isinstance(data.get(a), list) for a in ("drum", "roll"))
+                            or any(t in data for t in ("rider", "nip", "web")))
+    for table in data:
+        if legacy and table not in _LEGACY_TABLES:
+            raise SceneError(
+                f"{source}: [{table}]: a table of scenes of parts in a scene of the "
+                f"single-drum format ([drum] or [roll] is a single table); build a machine "
+                f"from parts with [[drum]] and [[roll]] (arrays of tables, each with a "
+                f"name); valid tables here: {', '.join(_LEGACY_TABLES)}")
+        if parts and table not in _PART_TABLES:
+            raise SceneError(
+                f"{source}: [{table}]: a table of the single-drum format in a scene of "
+                f"parts; each [[nip]] has its own contact and friction; valid tables: "
+                f"{', '.join(_PART_TABLES)}")
+    return parts
+
+
 def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
-    """Validate nested dictionaries (as read from TOML) and build a :class:`Scene`."""
+    """Validate nested dictionaries (as read from TOML) and build a :class:`Scene`: the
+    single-drum format or a scene of parts (machines spec §8)."""
     if not isinstance(data, dict):
         raise SceneError(f"{source}: a scene is a set of TOML tables, got {show(data)} "
                          f"({type(data).__name__})")
-    valid = ", ".join(t for t in _SPEC if t != "drum.drive")
+    valid = ", ".join(dict.fromkeys((*_LEGACY_TABLES, *_PART_TABLES)))
     for table in data:
-        if table not in _SPEC or table == "drum.drive":
+        if table not in _LEGACY_TABLES and table not in _PART_TABLES:
             raise SceneError(f"{source}: [{_name(table)}]: unknown table; valid "
                              f"tables: {valid}")
-    for table in _REQUIRED_TABLES:
-        if table not in data:
-            raise SceneError(f"{source}: [{table}]: missing required table")
-    t = {name: _parse_table(source, name, data.get(name, {})) for name in _SPEC
-         if name != "drum.drive"}
-    drum_raw = data["drum"]
-    if "drive" not in drum_raw:
-        raise SceneError(f"{source}: [drum.drive]: missing required table")
-    drive = _parse_table(source, "drum.drive", drum_raw["drive"])
-
+    parts = _is_parts(source, data)
+    if not parts:
+        for table in _REQUIRED_TABLES:
+            if table not in data:
+                raise SceneError(f"{source}: [{table}]: missing required table")
+    common = ("scene", "effects", "solver") + (() if parts else _LEGACY_TABLES)
+    t = {name: _parse_table(source, name, data.get(name, {}))
+         for name in dict.fromkeys(common)}
     effects = Effects(**t["effects"])
     info = SceneInfo(**{"name": Path(source).stem if source != "<scene>" else "scene",
                         **t["scene"]})
@@ -383,31 +660,6 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
                     f"{info.output_step!r} s over duration {info.duration!r} s gives "
                     f"{samples:.3g} samples; valid: at most {MAX_SAMPLES:.0e} samples "
                     f"(output_step >= {info.duration / MAX_SAMPLES:.3g} s)")
-    roll_kw = dict(t["roll"])
-    roll_kw.setdefault("initial_radius", roll_kw["core_radius"])
-    roll = Roll(**roll_kw)
-    if roll.initial_radius < roll.core_radius:
-        raise _fail(source, "roll", "initial_radius",
-                    f"{roll.initial_radius!r} m is below core_radius {roll.core_radius!r} m; "
-                    f"valid: >= core_radius")
-    e_max = max_com_offset(roll.core_radius, roll.core_mass, roll.core_inertia)
-    if not roll.com_offset < e_max:
-        raise _fail(source, "roll", "com_offset",
-                    f"{roll.com_offset!r} m puts the centre of mass outside the core or "
-                    f"makes the core's inertia about it, core_inertia − core_mass "
-                    f"com_offset², non-positive (core_radius {roll.core_radius!r} m, "
-                    f"core_inertia {roll.core_inertia!r} kg·m², core_mass "
-                    f"{roll.core_mass!r} kg); valid: com_offset < min(core_radius, "
-                    f"√(core_inertia/core_mass)) = {e_max:.6g} m")
-    radius = t["drum"]["radius"]
-    if roll.initial_height is not None and not roll.initial_height > radius:
-        raise _fail(source, "roll", "initial_height",
-                    f"{roll.initial_height!r} m puts the roll axis inside the drum or below "
-                    f"it; valid: > {radius!r} m (the drum radius, [drum] radius) and <= "
-                    f"{_MAX[('roll', 'initial_height')]:g} m")
-    if drive["kind"] == "speed_profile" and "web_speed" not in drive:
-        raise _fail(source, "drum.drive", "web_speed", "missing required key "
-                    "(kind = 'speed_profile')")
     solver_kw = dict(t["solver"])
     if "max_rhs" in solver_kw:
         if solver_kw["max_rhs"] != int(solver_kw["max_rhs"]):
@@ -417,6 +669,30 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
     if effects.slip_relaxation and not effects.contact:
         raise SceneError(f"{source}: [effects] slip_relaxation: true requires contact = true "
                          "(the relaxed force is the nip friction)")
+    if parts:
+        paper = Paper(**_parse_table(source, "paper", data["paper"])) \
+            if "paper" in data else None
+        return Scene(scene=info, effects=effects, drum=None, roll=None, paper=paper,
+                     contact=None, friction=None, solver=Solver(**solver_kw), source=source,
+                     **_parse_parts(source, data, effects, paper))
+
+    drum_raw = data["drum"]
+    if "drive" not in drum_raw:
+        raise SceneError(f"{source}: [drum.drive]: missing required table")
+    drive = _parse_table(source, "drum.drive", drum_raw["drive"])
+    roll_kw = dict(t["roll"])
+    roll_kw.setdefault("initial_radius", roll_kw["core_radius"])
+    _check_roll_core(source, "roll", roll_kw)
+    roll = Roll(**roll_kw)
+    radius = t["drum"]["radius"]
+    if roll.initial_height is not None and not roll.initial_height > radius:
+        raise _fail(source, "roll", "initial_height",
+                    f"{roll.initial_height!r} m puts the roll axis inside the drum or below "
+                    f"it; valid: > {radius!r} m (the drum radius, [drum] radius) and <= "
+                    f"{_MAX[('roll', 'initial_height')]:g} m")
+    if drive["kind"] == "speed_profile" and "web_speed" not in drive:
+        raise _fail(source, "drum.drive", "web_speed", "missing required key "
+                    "(kind = 'speed_profile')")
     contact = Contact(**t["contact"])
     if effects.contact and "contact" not in data:
         raise SceneError(f"{source}: [contact]: missing required table (effects.contact is on)")
@@ -427,6 +703,183 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
                   source=source)
     _check_rest_on_nip(scene)
     return scene
+
+
+# ---- scenes of parts -------------------------------------------------------------------
+
+def _elements(source: str, data: Mapping[str, Any], array: str
+              ) -> list[tuple[str, dict[str, Any]]]:
+    """``(label, raw table)`` of each element of ``[[array]]``; the label names it in
+    messages (``drum 'front'``, or ``drum #2`` while its name is not valid)."""
+    raw = data.get(array, [])
+    if not isinstance(raw, list):
+        raise SceneError(f"{source}: [{array}] must be an array of tables ([[{array}]], one "
+                         f"per {array}, each with a name), got {show(raw)} "
+                         f"({type(raw).__name__})")
+    out = []
+    for i, element in enumerate(raw):
+        label = f"{array} #{i + 1}"
+        if not isinstance(element, dict):
+            raise SceneError(f"{source}: [{label}] must be a table of keys, got "
+                             f"{show(element)} ({type(element).__name__})")
+        if "name" not in element:
+            raise _fail(source, label, "name", "missing required key")
+        name = _check_part_name(source, label, element["name"])
+        out.append((f"{array} {name!r}", element))
+    return out
+
+
+def _not_yet(source: str, table: str, key: str, what: str) -> SceneError:
+    return _fail(source, table, key, f"{what} not yet supported (unwinding rolls and web "
+                                     "spans come in a later issue)")
+
+
+def _parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
+                 paper: Paper | None) -> dict[str, Any]:
+    """The parts of a scene (machines spec §8): each element's keys, then names and
+    references."""
+    spec = _PART_SPEC
+    drums = []
+    for label, raw in _elements(source, data, "drum"):
+        kw = _parse_table(source, label, raw, spec_name="drum[]", specs=spec)
+        dlabel = f"{label}.drive"
+        d = _parse_table(source, dlabel, raw["drive"], spec_name="drum[].drive", specs=spec)
+        for key in d:
+            if key not in _DRIVE_KEYS[d["kind"]]:
+                raise _fail(source, dlabel, key, f"not a key of kind {d['kind']!r}; valid "
+                                                 f"keys: {', '.join(_DRIVE_KEYS[d['kind']])}")
+        if d["kind"] == "speed_profile":
+            if "web_speed" not in d:
+                raise _fail(source, dlabel, "web_speed",
+                            "missing required key (kind = 'speed_profile')")
+            drive: SpeedProfileDrive | TorqueDrive = SpeedProfileDrive(**d)
+        else:
+            drive = TorqueDrive(**d)
+        drums.append(DrumPart(**kw, drive=drive))
+    rolls = []
+    for label, raw in _elements(source, data, "roll"):
+        kw = _parse_table(source, label, raw, spec_name="roll[]", specs=spec)
+        if kw.get("kind", "wound") != "wound":
+            raise _not_yet(source, label, "kind", f"{kw['kind']!r}:")
+        if "drive" in raw:
+            raise _not_yet(source, label, "drive", "a roll drive (unwinding rolls only) is")
+        kw.setdefault("initial_radius", kw["core_radius"])
+        for key in ("density", "caliper"):
+            if key not in kw:
+                if paper is None:
+                    raise _fail(source, label, key, "missing required key (the scene has no "
+                                                    f"[paper] {key} to default to)")
+                kw[key] = getattr(paper, key)
+        _check_roll_core(source, label, kw)
+        rolls.append(RollPart(**kw))
+    riders = [RiderPart(**_parse_table(source, label, raw, spec_name="rider[]", specs=spec))
+              for label, raw in _elements(source, data, "rider")]
+    nips = []
+    for label, raw in _elements(source, data, "nip"):
+        kw = _parse_table(source, label, raw, spec_name="nip[]", specs=spec)
+        if effects.contact and "contact" not in raw:
+            raise _fail(source, label, "contact",
+                        "missing required table (effects.contact is on)")
+        for key, law in (("contact", ContactLaw), ("friction", FrictionLaw)):
+            kw[key] = law(**_parse_table(source, f"{label}.{key}", raw.get(key, {}),
+                                         spec_name=f"nip[].{key}", specs=spec))
+        nips.append(NipPart(**kw))
+    web_raw = data.get("web")
+    if isinstance(web_raw, list):
+        raise SceneError(f"{source}: [[web]]: a scene has one web, got {len(web_raw)} "
+                         "([[web]] is an array); write a single [web] table")
+    web = None
+    if web_raw is not None:
+        kw = _parse_table(source, "web", web_raw, specs=spec)
+        if isinstance(web_raw, dict) and "span" in web_raw:
+            raise _not_yet(source, "web", "span", "[web.span] (a web span from an unwinding "
+                                                   "roll) is")
+        web = WebPart(**kw)
+    _check_references(source, drums, rolls, riders, nips, web)
+    return {"drums": tuple(drums), "rolls": tuple(rolls), "riders": tuple(riders),
+            "nips": tuple(nips), "web": web}
+
+
+def _check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
+                      riders: list[RiderPart], nips: list[NipPart], web: WebPart | None
+                      ) -> None:
+    """Unique names, and every ``a``, ``b``, ``rides``, ``entry_nip`` naming a part of the
+    right kind; nips that can be assembled (machines spec §8)."""
+    kinds: dict[str, str] = {}
+    for kind, parts in (("drum", drums), ("roll", rolls), ("rider", riders), ("nip", nips)):
+        for i, p in enumerate(parts):
+            if p.name in kinds:
+                raise _fail(source, f"{kind} #{i + 1}", "name",
+                            f"{p.name!r} is already the name of {kinds[p.name]} {p.name!r}; "
+                            f"every part needs its own name (taken: {', '.join(kinds)})")
+            kinds[p.name] = kind
+    bodies = [n for n, k in kinds.items() if k != "nip"]
+    if not bodies:
+        raise SceneError(f"{source}: a scene of parts needs at least one body: a [[drum]], "
+                         "[[roll]] or [[rider]]")
+    fixed = {d.name for d in drums} | {r.name for r in rolls if not r.free}
+    pairs: dict[frozenset[str], str] = {}
+    for nip in nips:
+        label = f"nip {nip.name!r}"
+        for key in ("a", "b"):
+            ref = getattr(nip, key)
+            if kinds.get(ref) not in ("drum", "roll", "rider"):
+                what = f"is {kinds[ref]} {ref!r}, not a body" if ref in kinds else \
+                    "is not a body of the scene"
+                raise _fail(source, label, key, f"{show(ref)} {what}; a nip joins two "
+                                                f"bodies; valid names: {', '.join(bodies)}")
+        if nip.a == nip.b:
+            raise _fail(source, label, "b",
+                        f"{nip.b!r} is also a: a nip joins two different bodies; valid "
+                        f"names: {', '.join(n for n in bodies if n != nip.a) or '(none)'}")
+        if nip.a in fixed and nip.b in fixed:
+            raise _fail(source, label, "b",
+                        f"{nip.b!r}: a nip between two bodies with fixed centres "
+                        f"({kinds[nip.a]} {nip.a!r} and {kinds[nip.b]} {nip.b!r}) cannot be "
+                        "assembled: neither can move to carry its normal force; valid "
+                        "names: a roll free to move or a rider: "
+                        f"{', '.join(n for n in bodies if n not in fixed) or '(none)'}")
+        pair = frozenset((nip.a, nip.b))
+        if pair in pairs:
+            raise _fail(source, label, "b", f"{nip.b!r}: nip {pairs[pair]!r} already joins "
+                                            f"{nip.a!r} and {nip.b!r}; one nip per pair of "
+                                            "bodies")
+        pairs[pair] = nip.name
+    roll_names = [r.name for r in rolls]
+    for rider in riders:
+        label = f"rider {rider.name!r}"
+        if rider.rides not in roll_names:
+            what = f"is {kinds[rider.rides]} {rider.rides!r}, not a roll; a rider rides a " \
+                "paper roll" if rider.rides in kinds else "is not a roll of the scene"
+            raise _fail(source, label, "rides", f"{show(rider.rides)} {what}; valid names: "
+                                                f"{', '.join(roll_names) or '(none)'}")
+        if not any(n.a == rider.rides and n.b == rider.name for n in nips):
+            raise _fail(source, label, "rides",
+                        f"{rider.rides!r}: no [[nip]] with a = {rider.rides!r} and b = "
+                        f"{rider.name!r} (the rider rests on its roll through a nip); "
+                        "declare one; nips: "
+                        f"{', '.join(f'{n.name} ({n.a}, {n.b})' for n in nips) or '(none)'}")
+    wound = [r.name for r in rolls if r.kind == "wound"]
+    entries = [n.name for n in nips if kinds[n.a] == "drum" and n.b in wound]
+    if web is None:
+        if wound:
+            valid = ", ".join(entries) or "(none: no nip joins a drum, a, to the roll, b)"
+            raise SceneError(f"{source}: [web]: missing required table: the scene has the "
+                             f"wound roll {wound[0]!r}; add [web] with entry_nip = the nip "
+                             f"where the web enters it; valid names: {valid}")
+        return
+    if web.entry_nip not in entries:
+        ref = web.entry_nip
+        if kinds.get(ref) == "nip":
+            nip = next(n for n in nips if n.name == ref)
+            what = (f"is nip {ref!r} joining {kinds[nip.a]} {nip.a!r} (a) and "
+                    f"{kinds[nip.b]} {nip.b!r} (b); the web enters a wound roll (b) from "
+                    "the drum it wraps (a)")
+        else:
+            what = f"is {kinds[ref]} {ref!r}, not a nip" if ref in kinds else \
+                "is not a nip of the scene"
+        raise _fail(source, "web", "entry_nip", f"{show(ref)} {what}; valid names: "
+                                                f"{', '.join(entries) or '(none)'}")
 
 
 def _check_rest_on_nip(scene: Scene) -> None:

@@ -54,7 +54,8 @@ class WinderSystem:
         self.g = 0.0
         self.h_over_2pi = scene.paper.caliper / (2.0 * math.pi)
         self.effects: list[Effect] = sorted(
-            (EFFECTS[name](scene) for name in scene.effects.enabled()),
+            (EFFECTS[name](scene) for name in scene.effects.enabled()
+             if name in EFFECTS),  # web_tension, rider_load: no force here
             key=lambda e: e.order)
         names = list(BASE_STATES) + list(self.drive.states)
         self._drive_index = len(BASE_STATES)

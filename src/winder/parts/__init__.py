@@ -1,0 +1,13 @@
+"""The parts a machine is built from (machines spec §8): drums, paper rolls, rider rolls,
+nips and the web, as frozen dataclasses (one module per part). A scene file is read into
+them by :func:`winder.load_scene` (:class:`~winder.Scene` fields ``drums``, ``rolls``,
+``riders``, ``nips``, ``web``)."""
+
+from .drum import DrumPart, SpeedProfileDrive, TorqueDrive
+from .nip import CONTACT_LAWS, ContactLaw, FrictionLaw, NipPart
+from .rider import RiderPart
+from .roll import AXES, ROLL_KINDS, RollPart
+from .web import WebPart
+
+__all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "RollPart", "ROLL_KINDS", "AXES",
+           "RiderPart", "NipPart", "ContactLaw", "FrictionLaw", "CONTACT_LAWS", "WebPart"]
