@@ -31,8 +31,8 @@ def test_evaluation_budget_gives_the_partial_result(paper_scene, method, backend
     e = info.value
     assert isinstance(e, winder.SimulationError)
     assert 0.0 < e.time < 2.0 and e.step is not None and e.step > 0
-    assert set(e.state) == {"z", "roll_angle", "z_dot", "roll_speed", "radius",
-                            "friction_force"}
+    assert set(e.state) == {"roll.z", "roll.theta", "roll.z_dot", "roll.theta_dot",
+                            "roll.radius", "nip.friction"}
     part = e.partial
     assert part.meta["partial"] is True and set(part) == set(full)
     n = len(part.t)

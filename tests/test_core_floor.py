@@ -142,5 +142,5 @@ def test_at_core_rhs_is_constant_mass(paper_scene, backend) -> None:
 def test_initial_state_below_the_core_is_refused(paper_scene) -> None:
     y0 = WinderSystem(paper_scene).initial_state()
     y0[4] = R_CORE - 1e-9
-    with pytest.raises(winder.ArgumentError, match="initial_state.*core radius 0.075"):
+    with pytest.raises(winder.ArgumentError, match=r"initial_state.*roll.radius >= 0.075 m"):
         winder.simulate(paper_scene, initial_state=y0, t_end=1.0)

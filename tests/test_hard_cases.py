@@ -125,9 +125,9 @@ def test_budget_is_reported_with_time_step_and_state(paper_scene) -> None:
     raise it, the time, the last step and the state."""
     with pytest.raises(winder.BudgetExceeded,
                        match=r"max_rhs = 500 evaluations reached at t = .* s of t_end = 5 s "
-                             r".*last step .* s; state: z=.*raise max_rhs") as e:
+                             r".*last step .* s; state: roll.z=.*raise max_rhs") as e:
         winder.simulate(paper_scene, t_end=5.0, max_rhs=500)
-    assert e.value.time is not None and "radius" in e.value.state and e.value.step > 0
+    assert e.value.time is not None and "roll.radius" in e.value.state and e.value.step > 0
 
 
 def test_scipy_integrator_failure_is_a_clear_error(paper_scene) -> None:
@@ -136,14 +136,15 @@ def test_scipy_integrator_failure_is_a_clear_error(paper_scene) -> None:
     used to crash with an AttributeError when no sample had been written)."""
     start = winder.simulate(paper_scene, t_end=25.0, method="DOPRI5", rtol=1e-10,
                             atol=1e-12, output_step=25.0)
-    y25 = [start[k][-1] for k in ("z", "roll_angle", "z_dot", "roll_speed", "radius",
-                                  "friction_force")]
+    # the state vector by name (roll.theta = -roll_angle: the roll's sense is -1)
+    y25 = [start["z"][-1], -start["roll_angle"][-1], start["z_dot"][-1],
+           -start["roll_speed"][-1], start["radius"][-1], start["friction_force"][-1]]
     with pytest.raises(winder.SimulationError, match="integrator DOP853 failed") as info:
         winder.simulate(paper_scene, t_start=25.0, initial_state=y25, t_end=25.5,
                         method="DOP853", rtol=1e-12, atol=1e-14, output_step=0.5)
     assert 25.0 <= info.value.time < 25.5
-    assert set(info.value.state) == {"z", "roll_angle", "z_dot", "roll_speed", "radius",
-                                     "friction_force"}
+    assert set(info.value.state) == {"roll.z", "roll.theta", "roll.z_dot", "roll.theta_dot",
+                                     "roll.radius", "nip.friction"}
 
 
 def test_initial_radius_equal_to_core(paper_scene) -> None:
@@ -172,4 +173,4 @@ def test_evaluation_guard_stops_with_time_and_state(paper_scene, method) -> None
     naming the budget, time and state instead of running on."""
     with pytest.raises(winder.BudgetExceeded, match="max_rhs") as info:
         winder.simulate(paper_scene, t_end=30.0, method=method, max_rhs=5_000)
-    assert 0.0 <= info.value.time < 30.0 and "radius" in info.value.state
+    assert 0.0 <= info.value.time < 30.0 and "roll.radius" in info.value.state

@@ -235,14 +235,14 @@ def test_frictionless_nip_has_no_mode_map(models_dir, tmp_path) -> None:
     assert not (tmp_path / "m.csv").exists()
 
 
-def test_pinocchio_jacobian_in_implicit_methods(models_dir) -> None:
-    """BDF with the Pinocchio-derivative Jacobian solves the same problem as with finite
+def test_exact_jacobian_in_implicit_methods(models_dir) -> None:
+    """BDF with the generated exact Jacobian solves the same problem as with finite
     differences (to the tolerance)."""
     scene = winder.load_scene(models_dir / "paper_winding_smooth.toml")
     kw = {"t_end": 5.0, "output_step": 0.5, "method": "BDF", "rtol": 1e-8, "atol": 1e-10}
-    a = winder.simulate(scene, jacobian="pinocchio", **kw)
+    a = winder.simulate(scene, jacobian="exact", **kw)
     b = winder.simulate(scene, jacobian="fd", **kw)
     for k in ("radius", "roll_speed", "z", "normal_force"):
         np.testing.assert_allclose(a[k], b[k], rtol=1e-5, atol=1e-6 * np.max(np.abs(b[k])))
-    with pytest.raises(winder.ArgumentError, match="valid: fd, pinocchio"):
-        winder.simulate(scene, t_end=0.1, jacobian="exact")
+    with pytest.raises(winder.ArgumentError, match="valid: exact, fd, pinocchio"):
+        winder.simulate(scene, t_end=0.1, jacobian="analytic")

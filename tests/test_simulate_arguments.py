@@ -36,7 +36,7 @@ BAD = [  # (keyword arguments, what the message must contain)
     ({"t_start": 800.0}, r"t_start = 800.0 .* < \[scene\] duration = 700"),
     ({"method": "Euler"}, r"method = 'Euler' is unknown; valid: auto, DOPRI5, RK4"),
     ({"backend": "gpu"}, r"backend = 'gpu' is unknown; valid: compiled, pinocchio"),
-    ({"jacobian": "exact"}, r"jacobian = 'exact' is unknown; valid: fd, pinocchio"),
+    ({"jacobian": "analytic"}, r"jacobian = 'analytic' is unknown; valid: exact, fd, pinocchio"),
     ({"method": "DOPRI5", "backend": "pinocchio"}, r"method = 'DOPRI5' needs backend "
                                                     r"'compiled'.*valid methods"),
     ({"max_rhs": 0}, r"max_rhs = 0 .* whole number >= 1"),

@@ -26,10 +26,9 @@ OUTPUTS = tuple(LEGACY_CHANNELS)
 
 def inputs_of(system: MachineSystem) -> dict[str, str]:
     """The inputs of a scene: input name → run-time parameter (``DRUM.torque``)."""
-    names = system.torque_inputs()
     if getattr(system.scene, "legacy", False):
-        return {"drum_torque": n for n in names}
-    return {n.replace(".", "_"): n for n in names}
+        return {"drum_torque": "drum.torque"}
+    return {n.replace(".", "_"): n for n in system.torque_inputs()}
 
 
 def outputs_of(system: MachineSystem) -> tuple[str, ...]:
@@ -81,7 +80,7 @@ class Stepper:
             raise SimulationError("the Stepper needs the generated code: no C compiler")
         self.inputs = inputs_of(self.system)
         self.output_names = outputs_of(self.system)
-        self.free_drum = bool(self.inputs)
+        self.free_drum = bool(self.system.torque_inputs())
         self._breaks = tuple(self.system.breakpoints)
         self.reset()
 
@@ -108,6 +107,9 @@ class Stepper:
         if name not in self.inputs:
             valid = ", ".join(self.inputs) or "none (no drum of drive kind 'torque')"
             raise ArgumentError(f"unknown input {name!r}; valid: {valid}")
+        if self.inputs[name] not in self.system.machine.param_names:
+            raise ArgumentError(f"{name} is an input only with [drum.drive] kind = 'torque'; "
+                                "this scene prescribes the drum speed")
         v = check_real(name, value, math.isfinite, "a finite number [N·m]")
         self.system.set_input(self.inputs[name], v)
         self._outputs = None
