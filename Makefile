@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.winder-installed
 OUT    ?= out
 
-.PHONY: demo test test-slow bench peers fmu docs-figures lint chromium clean
+.PHONY: demo test test-slow bench peers fmu docs-figures lint chromium clean venv pin-casadi
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -13,7 +13,13 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test,fmu,peers]'
 	touch $(STAMP)
 
-venv: $(STAMP)
+# The pin_casadi generator (Pinocchio's C++ headers on casadi::SX, winder/core/_pin_casadi.cpp):
+# built under $(VENV)/winder-pin-casadi/<pin, casadi, eigen versions>/ when missing (about 160 s
+# of g++ and 4 GB, once per version); a no-op otherwise; a warning only where g++ is missing.
+pin-casadi: $(STAMP)
+	$(PY) -m winder.core.pin_casadi
+
+venv: $(STAMP) pin-casadi
 
 # Headless Chromium for the browser test and the snapshots (Debian package; root only).
 chromium:
@@ -24,7 +30,7 @@ chromium:
 	    || echo "warning: could not install chromium; browser tests will be skipped"; \
 	else echo "warning: chromium not found and not root; browser tests will be skipped"; fi
 
-demo: $(STAMP) chromium
+demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
@@ -33,7 +39,7 @@ demo: $(STAMP) chromium
 	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
 	@echo "demo outputs in $(OUT)/"
 
-test: $(STAMP) chromium
+test: $(STAMP) pin-casadi chromium
 	$(PY) -m ruff check src viewer tests examples benchmarks
 	$(PY) -m pytest -q
 

@@ -1,0 +1,1 @@
+"""The core of the generated Pinocchio/CasADi model (issue 14)."""
