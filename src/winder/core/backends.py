@@ -10,7 +10,7 @@ import pinocchio as pin
 
 from .mathns import NUMERIC, SYMBOLIC, MathNamespace
 
-__all__ = ["NumericBackend", "SymbolicBackend"]
+__all__ = ["NumericBackend", "SymbolicBackend", "ROUTES", "default_route"]
 
 
 class NumericBackend:
@@ -61,14 +61,54 @@ class NumericBackend:
                              np.array(a, float), self._fext))
 
 
-class SymbolicBackend:
-    """Pinocchio's ABA/RNEA/kinematics on CasADi ``SX`` (:mod:`winder.core.spatial`)."""
+#: Routes to Pinocchio's algorithms on CasADi symbols: ``cpp`` (Pinocchio's own templated
+#: ABA/RNEA instantiated on ``casadi::SX``, :mod:`winder.core.pin_casadi`) and ``py`` (the
+#: same algorithms over the ``pin.Model``'s structure, :mod:`winder.core.spatial`).
+ROUTES = ("cpp", "py")
+
+
+def default_route() -> str:
+    """``cpp`` where its generator is built (``make venv`` builds it), else ``py``."""
+    from .pin_casadi import generator_path
+
+    try:
+        return "cpp" if generator_path(build=False) is not None else "py"
+    except Exception:  # noqa: BLE001 - no wheels or no compiler: the py route works anywhere
+        return "py"
+
+
+class _CppRoute:
+    """Pinocchio's templated algorithms on ``casadi::SX``, with :class:`SpatialFunctions`'s
+    call signature (velocities as a list of 6-vectors)."""
 
     def __init__(self, model: pin.Model) -> None:
+        from .pin_casadi import functions
+
+        self.fns = functions(model)
+        self.nj = model.njoints - 1
+
+    def vel(self, q: Any, v: Any) -> list[Any]:
+        V = self.fns.vel(q, v)
+        return [V[6 * i:6 * i + 6] for i in range(self.nj)]
+
+    def aba(self, q: Any, v: Any, tau: Any, dyn: Any, fext: Any, g: Any) -> Any:
+        return self.fns.aba(q, v, tau, dyn, fext, g)
+
+    def rnea(self, q: Any, v: Any, a: Any, dyn: Any, fext: Any, g: Any) -> Any:
+        return self.fns.rnea(q, v, a, dyn, fext, g)
+
+
+class SymbolicBackend:
+    """Pinocchio's ABA/RNEA/kinematics on CasADi ``SX`` by one of :data:`ROUTES`."""
+
+    def __init__(self, model: pin.Model, route: str = "py") -> None:
         from .spatial import SpatialFunctions
 
+        if route not in ROUTES:
+            raise ValueError(f"route = {route!r} is unknown; valid: {', '.join(ROUTES)}")
         self.M = SYMBOLIC
-        self.f = SpatialFunctions(model)
+        self.route = route
+        self.f: Any = _CppRoute(model) if route == "cpp" else SpatialFunctions(model)
         self._vel: Any = None
 
     @staticmethod

@@ -56,7 +56,7 @@ def _source_hash() -> str:
     h = hashlib.sha256()
     root = Path(__file__).resolve().parent.parent
     for sub in ("core", "forces"):
-        for f in sorted((root / sub).glob("*.py")):
+        for f in sorted([*(root / sub).glob("*.py"), *(root / sub).glob("*.cpp")]):
             h.update(f.name.encode())
             h.update(f.read_bytes())
     return h.hexdigest()
@@ -86,6 +86,7 @@ class Generated:
     addresses: np.ndarray  # int64 addresses of FUNCTIONS
     build_seconds: float = 0.0
     from_cache: bool = False
+    route: str = "py"
     _lib: Any = field(default=None, repr=False)
 
     def call(self, which: str, t: float, x: np.ndarray, p: np.ndarray,
@@ -108,7 +109,7 @@ class Generated:
         return f"w{self.key}"
 
 
-def _c_source(machine: Machine, symbol: str, directory: Path) -> Path:
+def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Path:
     import casadi as ca
 
     from .backends import SymbolicBackend
@@ -117,7 +118,7 @@ def _c_source(machine: Machine, symbol: str, directory: Path) -> Path:
     x = ca.SX.sym("x", machine.n_states)
     p = ca.SX.sym("p", len(machine.param_names))
     m = ca.SX.sym("m", len(machine.mode_names))
-    ev = machine.evaluate(SymbolicBackend(machine.model), t, x, p, m)
+    ev = machine.evaluate(SymbolicBackend(machine.model, route), t, x, p, m)
     xdot = ca.vertcat(*[ev.rates[n] for n in machine.state_names])
     outs = {
         "rhs": xdot,
@@ -147,15 +148,21 @@ def _c_source(machine: Machine, symbol: str, directory: Path) -> Path:
     return path
 
 
-def generate(machine: Machine, *, directory: Path | None = None) -> Generated:
+def generate(machine: Machine, *, directory: Path | None = None,
+             route: str | None = None) -> Generated:
     """The compiled functions of ``machine``: from the cache, or generated and compiled
-    (and cached). Raises :class:`CompilerMissing` without a C compiler."""
+    (and cached). ``route``: how Pinocchio's algorithms reach the symbols (one of
+    :data:`~winder.core.backends.ROUTES`; default ``cpp`` where its generator is built).
+    Raises :class:`CompilerMissing` without a C compiler."""
     import casadi as ca
+
+    from .backends import default_route
 
     global _SOURCE
     if _SOURCE is None:
         _SOURCE = _source_hash()
-    key = hashlib.sha256("|".join((machine.structure_key(), _SOURCE, ca.__version__,
+    route = default_route() if route is None else route
+    key = hashlib.sha256("|".join((machine.structure_key(), _SOURCE, ca.__version__, route,
                                    " ".join(CFLAGS))).encode()).hexdigest()[:20]
     symbol = f"w{key}"
     root = Path(directory) if directory is not None else cache_dir() / "generated"
@@ -166,7 +173,7 @@ def generate(machine: Machine, *, directory: Path | None = None) -> Generated:
         cc = _compiler()
         root.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
-            src = _c_source(machine, symbol, Path(tmp))
+            src = _c_source(machine, symbol, Path(tmp), route)
             tmp_lib = Path(tmp) / f"{symbol}.so"
             proc = subprocess.run([cc, *CFLAGS, str(src), "-o", str(tmp_lib), "-lm"],
                                   capture_output=True, text=True)
@@ -183,4 +190,4 @@ def generate(machine: Machine, *, directory: Path | None = None) -> Generated:
     return Generated(key, lib, machine.n_states, len(machine.param_names),
                      len(machine.mode_names), len(machine.switch_names),
                      len(machine.channel_names), addrs, time.perf_counter() - t0, from_cache,
-                     handle)
+                     route, handle)
