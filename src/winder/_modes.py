@@ -260,7 +260,8 @@ class _Linearisation:
                 D = 1.0 / np.maximum(np.max(np.abs(J), axis=1), 1e-300)
                 merit = np.linalg.norm(D * res)
                 for _ in range(_NEWTON_STEPS):
-                    step = np.linalg.solve(J, -res)
+                    # least squares: singular where a nip carries no load yet (δ = 0)
+                    step = np.linalg.lstsq(J, -res, rcond=None)[0]
                     x0 = y[u].copy()
                     if np.all(np.abs(step) <= 1e-10 * np.maximum(np.abs(x0), floor)):
                         y[u] = x0 + step
