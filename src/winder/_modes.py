@@ -407,8 +407,9 @@ class ModeMap:
     damped frequency and damping ratio; ``bounce_frequency``/``bounce_damping``: the mode
     of the wound roll's own ``z`` (the single-drum bounce mode); ``slip_*``: the fastest
     slip/torsion mode (``|λ|/2π``); ``rotation_1x`` the roll's rotation frequency
-    ``v/(2π r)``; ``drum_rotation`` each drum's rotation frequency; ``critical_web_speed``
-    the web speed at which 1× meets ``bounce_frequency``."""
+    ``ratio · v/(2π r)`` at no slip (``ratio`` of the drum the web wraps);
+    ``drum_rotation`` each drum's rotation frequency; ``critical_web_speed`` the web speed
+    at which 1× meets ``bounce_frequency``."""
 
     radius: np.ndarray
     frequencies: dict[str, np.ndarray]
@@ -445,7 +446,7 @@ class ModeMap:
 
     @property
     def critical_web_speed(self) -> np.ndarray:
-        return 2 * np.pi * self.radius * self.bounce_frequency
+        return self.web_speed * self.bounce_frequency / self.rotation_1x
 
     def harmonics(self) -> dict[str, np.ndarray]:
         """The excitation lines [Hz] over ``radius``: ``1x``, ``2x``, ``3x`` of the roll's
@@ -567,6 +568,8 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
             slip[:, i] = ms[nt].natural_frequency, ms[nt].damping_ratio
     drums = {b.name: b.part.drive.ratio * v / (2 * math.pi * b.part.radius)
              for b in lin.machine.bodies if b.prescribed}
+    ratio = _entry_drum(scene).drive.ratio  # the roll's surface runs at ratio · v
     return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),
                    dict(zip(lin.coords, damp, strict=True)), slip[0], slip[1],
-                   v / (2 * math.pi * radii), v, lin.roll.name, drums, bool(scene.legacy))
+                   ratio * v / (2 * math.pi * radii), v, lin.roll.name, drums,
+                   bool(scene.legacy))
