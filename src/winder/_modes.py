@@ -17,18 +17,20 @@ is linearised with its exact Jacobian (:func:`winder.jacobian`) about its quasi-
 - angles 0, the imbalance off (``com_offset = 0``: it is the excitation), the other
   paper rolls at their initial radius.
 
-These unknowns (positions, rotation speeds, friction states) solve ``rhs = target`` with
-Newton/Powell steps on the exact Jacobian (the nips held in contact while solving, checked
-in contact after). The Jacobian restricted to the fast states (positions and velocities
-of the free coordinates, rotation speeds, friction states; angles and radii are slow or
-absent) gives the modes: the ``n`` eigenvalue pairs that move the free translational
-coordinates most are the **bounce modes**, one per free coordinate and named after the
-coordinate that dominates it (``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a
-single-drum scene); the rest are the slip/torsion modes. The roll turns at
-``f₁ = v/(2π r)``; where ``k f₁`` (``k = 1, 2, 3``) or a drum's rotation frequency crosses a
-bounce mode, the imbalance (or a drum's runout) drives that mode at resonance (critical
-radii). For each radius the web speed at which the 1× line meets the roll's own vertical
-bounce mode is ``v_crit = 2π r f_bounce``.
+These unknowns (positions, rotation speeds, friction states) solve ``rhs = target`` by
+damped Newton steps on the exact Jacobian from touching positions and no-slip speeds (the
+nips held in contact while solving, checked in contact after). The Jacobian restricted to
+the fast states (positions and velocities of the free coordinates, rotation speeds,
+friction states; angles and radii are slow or absent) gives the modes. Each free
+coordinate names one **bounce mode**: the eigenpair in which that coordinate carries the
+largest share of the mode's kinetic energy (``½ m |ẋ|²`` per free coordinate, ``½ J |θ̇|²``
+per turning body), an oscillating pair first (share ≥ 1/4), each pair used once
+(``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a single-drum scene); the rest are the
+slip/torsion modes. The roll turns at ``f₁ = v/(2π r)``; where ``k f₁`` (``k = 1, 2, 3``)
+or a drum's rotation frequency crosses an oscillating bounce mode, the imbalance (or a
+drum's runout) drives that mode at resonance (critical radii). For each radius the web
+speed at which the 1× line meets the roll's own vertical bounce mode is
+``v_crit = 2π r f_bounce``.
 """
 
 from __future__ import annotations
