@@ -1,20 +1,42 @@
-"""Resonance map: nip modes of the winder against roll radius (a Campbell chart).
+"""Resonance map: the bounce modes of a machine against the rotation harmonics as the wound
+roll grows (a Campbell chart), for any machine from parts.
 
-At each radius the winder is linearised (:func:`winder._linearise.jacobian`) about its
-quasi-steady operating point: web speed at its final value, roll on the nip at static
-equilibrium under its current weight, slip and friction at the values that carry the
-roll's slow deceleration ``ω̇ = −v ṙ/r²``, imbalance off (it is the excitation). The
-eigenvalues of the Jacobian restricted to the fast states ``(z, ż, ω, F_t)`` give the
-bounce mode (the pair dominated by ``z``) and the slip/torsion mode(s). The roll turns at
-``f₁ = v/(2π r)``; where ``n f₁`` crosses the bounce frequency the imbalance drives the
-nip at resonance (critical radii). For each radius the web speed at which the 1× line
-meets the bounce mode is ``v_crit = 2π r f_bounce``.
+At each radius of the wound roll (the roll the web enters, ``[web] entry_nip``) the machine
+is linearised with its exact Jacobian (:func:`winder.jacobian`) about its quasi-steady
+**operating point**:
+
+- every speed-profile drum at its full speed ``ratio · v / R`` (``v`` the web speed);
+- every roll and rider turning so that its surface speed stays constant: the rotation
+  accelerations are ``ω̇ = −ω ṙ/r`` for a paper roll (its slow deceleration as it grows)
+  and ``0`` for a rider; the nip slip and the friction states take the values that carry
+  these accelerations against the web forces (slip-relaxation friction at its steady value
+  ``F_t = F_ss(v_s)``, ``dF_t/dt = 0``);
+- every free translational coordinate (``x``, ``z``) in balance: its acceleration is 0
+  with the translational velocities 0 (the nips' damping sees only the radius growth
+  ``δ̇ = ṙ``);
+- angles 0, the imbalance off (``com_offset = 0``: it is the excitation), the other
+  paper rolls at their initial radius.
+
+These unknowns (positions, rotation speeds, friction states) solve ``rhs = target`` by
+damped Newton steps on the exact Jacobian from touching positions and no-slip speeds (the
+nips held in contact while solving, checked in contact after). The Jacobian restricted to
+the fast states (positions and velocities of the free coordinates, rotation speeds,
+friction states; angles and radii are slow or absent) gives the modes. Each free
+coordinate names one **bounce mode**: the eigenpair in which that coordinate carries the
+largest share of the mode's kinetic energy (``½ m |ẋ|²`` per free coordinate, ``½ J |θ̇|²``
+per turning body), an oscillating pair first (share ≥ 1/4), each pair used once
+(``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a single-drum scene); the rest are the
+slip/torsion modes. The roll turns at ``f₁ = v/(2π r)``; where ``k f₁`` (``k = 1, 2, 3``)
+or a drum's rotation frequency crosses an oscillating bounce mode, the imbalance (or a
+drum's runout) drives that mode at resonance (critical radii). For each radius the web
+speed at which the 1× line meets the roll's own vertical bounce mode is
+``v_crit = 2π r f_bounce``.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -22,23 +44,32 @@ from ._args import integer, number, show
 from ._errors import ArgumentError, ArgumentTypeError
 from ._linearise import jacobian
 from ._scene import _MAX, Scene
-from ._system import WinderSystem
+from .core.machine import AUTO, IN_CONTACT
+from .solve.system import MachineSystem
 
 __all__ = ["Mode", "ModeMap", "operating_point", "modes_at", "mode_map", "MAX_POINTS"]
 
 #: Most radii of one resonance map.
 MAX_POINTS = 10_000
 WEB_SPEED_MAX = _MAX[("drum.drive", "web_speed")]  # [m/s], as in a scene
+#: Most Newton steps of one operating point.
+_NEWTON_STEPS = 200
+#: Largest relative change of a mode's frequency between neighbouring radii at a crossing.
+_JUMP = 0.25
+#: Harmonics of the roll's rotation drawn and searched for crossings.
+ORDERS = (1, 2, 3)
 
 
 @dataclass(frozen=True)
 class Mode:
-    """One eigenvalue pair: ``frequency`` [Hz] (damped, 0 for a real eigenvalue),
-    ``natural_frequency`` ``|λ|/2π`` [Hz], ``damping_ratio`` [-], ``kind``
-    (``bounce`` or ``slip``)."""
+    """One eigenvalue (of a pair): ``frequency`` [Hz] (damped, 0 for a real eigenvalue),
+    ``natural_frequency`` ``|λ|/2π`` [Hz], ``damping_ratio`` [-], ``kind`` (``bounce`` or
+    ``slip``) and ``coordinate``: the free coordinate that dominates a bounce mode
+    (``BODY.x``/``BODY.z``), or the state that dominates a slip mode."""
 
     eigenvalue: complex
     kind: str
+    coordinate: str = ""
 
     @property
     def frequency(self) -> float:
@@ -54,155 +85,449 @@ class Mode:
         return -lam.real / abs(lam) if abs(lam) > 0 else 0.0
 
 
-def _steady_scene(scene: Scene, where: str) -> Scene:
-    """The scene of the quasi-steady operating point (imbalance off: it is the excitation);
-    an :class:`ArgumentError` if the scene has no such point."""
+def _where_drum(scene: Scene, name: str) -> str:
+    return "[drum.drive]" if scene.legacy else f"[[drum]] {name!r} drive"
+
+
+def _check_scene(scene: Scene, where: str) -> None:
+    """An :class:`ArgumentError` if the scene has no winding operating point."""
     if not isinstance(scene, Scene):
         raise ArgumentTypeError(f"{where}: scene must be a winder.Scene (winder.load_scene), "
                                 f"got {show(scene)} ({type(scene).__name__})")
     if not scene.effects.contact:
         raise ArgumentError(f"{where}: {scene.source}: the resonance map needs the nip: "
                             "[effects] contact = false; valid: contact = true")
-    if scene.drum.drive.kind != "speed_profile":
-        raise ArgumentError(f"{where}: {scene.source}: the resonance map needs [drum.drive] "
-                            f"kind = 'speed_profile' (its web speed is the operating speed), "
-                            f"got {scene.drum.drive.kind!r}")
+    if scene.web is None:
+        raise ArgumentError(f"{where}: {scene.source}: the resonance map needs a wound roll "
+                            "and the web entering it ([web] entry_nip); this scene has no "
+                            "[web]")
+    for d in scene.drums:
+        if d.drive.kind != "speed_profile":
+            raise ArgumentError(f"{where}: {scene.source}: the resonance map needs "
+                                f"{_where_drum(scene, d.name)} kind = 'speed_profile' (its "
+                                f"web speed is the operating speed), got {d.drive.kind!r}")
     if not scene.effects.gravity or scene.scene.gravity == 0.0:
         raise ArgumentError(f"{where}: {scene.source}: the resonance map needs the roll's "
                             "weight on the nip, but [effects] gravity = "
                             f"{str(scene.effects.gravity).lower()} and [scene] gravity = "
                             f"{scene.scene.gravity!r}; valid: gravity on and > 0")
-    if scene.friction.mu == 0.0:
-        raise ArgumentError(f"{where}: {scene.source}: [friction] mu = 0: without friction "
-                            "the drum does not drive the roll, so there is no winding "
-                            "operating point and no slip mode; valid: mu > 0")
-    return scene.replace(effects={"imbalance": False})
+    for n in scene.nips:
+        if n.friction.mu == 0.0:
+            key = "[friction] mu" if scene.legacy else f"[[nip]] {n.name!r} friction mu"
+            raise ArgumentError(f"{where}: {scene.source}: {key} = 0: without friction the "
+                                "drum does not drive the roll, so there is no winding "
+                                "operating point and no slip mode; valid: mu > 0")
+
+
+def _entry_drum(scene: Scene):  # noqa: ANN202 - a DrumPart
+    nip = next(n for n in scene.nips if n.name == scene.web.entry_nip)
+    return next(d for d in scene.drums if d.name == nip.a)
 
 
 def _web_speed(where: str, scene: Scene, web_speed: float | None, lo_open: bool) -> float:
-    """The operating web speed [m/s]: the argument, or the scene's ``[drum.drive]
-    web_speed``; finite, ``> 0`` (``>= 0`` where ``lo_open`` is false)."""
+    """The operating web speed [m/s]: the argument, or the ``web_speed`` of the drum the web
+    wraps; finite, ``> 0`` (``>= 0`` where ``lo_open`` is false)."""
     if web_speed is None:
-        v = scene.drum.drive.web_speed
+        drum = _entry_drum(scene)
+        v = drum.drive.web_speed
         if lo_open and not v > 0.0:
-            raise ArgumentError(f"{where}: web_speed is not given and the scene's "
-                                f"[drum.drive] web_speed is {v!r} ({scene.source}); valid: "
-                                "a web speed > 0 m/s")
+            key = "[drum.drive]" if scene.legacy else f"[[drum]] {drum.name!r} drive"
+            raise ArgumentError(f"{where}: web_speed is not given and the scene's {key} "
+                                f"web_speed is {v!r} ({scene.source}); valid: a web speed "
+                                "> 0 m/s")
         return v
     return number(where, "web_speed", web_speed, lo=0.0, lo_open=lo_open,
                   hi=WEB_SPEED_MAX, unit="m/s")
 
 
+class _Linearisation:
+    """The machine of a scene at its operating points (see the module docstring): one
+    :class:`MachineSystem` with the imbalance off and the drums at full speed ``v``."""
+
+    def __init__(self, scene: Scene, v: float) -> None:
+        self.scene, self.v = scene, v
+        self.system = sys_ = MachineSystem(scene)
+        m = self.machine = sys_.machine
+        p = sys_.params
+        for b in m.rolls:
+            if f"{b.name}.com_offset" in m.param_names:
+                p[m.param_index(f"{b.name}.com_offset")] = 0.0
+        for b in m.bodies:
+            if b.prescribed:  # full speed from t = 0
+                p[m.param_index(f"{b.name}.ramp_time")] = 0.0
+                p[m.param_index(f"{b.name}.web_speed")] = v
+        self.t = 0.0
+        self.roll = m.entry.b
+        self.i_r = m.index(f"{self.roll.name}.radius")
+        self.rc = self.roll.part.core_radius
+        names = m.state_names
+        self.positions = [m.index(f"{b.name}.{c}") for b in m.bodies for c in b.free]
+        self.coords = [f"{b.name}.{c}" for b in m.bodies for c in b.free]
+        self.velocities = [m.index(f"{n}_dot") for n in self.coords]
+        self.speeds = [m.index(f"{b.name}.theta_dot") for b in m.bodies if not b.prescribed]
+        slow = {m.index(f"{b.name}.theta") for b in m.bodies if not b.prescribed}
+        slow |= {m.index(f"{b.name}.radius") for b in m.rolls}
+        taken = set(self.positions) | set(self.velocities) | set(self.speeds) | slow
+        self.others = [i for i in range(len(names)) if i not in taken]  # friction, ...
+        # unknowns of the balance and their equations (rates)
+        self.unknowns = self.positions + self.speeds + self.others
+        self.equations = self.velocities + self.speeds + self.others
+        self.fast = self.positions + self.velocities + self.speeds + self.others
+        self.paper = {m.index(f"{b.name}.theta_dot"): m.index(f"{b.name}.radius")
+                      for b in m.rolls}
+        self._speed_slots = np.arange(len(self.positions),
+                                      len(self.positions) + len(self.speeds))
+        self.v_ref = min(n.part.friction.slip_velocity for n in m.nips)
+        self.contact = np.array([n.endswith(".contact") for n in m.mode_names])
+
+    # ---- the operating point ------------------------------------------------------------
+    def _radius_of(self, y: np.ndarray, name: str) -> float:
+        b = self.machine.body[name]
+        return float(y[self.machine.index(f"{name}.radius")]) if b.kind == "roll" \
+            else float(b.part.radius)
+
+    def _speed_radius(self, y: np.ndarray) -> np.ndarray:
+        """Radius [m] of each body whose speed is an unknown."""
+        return np.array([self._radius_of(y, b.name) for b in self.machine.bodies
+                         if not b.prescribed])
+
+    def guess(self, r: float) -> np.ndarray:
+        """The initial guess at radius ``r`` [m]: every free body touching the bodies it
+        rests on (placed in the machine's order), no-slip speeds, friction 0."""
+        m = self.machine
+        y = np.array(m.state_initial, dtype=float)
+        y[self.i_r] = r
+        centre = {b.name: list(b.centre) for b in m.bodies}
+        placed = {b.name for b in m.bodies if not b.free}
+        for b in m.bodies:
+            if not b.free:
+                continue
+            sup = [(n.a.name, self._radius_of(y, n.a.name) + self._radius_of(y, b.name))
+                   for n in m.nips if n.b is b and n.a.name in placed]
+            cx, cz = centre[b.name]
+            if "x" in b.free and len(sup) >= 2:  # upper intersection of two circles
+                (a1, d1), (a2, d2) = sup[:2]
+                p1, p2 = np.array(centre[a1]), np.array(centre[a2])
+                base = np.linalg.norm(p2 - p1)
+                s = (d1 * d1 - d2 * d2 + base * base) / (2 * base)
+                h = math.sqrt(max(d1 * d1 - s * s, 0.0))
+                e = (p2 - p1) / base
+                cx, cz = p1 + s * e + h * np.array([-e[1], e[0]]) * (1 if e[0] >= 0 else -1)
+            elif sup:
+                cz = max(centre[a][1] + math.sqrt(max(d * d - (cx - centre[a][0]) ** 2, 0.0))
+                         for a, d in sup)
+            centre[b.name] = [float(cx), float(cz)]
+            placed.add(b.name)
+            for c in b.free:
+                y[m.index(f"{b.name}.{c}")] = centre[b.name][0 if c == "x" else 1]
+        # no slip, θ̇_b = −θ̇_a r_a / r_b across each nip, from the drums
+        omega = {b.name: b.sense * b.part.drive.ratio * self.v / b.part.radius
+                 for b in m.bodies if b.prescribed}
+        for _ in m.nips:
+            for n in m.nips:
+                a, b = n.a.name, n.b.name
+                ra, rb = self._radius_of(y, a), self._radius_of(y, b)
+                if a in omega and b not in omega:
+                    omega[b] = -omega[a] * ra / rb
+                elif b in omega and a not in omega:
+                    omega[a] = -omega[b] * rb / ra
+        for b in m.bodies:
+            if not b.prescribed and b.name in omega:
+                y[m.index(f"{b.name}.theta_dot")] = omega[b.name]
+        return y
+
+    def _residual(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``rhs − target`` on the equations and its exact Jacobian in the unknowns."""
+        f = self.system.rhs(self.t, y)
+        J = self.system.jac(self.t, y)
+        for i_w, i_r in self.paper.items():  # constant surface speed: ω̇ = −ω ṙ / r
+            f[i_w] += y[i_w] * f[i_r] / y[i_r]
+            J[i_w, i_w] += (f[i_r] + y[i_w] * J[i_r, i_w]) / y[i_r]
+        return f[self.equations], J[np.ix_(self.equations, self.unknowns)]
+
+    def solve(self, r: float, where: str) -> np.ndarray:
+        """The operating point at radius ``r`` [m] (an :class:`ArgumentError` if none):
+        damped Newton steps on the exact Jacobian (rows scaled by their largest entry),
+        from :meth:`guess`, to a step below 1e-10 of the unknowns' scale (1 m, 1 rad/s,
+        1 N or their value)."""
+        sys_ = self.system
+        y = self.guess(r)
+        u = self.unknowns
+        floor = np.ones(len(u))  # [m], [rad/s], [N]
+        converged, res = False, np.array([np.inf])
+        sys_.modes[self.contact] = IN_CONTACT  # smooth while solving
+        try:
+            with np.errstate(all="ignore"):
+                res, J = self._residual(y)
+                D = 1.0 / np.maximum(np.max(np.abs(J), axis=1), 1e-300)
+                merit = np.linalg.norm(D * res)
+                for _ in range(_NEWTON_STEPS):
+                    # least squares: singular where a nip carries no load yet (δ = 0)
+                    step = np.linalg.lstsq(J, -res, rcond=None)[0]
+                    x0 = y[u].copy()
+                    if np.all(np.abs(step) <= 1e-10 * np.maximum(np.abs(x0), floor)):
+                        y[u] = x0 + step
+                        converged = True
+                        break
+                    # the slip law saturates beyond a few v_ref: a speed moves at most
+                    # v_ref/2 of surface speed per step
+                    big = np.abs(step[self._speed_slots]) * self._speed_radius(y)
+                    step *= min(1.0, float(np.min(self.v_ref / 2 / np.maximum(big, 1e-300),
+                                                  initial=np.inf)))
+                    lam = 1.0
+                    while lam > 1e-6:
+                        y[u] = x0 + lam * step
+                        res_n, J_n = self._residual(y)
+                        m_n = np.linalg.norm(D * res_n)
+                        if np.isfinite(m_n) and m_n <= (1 - 1e-4 * lam) * merit or m_n == 0:
+                            break
+                        lam /= 2
+                    else:
+                        break
+                    res, J, merit = res_n, J_n, m_n
+        except (np.linalg.LinAlgError, FloatingPointError, ArithmeticError):
+            converged = False
+        except Exception as exc:  # a non-finite rhs on the way: no balance
+            if type(exc).__name__ != "SimulationError":
+                raise
+            converged = False
+        finally:
+            sys_.modes[self.contact] = AUTO
+        v = self.v
+        if not converged:
+            nips = "the nip cannot" if len(self.machine.nips) == 1 else "the nips cannot"
+            raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s "
+                                f"{nips} carry the roll's torque and weight: no operating "
+                                "point (the balance of rotation and friction has no "
+                                "solution); valid: a lower web speed or a smaller radius")
+        sw = sys_.switches(self.t, y)
+        for n in self.machine.nips:
+            g = sw[self.machine.switch_names.index(f"{n.name}.contact")]
+            ra, rb = self._radius_of(y, n.a.name), self._radius_of(y, n.b.name)
+            delta = ra + rb - self._distance(y, n)
+            if not g > 0.0:
+                raise ArgumentError(f"{where}: at radius = {r:g} m nip {n.name!r} opens at "
+                                    "the operating point (no normal force): no bounce mode "
+                                    "about a lasting contact there")
+            if delta >= min(ra, rb):
+                raise ArgumentError(f"{where}: at radius = {r:g} m the load compresses nip "
+                                    f"{n.name!r} by {delta:.4g} m, more than a radius (one "
+                                    "axis would lie inside the other body); valid: a smaller "
+                                    "radius or a stiffer nip (contact stiffness)")
+        return y
+
+    def _distance(self, y: np.ndarray, n) -> float:  # noqa: ANN001
+        def c(b):  # noqa: ANN001, ANN202
+            x = y[self.machine.index(f"{b.name}.x")] if "x" in b.free else b.centre[0]
+            z = y[self.machine.index(f"{b.name}.z")] if "z" in b.free else b.centre[1]
+            return np.array([x, z])
+        return float(np.linalg.norm(c(n.b) - c(n.a)))
+
+    # ---- the modes ----------------------------------------------------------------------
+    def modes(self, y: np.ndarray) -> list[Mode]:
+        """Bounce modes (in the order of the free coordinates), then slip modes (slowest
+        first), at the operating point ``y``."""
+        from scipy.optimize import linear_sum_assignment
+
+        A = jacobian(self.system, self.t, y)[np.ix_(self.fast, self.fast)]
+        lam, vec = np.linalg.eig(A)
+        nt, ns = len(self.positions), len(self.speeds)
+        keep = [i for i in range(len(lam)) if lam[i].imag >= 0.0]  # one of each pair
+        # kinetic energy of each eigenvector: ½ m |ẋ|² per free coordinate, ½ J |θ̇|² per
+        # turning body; a coordinate's share of it names the bounce mode
+        ev = self.system.evaluate_numeric(self.t, y, outputs=False)
+        mass = np.array([float(ev.bodies[c.rsplit(".", 1)[0]].mass) for c in self.coords])
+        inertia = np.array([float(ev.bodies[b.name].inertia)
+                            for b in self.machine.bodies if not b.prescribed])
+        V = vec[:, keep]
+        kin = np.vstack([mass[:, None] * np.abs(V[nt:2 * nt]) ** 2,
+                         inertia[:, None] * np.abs(V[2 * nt:2 * nt + ns]) ** 2])
+        share = kin[:nt] / np.maximum(kin.sum(axis=0), 1e-300)
+        # each coordinate takes the eigenpair in which it has the largest share, an
+        # oscillating one first (its share >= 1/4), every pair at most once
+        oscillating = np.array([lam[i].imag > 0.0 for i in keep])
+        score = share + (oscillating[None, :] & (share >= 0.25))
+        rows, cols = linear_sum_assignment(-score)
+        bounce = {int(r): keep[int(c)] for r, c in zip(rows, cols, strict=True)}
+        names = [self.machine.state_names[i] for i in self.fast]
+        out = [Mode(complex(lam[bounce[c]]), "bounce", self.coords[c]) for c in range(nt)]
+        slips = sorted((i for i in keep if i not in bounce.values()), key=lambda i: abs(lam[i]))
+        return out + [Mode(complex(lam[i]), "slip",
+                           names[2 * nt + int(np.argmax(np.abs(vec[2 * nt:, i])))])
+                      for i in slips]
+
+
+def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: bool
+                   ) -> _Linearisation:
+    _check_scene(scene, where)
+    return _Linearisation(scene, _web_speed(where, scene, web_speed, lo_open=lo_open))
+
+
+def _radius(where: str, lin: _Linearisation, radius: float) -> float:
+    key = "[roll] core_radius" if lin.scene.legacy else \
+        f"[[roll]] {lin.roll.name!r} core_radius"
+    return number(where, "radius", radius, lo=lin.rc, unit="m",
+                  valid=f"a finite radius >= {key} = {lin.rc:g} m")
+
+
 def operating_point(scene: Scene, radius: float, *, web_speed: float | None = None
-                    ) -> tuple[WinderSystem, float, np.ndarray]:
-    """``(system, t, y)`` of the quasi-steady operating point at ``radius`` [m]
-    (``>= [roll] core_radius``) and ``web_speed`` [m/s] (``>= 0``; default the scene's).
+                    ) -> tuple[MachineSystem, float, np.ndarray]:
+    """``(system, t, y)`` of the quasi-steady operating point (module docstring) at
+    ``radius`` [m] of the wound roll (``>=`` its core radius) and ``web_speed`` [m/s]
+    (``>= 0``; default the scene's). ``system.params`` hold the drums at full speed and the
+    imbalance off.
 
     Raises
     ------
     ArgumentError: a radius or web speed out of range, a scene without a winding operating
-        point (no nip, no weight, no friction, a torque drive), or a radius and speed at
-        which the nip cannot carry the roll's torque or weight.
+        point (no nip, no web, no weight, no friction, a torque drive), or a radius and
+        speed at which the nips cannot carry the rolls' torques or weights.
     """
     where = "operating_point"
-    steady = _steady_scene(scene, where)
-    v = _web_speed(where, scene, web_speed, lo_open=False)
-    rc = scene.roll.core_radius
-    r = number(where, "radius", radius, lo=rc, unit="m",
-               valid=f"a finite radius >= [roll] core_radius = {rc:g} m")
-    sc = steady.replace(drum={"drive": {"web_acceleration": 0.0, "web_speed": v}})
-    system = WinderSystem(sc)
-    law, contact = system.law, system.contact
-    assert contact is not None
-    g = system.g
-    m, J = law.mass(r), law.polar_inertia(r)
-    w = v / r
-    ft = 0.0
-    fn = m * g
-    for _ in range(4):  # slip ↔ friction ↔ roll speed
-        rdot = system.h_over_2pi * w
-        mrate = law.mass_derivative(r) * rdot
-        tweb = mrate * v if sc.effects.web_momentum else 0.0
-        jrate = law.polar_inertia_derivative(r) * rdot if sc.effects.variable_mass else 0.0
-        wdot = -v * rdot / r**2
-        ft = (J * wdot + jrate * w) / r - tweb
-        ratio = ft / (contact.mu * fn)
-        if abs(ratio) >= 1.0:
-            raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s the "
-                                f"nip cannot carry the roll's torque (|F_t| = {abs(ft):.3g} "
-                                f"N > μ F_n = {contact.mu * fn:.3g} N): no operating point; "
-                                "valid: a lower web speed or a smaller radius")
-        vs = contact.v_ref * math.atanh(ratio)
-        w = (v - vs) / r
-    rdot = system.h_over_2pi * w
-    z = contact.initial_height(m, r, rdot, g)
-    if not z > system.drum_radius:
-        raise ArgumentError(f"{where}: at radius = {r:g} m the roll's weight {fn:.4g} N "
-                            f"compresses the nip by more than the radius (the roll axis "
-                            f"would lie inside the drum); valid: a smaller radius or a "
-                            f"stiffer nip ([contact] stiffness)")
-    y = np.zeros(system.n_states)
-    y[:5] = (z, 0.0, 0.0, w, r)
-    if sc.effects.slip_relaxation:
-        y[5] = ft
-    return system, 1.0, y
+    lin = _linearisation(scene, where, web_speed, lo_open=False)
+    r = _radius(where, lin, radius)
+    return lin.system, lin.t, lin.solve(r, where)
 
 
 def modes_at(scene: Scene, radius: float, *, web_speed: float | None = None) -> list[Mode]:
-    """Modes of the linearised winder at ``radius`` [m] and ``web_speed`` [m/s] (see
-    :func:`operating_point` for the valid range), bounce first."""
-    system, t, y = operating_point(scene, radius, web_speed=web_speed)
-    A = jacobian(system, t, y)
-    fast = [0, 2, 3] + ([5] if system.n_states > 5 else [])
-    lam, vec = np.linalg.eig(A[np.ix_(fast, fast)])
-    out, used = [], set()
-    order = np.argsort(-np.abs(vec[0]) / np.linalg.norm(vec, axis=0))  # z-dominated first
-    for i in order:
-        if i in used:
-            continue
-        used.add(i)
-        if abs(lam[i].imag) > 0:  # take one of the conjugate pair
-            j = int(np.argmin(np.abs(lam - np.conj(lam[i])) + (np.arange(len(lam)) == i)))
-            used.add(j)
-        out.append(Mode(complex(lam[i]), "bounce" if not out else "slip"))
-    return out
+    """Modes of the linearised machine at ``radius`` [m] and ``web_speed`` [m/s] (see
+    :func:`operating_point` for the valid range): the bounce modes, one per free
+    translational coordinate in the machine's order (a single-drum scene: its one bounce
+    mode first), then the slip/torsion modes."""
+    where = "operating_point"
+    lin = _linearisation(scene, where, web_speed, lo_open=False)
+    r = _radius(where, lin, radius)
+    return lin.modes(lin.solve(r, where))
 
 
 @dataclass(frozen=True)
 class ModeMap:
-    """Modes against radius. Arrays over ``radius`` [m]; frequencies [Hz]; speeds [m/s]."""
+    """Modes against the wound roll's radius. Arrays over ``radius`` [m]; frequencies
+    [Hz]; speeds [m/s].
+
+    ``frequencies``/``dampings``: per bounce mode (``coordinates``, e.g. ``set.x``) its
+    damped frequency and damping ratio; ``bounce_frequency``/``bounce_damping``: the mode
+    of the wound roll's own ``z`` (the single-drum bounce mode); ``slip_*``: the fastest
+    slip/torsion mode (``|λ|/2π``); ``rotation_1x`` the roll's rotation frequency
+    ``ratio · v/(2π r)`` at no slip (``ratio`` of the drum the web wraps);
+    ``drum_rotation`` each drum's rotation frequency; ``critical_web_speed`` the web speed
+    at which 1× meets ``bounce_frequency``."""
 
     radius: np.ndarray
-    bounce_frequency: np.ndarray
-    bounce_damping: np.ndarray
+    frequencies: dict[str, np.ndarray]
+    dampings: dict[str, np.ndarray]
     slip_frequency: np.ndarray
     slip_damping: np.ndarray
     rotation_1x: np.ndarray
-    rotation_2x: np.ndarray
-    critical_web_speed: np.ndarray
     web_speed: float
+    roll: str
+    drum_rotation: dict[str, float] = field(default_factory=dict)
+    legacy: bool = False
 
-    def critical_radii(self, order: int = 1) -> list[float]:
-        """Radii where ``order × f₁`` crosses the bounce frequency (linear interpolation)."""
-        d = self.bounce_frequency - order * self.rotation_1x
+    @property
+    def coordinates(self) -> list[str]:
+        return list(self.frequencies)
+
+    @property
+    def main(self) -> str:
+        """The wound roll's vertical mode (``ROLL.z``), else the first."""
+        z = f"{self.roll}.z"
+        return z if z in self.frequencies else self.coordinates[0]
+
+    @property
+    def bounce_frequency(self) -> np.ndarray:
+        return self.frequencies[self.main]
+
+    @property
+    def bounce_damping(self) -> np.ndarray:
+        return self.dampings[self.main]
+
+    @property
+    def rotation_2x(self) -> np.ndarray:
+        return 2 * self.rotation_1x
+
+    @property
+    def critical_web_speed(self) -> np.ndarray:
+        return self.web_speed * self.bounce_frequency / self.rotation_1x
+
+    def harmonics(self) -> dict[str, np.ndarray]:
+        """The excitation lines [Hz] over ``radius``: ``1x``, ``2x``, ``3x`` of the roll's
+        rotation and ``DRUM`` (each drum's rotation, constant; equal drums merged)."""
+        out = {f"{k}x": k * self.rotation_1x for k in ORDERS}
+        seen: list[float] = []
+        for f in self.drum_rotation.values():
+            if not any(abs(f - s) <= 1e-12 * abs(s) for s in seen):
+                seen.append(f)
+                same = [n for n, g in self.drum_rotation.items() if abs(g - f) <= 1e-12 * f]
+                key = "drum" if same == ["drum"] else "drum " + "/".join(same)
+                out[key] = np.full(len(self.radius), f)
+        return out
+
+    def critical_radii(self, order: int | str = 1, mode: str | None = None) -> list[float]:
+        """Radii [m] where a harmonic (``order`` ``k`` for ``k × f₁``, or a key of
+        :meth:`harmonics`) crosses a bounce mode (``mode``, default :attr:`main`), by
+        linear interpolation; only where the mode oscillates on both sides and its
+        frequency changes by less than 25 % between the two radii."""
+        line = self.harmonics()[f"{order}x" if isinstance(order, int) else order]
+        f = self.frequencies[mode or self.main]
+        d = f - line
         out = []
-        for i in np.nonzero(np.sign(d[:-1]) * np.sign(d[1:]) < 0)[0]:
+        # a crossing of an oscillating mode whose frequency moves continuously (less than
+        # _JUMP between neighbours): not where the mode turns overdamped (f → 0) or where
+        # its eigenvalue branch changes
+        a, b = f[:-1], f[1:]
+        ok = (np.isfinite(d[:-1]) & np.isfinite(d[1:]) & (a > 0) & (b > 0)
+              & (np.abs(b - a) <= _JUMP * np.maximum(a, b)))
+        for i in np.nonzero(ok & (np.sign(d[:-1]) * np.sign(d[1:]) < 0))[0]:
             s = d[i] / (d[i] - d[i + 1])
             out.append(float(self.radius[i] + s * (self.radius[i + 1] - self.radius[i])))
         return out
 
+    def crossings(self) -> list[tuple[str, str, float]]:
+        """Every crossing ``(mode, harmonic, radius [m])``."""
+        return [(c, h, rc) for c in self.coordinates for h in self.harmonics()
+                for rc in self.critical_radii(h, c)]
+
     def as_columns(self) -> dict[str, np.ndarray]:
-        return {"radius": self.radius, "bounce_frequency": self.bounce_frequency,
-                "bounce_damping": self.bounce_damping, "slip_frequency": self.slip_frequency,
-                "slip_damping": self.slip_damping, "rotation_1x": self.rotation_1x,
-                "rotation_2x": self.rotation_2x, "critical_web_speed": self.critical_web_speed}
+        """The CSV table: for a single-drum scene the historic columns; otherwise also every
+        bounce mode (``BODY_x_frequency``, ``BODY_x_damping``, ...) and the drums'
+        rotation frequencies."""
+        cols = {"radius": self.radius, "bounce_frequency": self.bounce_frequency,
+                "bounce_damping": self.bounce_damping}
+        if not self.legacy:
+            for c in self.coordinates:
+                key = c.replace(".", "_")
+                cols[f"{key}_frequency"] = self.frequencies[c]
+                cols[f"{key}_damping"] = self.dampings[c]
+        cols.update({"slip_frequency": self.slip_frequency, "slip_damping": self.slip_damping,
+                     "rotation_1x": self.rotation_1x, "rotation_2x": self.rotation_2x})
+        if not self.legacy:
+            cols["rotation_3x"] = 3 * self.rotation_1x
+            for name, f in self.drum_rotation.items():
+                cols[f"{name}_rotation"] = np.full(len(self.radius), f)
+        cols["critical_web_speed"] = self.critical_web_speed
+        return cols
+
+
+def wound_length(scene: Scene, v: float) -> float:
+    """Paper [m] the web brings in over the scene's duration at web speed ``v`` [m/s]:
+    the drum the web wraps ramps at its ``web_acceleration`` to ``v`` (none: ``v`` from
+    the start)."""
+    drive, T = _entry_drum(scene).drive, scene.scene.duration
+    a = drive.web_acceleration
+    if a > 0.0 and v > 0.0:
+        tr = v / a
+        return a * T * T / 2 if T <= tr else v * T - v * tr / 2
+    return v * T
 
 
 def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
              web_speed: float | None = None, n: int = 200) -> ModeMap:
-    """The resonance map over ``radii`` [m] (each ``>= [roll] core_radius``; default: ``n``
-    points, 2 … 10 000, from the initial radius to the radius at the end of the scene's run)
-    at ``web_speed`` [m/s] (``> 0``; default the scene's).
+    """The resonance map over ``radii`` [m] of the wound roll (each ``>=`` its core
+    radius; default: ``n`` points, 2 … 10 000, from its initial radius to its radius at the
+    end of the scene's run, winding one caliper per revolution at no slip:
+    ``r² = r₀² + h L/π`` with ``L`` the paper brought in by the drive's ramp and full
+    speed) at ``web_speed`` [m/s] (``> 0``; default the scene's).
 
     Raises
     ------
@@ -210,14 +535,12 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
         winding operating point (see :func:`operating_point`).
     """
     where = "mode_map"
-    _steady_scene(scene, where)
-    v = _web_speed(where, scene, web_speed, lo_open=True)
-    rc = scene.roll.core_radius
+    lin = _linearisation(scene, where, web_speed, lo_open=True)
+    v, rc, roll = lin.v, lin.rc, lin.roll.part
     if radii is None:
         n = integer(where, "n", n, lo=2, hi=MAX_POINTS)
-        r0 = scene.roll.initial_radius
-        # r² − r_c² = h v t/π at no slip
-        r_end = math.sqrt(r0**2 + scene.paper.caliper * v * scene.scene.duration / math.pi)
+        r0 = roll.initial_radius
+        r_end = math.sqrt(r0**2 + roll.caliper * wound_length(scene, v) / math.pi)
         radii = np.linspace(r0, r_end, n)
     try:
         radii = np.asarray(radii, dtype=float)
@@ -230,14 +553,25 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     bad = ~(np.isfinite(radii) & (radii >= rc))
     if bad.any():
         i = int(np.argmax(bad))
+        key = "[roll] core_radius" if scene.legacy else \
+            f"[[roll]] {lin.roll.name!r} core_radius"
         raise ArgumentError(f"{where}: radii[{i}] = {float(radii[i])!r} is out of range; "
-                            f"valid: finite radii >= [roll] core_radius = {rc:g} m")
-    cols = np.full((4, len(radii)), np.nan)
+                            f"valid: finite radii >= {key} = {rc:g} m")
+    nt = len(lin.coords)
+    freq = np.full((nt, len(radii)), np.nan)
+    damp = np.full((nt, len(radii)), np.nan)
+    slip = np.full((2, len(radii)), np.nan)
     for i, r in enumerate(radii):
-        ms = modes_at(scene, float(r), web_speed=v)
-        cols[0, i], cols[1, i] = ms[0].frequency, ms[0].damping_ratio
-        if len(ms) > 1:
-            cols[2, i], cols[3, i] = ms[1].natural_frequency, ms[1].damping_ratio
-    f1 = v / (2 * math.pi * radii)
-    return ModeMap(radii, cols[0], cols[1], cols[2], cols[3], f1, 2 * f1,
-                   2 * math.pi * radii * cols[0], v)
+        ms = lin.modes(lin.solve(float(r), where))
+        for m in ms[:nt]:
+            j = lin.coords.index(m.coordinate)
+            freq[j, i], damp[j, i] = m.frequency, m.damping_ratio
+        if len(ms) > nt:
+            slip[:, i] = ms[nt].natural_frequency, ms[nt].damping_ratio
+    drums = {b.name: b.part.drive.ratio * v / (2 * math.pi * b.part.radius)
+             for b in lin.machine.bodies if b.prescribed}
+    ratio = _entry_drum(scene).drive.ratio  # the roll's surface runs at ratio · v
+    return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),
+                   dict(zip(lin.coords, damp, strict=True)), slip[0], slip[1],
+                   ratio * v / (2 * math.pi * radii), v, lin.roll.name, drums,
+                   bool(scene.legacy))

@@ -149,11 +149,12 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     return paths
 
 
-def normal_force_envelope(result: Result, window: float = 0.5
+def normal_force_envelope(result: Result, window: float = 0.5, *,
+                          force: str = "normal_force", radius: str = "radius"
                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(radius, min, max, half peak-to-peak)`` of the normal force over windows of
-    ``window`` [s]."""
-    t, fn, r = result.t, result["normal_force"], result["radius"]
+    """``(radius, min, max, half peak-to-peak)`` of the channel ``force`` [N] over windows
+    of ``window`` [s], against the channel ``radius`` [m]."""
+    t, fn, r = result.t, result[force], result[radius]
     dt = float(np.median(np.diff(t))) if len(t) > 1 else window
     w = max(1, int(round(window / dt)))
     n = len(t) // w
@@ -162,39 +163,74 @@ def normal_force_envelope(result: Result, window: float = 0.5
     return r.mean(axis=1), lo, hi, (hi - lo) / 2
 
 
+_HARMONIC_STYLE = {"1x": "-", "2x": "--", "3x": ":"}
+
+
 def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
-                    title: str = "") -> Path:
-    """Resonance map (bounce and slip modes, 1×/2×/3× rotation lines, critical radii)
-    over the radius; with ``result``, the simulated normal-force envelope below on the
-    same radius axis."""
+                    title: str = "", envelopes: dict[str, tuple[str, str]] | None = None
+                    ) -> Path:
+    """Resonance map (:class:`winder.ModeMap`): the bounce modes (one line per free
+    coordinate) and the slowest slip/torsion mode against the radius, the 1×/2×/3× roll
+    rotation lines and the drums' rotation, every crossing of a harmonic with a bounce mode
+    marked; with ``result``, the simulated normal-force envelopes below on the same radius
+    axis (``envelopes``: label → (force channel, radius channel); default the single-drum
+    ``normal_force`` against ``radius``)."""
     mm = mode_map
     rows = 2 if result is not None else 1
     fig, axes = plt.subplots(rows, 1, figsize=(8, 4.2 * rows), sharex=True, squeeze=False)
     ax = axes[0, 0]
-    ax.plot(mm.radius, mm.bounce_frequency, "C0", lw=2, label="bounce mode (damped)")
-    ax.plot(mm.radius, mm.slip_frequency, "C2", lw=1.2,
-            label="slip/torsion mode |λ|/2π (overdamped)")
-    for k, style in ((1, "k-"), (2, "k--"), (3, "k:")):
-        ax.plot(mm.radius, k * mm.rotation_1x, style, lw=1,
-                label=f"{k}× roll rotation at {mm.web_speed:g} m/s")
-        for rc in mm.critical_radii(k):
+    r = mm.radius
+    one = len(mm.coordinates) == 1
+    for i, c in enumerate(mm.coordinates):
+        f = mm.frequencies[c]
+        ax.plot(r, np.where(f > 0, f, np.nan), f"C{i}", lw=2,
+                label="bounce mode (damped)" if one else f"bounce mode {c} (damped)")
+    ax.plot(r, mm.slip_frequency, "C2" if one else "C7", lw=1.0,
+            label="slip/torsion mode |λ|/2π (slowest)")
+    harmonics = mm.harmonics()
+    for name, line in harmonics.items():
+        if name in _HARMONIC_STYLE:
+            ax.plot(r, line, _HARMONIC_STYLE[name], color="k", lw=1,
+                    label=f"{name[:-1]}× roll rotation at {mm.web_speed:g} m/s")
+        else:
+            ax.plot(r, line, "-.", color="0.45", lw=1, label=f"{name} rotation")
+    values = np.concatenate([f[np.isfinite(f) & (f > 0)]
+                             for f in (*mm.frequencies.values(), *harmonics.values())])
+    log = values.size > 0 and values.max() / values.min() > 30
+    if log:
+        ax.set_yscale("log")
+        ax.set_ylim(max(values.min() * 0.7, 0.1), values.max() * 1.5)
+    else:
+        ax.set_ylim(0, float(np.nanmax(mm.bounce_frequency)) * 1.1)
+    crossings = mm.crossings()
+    for c, h, rc in crossings:
+        f = float(np.interp(rc, r, mm.frequencies[c]))
+        ax.plot([rc], [f], "o", color="C3", ms=5, mfc="none", mew=1.2)
+        if one:
             ax.axvline(rc, color="C3", lw=0.8, alpha=0.7)
-            ax.annotate(f"{k}×: r = {rc:.3f} m", (rc, ax.get_ylim()[1] * 0.02 + 1),
+            ax.annotate(f"{h[:-1]}×: r = {rc:.3f} m", (rc, ax.get_ylim()[1] * 0.02 + 1),
                         rotation=90, fontsize=8, color="C3", va="bottom")
-    top = float(np.nanmax(mm.bounce_frequency)) * 1.1
-    ax.set_ylim(0, top)
+        else:
+            ax.annotate(h.split()[0], (rc, f), xytext=(3, 3), textcoords="offset points",
+                        fontsize=7, color="C3")
+    if crossings and not one:
+        ax.plot([], [], "o", color="C3", mfc="none", label="crossing (critical radius)")
     ax.set_ylabel("frequency [Hz]")
-    ax.legend(fontsize=8, loc="upper right")
-    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8 if one else 7, loc="upper right")
+    ax.grid(alpha=0.3, which="both" if log else "major")
     ax.set_title(_label(title, 120) or "Resonance map (Campbell chart)")
     if result is not None:
-        r, lo, hi, _ = normal_force_envelope(result)
         b = axes[1, 0]
-        b.fill_between(r, lo / 1e3, hi / 1e3, color="C1", alpha=0.5, lw=0)
-        b.plot(r, hi / 1e3, "C1", lw=0.6)
-        for k in (1, 2, 3):
-            for rc in mm.critical_radii(k):
-                b.axvline(rc, color="C3", lw=0.8, alpha=0.7)
+        pairs = envelopes or {"": ("normal_force", "radius")}
+        for i, (label, (force, radius)) in enumerate(pairs.items()):
+            rr, lo, hi, _ = normal_force_envelope(result, force=force, radius=radius)
+            b.fill_between(rr, lo / 1e3, hi / 1e3, color=f"C{i + 1}", alpha=0.5, lw=0,
+                           label=label or None)
+            b.plot(rr, hi / 1e3, f"C{i + 1}", lw=0.6)
+        for _, _, rc in crossings:
+            b.axvline(rc, color="C3", lw=0.8, alpha=0.5)
+        if len(pairs) > 1:
+            b.legend(fontsize=8, loc="upper right")
         b.set_ylabel("normal force envelope [kN]")
         b.grid(alpha=0.3)
         b.set_title("simulated nip normal force (min-max over 0.5 s)", fontsize=10)

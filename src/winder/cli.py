@@ -283,12 +283,16 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     mm = mode_map(scene, web_speed=args.web_speed, n=args.points)
     print(f"{scene.name}: modes at {len(mm.radius)} radii, {mm.radius[0]:.3f}-"
           f"{mm.radius[-1]:.3f} m, web speed {mm.web_speed:g} m/s")
-    print(f"  bounce mode {mm.bounce_frequency[0]:.1f} -> {mm.bounce_frequency[-1]:.1f} Hz, "
-          f"damping ratio {mm.bounce_damping[0]:.3f} -> {mm.bounce_damping[-1]:.3f}")
-    for k in (1, 2, 3):
-        crit = mm.critical_radii(k)
-        print(f"  {k}x rotation meets the bounce mode at r = "
-              + (", ".join(f"{c:.4f} m" for c in crit) if crit else "(no crossing)"))
+    one = len(mm.coordinates) == 1
+    for c in mm.coordinates:
+        f, z = mm.frequencies[c], mm.dampings[c]
+        print(f"  bounce mode{'' if one else ' ' + c} {f[0]:.1f} -> {f[-1]:.1f} Hz, "
+              f"damping ratio {z[0]:.3f} -> {z[-1]:.3f}")
+    for c in mm.coordinates:
+        for h in mm.harmonics():
+            crit = mm.critical_radii(h, c)
+            print(f"  {h} rotation meets the bounce mode{'' if one else ' ' + c} at r = "
+                  + (", ".join(f"{x:.4f} m" for x in crit) if crit else "(no crossing)"))
     if csv is not None:
         cols = mm.as_columns()
         header = ",".join(cols)
@@ -304,7 +308,10 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         if args.simulate:
             print("  simulating the scene for the normal-force envelope ...", file=sys.stderr)
             result = simulate(scene, progress=sys.stderr.isatty())
-        path = campbell_figure(mm, plot, result=result,
+        nips = {} if scene.legacy else {
+            n.name: (f"{n.name}_normal_force", f"{mm.roll}_radius") for n in scene.nips
+            if mm.roll in (n.a, n.b)}
+        path = campbell_figure(mm, plot, result=result, envelopes=nips or None,
                                title=f"Resonance map of {scene.name}")
         print(f"  figure written to {path}")
     return 0
@@ -400,7 +407,8 @@ def _build_parser() -> argparse.ArgumentParser:
     fmu.add_argument("--check", action=argparse.BooleanOptionalAction, default=True,
                      help="load the built FMU with FMPy and step it (default on)")
     fmu.set_defaults(func=_cmd_fmu)
-    modes = sub.add_parser("modes", help="nip modes against roll radius (resonance map)")
+    modes = sub.add_parser("modes", help="bounce modes against the wound roll's radius and "
+                           "the rotation harmonics (resonance map)")
     modes.add_argument("scene", help="scene file (TOML)")
     modes.add_argument("--plot", nargs="?", const="campbell.png",
                        help="write the Campbell chart (PNG; default name campbell.png)")
