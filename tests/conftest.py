@@ -58,17 +58,54 @@ def _signed_log(rng: np.random.Generator, lo: float, hi: float) -> float:
     return float(rng.choice((-1.0, 1.0)) * 10.0 ** rng.uniform(math.log10(lo), math.log10(hi)))
 
 
+#: The single-drum state in the order of the old planar kernel (``z, φ, ż, ω, r, [θ_d,
+#: Ω], [F_t]``, the order the hand-written spec equations of the tests use) and where each
+#: lives in the machine's named state, with its sign (the roll's sense is −1: θ = −φ).
+OLD_LAYOUT = (("z", "roll.z", 1.0), ("roll_angle", "roll.theta", -1.0),
+              ("z_dot", "roll.z_dot", 1.0), ("roll_speed", "roll.theta_dot", -1.0),
+              ("radius", "roll.radius", 1.0), ("drum_angle", "drum.theta", 1.0),
+              ("drum_speed", "drum.theta_dot", 1.0), ("friction_force", "nip.friction", 1.0))
+
+
+def old_names(system) -> list[str]:
+    """The old-layout names of a single-drum system's states, in the old order."""
+    return [old for old, new, _ in OLD_LAYOUT if new in system.state_names]
+
+
+def to_old(system, y: np.ndarray) -> np.ndarray:
+    """A machine state (or its derivative) of a single-drum scene in the old layout."""
+    return np.array([s * y[system.index(new)] for _, new, s in OLD_LAYOUT
+                     if new in system.state_names])
+
+
+def to_machine(system, y_old: np.ndarray) -> np.ndarray:
+    """The inverse of :func:`to_old`."""
+    y = np.empty(system.n_states)
+    pairs = [(new, s) for _, new, s in OLD_LAYOUT if new in system.state_names]
+    for value, (new, s) in zip(y_old, pairs, strict=True):
+        y[system.index(new)] = s * value
+    return y
+
+
+def prescribed_drum_speed(scene: winder.Scene, t: float) -> float:
+    """``Ω(t)`` [rad/s] of the single-drum scene's speed profile (spec §5)."""
+    d = scene.drum
+    a, v = d.drive.web_acceleration, d.drive.web_speed
+    return (min(a * t, v) if a > 0 else v) / d.radius
+
+
 def random_states(system, rng: np.random.Generator, n: int) -> Iterator[tuple[float, np.ndarray]]:
-    """``n`` random ``(t, y)`` for a ``WinderSystem`` that reach every branch of the nip and
-    the drive: penetration ``δ`` and its rate ``δ̇`` of both signs over five decades each
-    (so out of contact, in contact, and where ``δ > 0`` but the law would pull), slip
-    ``v_s = Ω R − ω r`` of both signs from creep to gross slip, any angle, radii over the
-    whole cycle, times on the ramp and after it, any relaxed friction. Use
+    """``n`` random ``(t, y)`` for a single-drum ``MachineSystem`` that reach every branch
+    of the nip and the drive: penetration ``δ`` and its rate ``δ̇`` of both signs over
+    five decades each (so out of contact, in contact, and where ``δ > 0`` but the law would
+    pull), slip ``v_s = Ω R − ω r`` of both signs from creep to gross slip, any angle,
+    radii over the whole cycle, times on the ramp and after it, any relaxed friction. Use
     :func:`state_regions` to count what was drawn."""
-    names = system.state_names
     scene = system.scene
-    R, rc, h2pi = system.drum_radius, scene.roll.core_radius, system.h_over_2pi
-    y0 = system.initial_state()
+    names = old_names(system)
+    R, rc = scene.drum.radius, scene.roll.core_radius
+    h2pi = scene.paper.caliper / (2.0 * math.pi)
+    y0 = to_old(system, system.initial_state())
     for _ in range(n):
         t = float(rng.uniform(0.0, 60.0))
         y = y0.copy()
@@ -78,13 +115,13 @@ def random_states(system, rng: np.random.Generator, n: int) -> Iterator[tuple[fl
             y[names.index("drum_speed")] = rng.uniform(-5.0, 45.0)
             Om = y[names.index("drum_speed")]
         else:
-            Om = system.drive.kinematics(t, [])[1]
+            Om = prescribed_drum_speed(scene, t)
         w = (Om * R - _signed_log(rng, 1e-4, 3.0)) / r
         delta, ddot = _signed_log(rng, 1e-7, 3e-3), _signed_log(rng, 1e-4, 30.0)
         y[:5] = (R + r - delta, rng.uniform(-math.pi, math.pi), h2pi * w - ddot, w, r)
         if "friction_force" in names:
             y[names.index("friction_force")] = rng.normal(0.0, 300.0)
-        yield t, y
+        yield t, to_machine(system, y)
 
 
 def state_regions(system, states: list[tuple[float, np.ndarray]]) -> dict[str, int]:
@@ -92,13 +129,16 @@ def state_regions(system, states: list[tuple[float, np.ndarray]]) -> dict[str, i
     parameters: ``out`` (δ ≤ 0), ``pulling`` (δ > 0 but the unclamped law < 0: the clamp
     acts), ``pressing`` (F_n > 0), ``out_law_positive`` (δ ≤ 0 where the unclamped linear
     law would push), the signs of ``δ̇`` and of the slip."""
-    c, R = system.scene.contact, system.drum_radius
-    names = system.state_names
+    scene = system.scene
+    c, R = scene.contact, scene.drum.radius
+    h2pi = scene.paper.caliper / (2.0 * math.pi)
+    names = old_names(system)
     out = dict.fromkeys(("out", "pulling", "pressing", "out_law_positive", "closing",
                          "opening", "slip+", "slip-"), 0)
-    for t, y in states:
+    for t, y_machine in states:
+        y = to_old(system, y_machine)
         z, zd, w, r = y[0], y[2], y[3], y[4]
-        delta, ddot = R + r - z, system.h_over_2pi * w - zd
+        delta, ddot = R + r - z, h2pi * w - zd
         law = (c.stiffness * delta + c.damping * ddot if c.law == "linear"
                else c.stiffness * abs(delta) ** c.exponent * (1 + c.hc_damping * ddot))
         if delta <= 0:
@@ -108,6 +148,6 @@ def state_regions(system, states: list[tuple[float, np.ndarray]]) -> dict[str, i
             out["pulling" if law <= 0 else "pressing"] += 1
         out["closing" if ddot > 0 else "opening"] += 1
         Om = (y[names.index("drum_speed")] if "drum_speed" in names
-              else system.drive.kinematics(t, [])[1])
+              else prescribed_drum_speed(scene, t))
         out["slip+" if Om * R - w * r > 0 else "slip-"] += 1
     return out

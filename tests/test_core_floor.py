@@ -8,11 +8,10 @@ import math
 
 import numpy as np
 import pytest
-from conftest import random_states
+from conftest import random_states, to_machine, to_old
 
 import winder
-from winder._planar import PlanarSystem
-from winder._system import WinderSystem
+from winder.solve.system import MachineSystem
 
 R_CORE, CALIPER = 0.075, 160e-6
 
@@ -123,24 +122,27 @@ def test_at_core_rhs_is_constant_mass(paper_scene, backend) -> None:
     with ṁ = J̇ = 0); turning forwards at the core, ṙ = h ω/2π."""
     const = paper_scene.replace(effects={"variable_mass": False, "web_momentum": False})
 
-    def rhs(scene: winder.Scene):
-        system = WinderSystem(scene)
-        return (PlanarSystem(scene, system) if backend == "compiled" else system).rhs
+    system, system_const = (MachineSystem(s, backend=backend) for s in (paper_scene, const))
 
-    f, f_const = rhs(paper_scene), rhs(const)
+    def f(t: float, y: np.ndarray, s: MachineSystem = system) -> np.ndarray:
+        """The right-hand side in the old layout (z, φ, ż, ω, r, F_t)."""
+        return to_old(s, s.rhs(t, to_machine(s, y)))
+
     rng = np.random.default_rng(5)
-    for t, y in random_states(WinderSystem(paper_scene), rng, 20):
+    for t, y_machine in random_states(system, rng, 20):
+        y = to_old(system, y_machine)
         y[4] = R_CORE
         y[3] = -abs(y[3]) - 0.1
         dy = f(t, y)
         assert dy[4] == 0.0
-        np.testing.assert_allclose(dy, f_const(t, y), rtol=1e-13, atol=1e-12)
+        np.testing.assert_allclose(dy, f(t, y, system_const), rtol=1e-13, atol=1e-12)
         y[3] = -y[3]
         assert f(t, y)[4] == pytest.approx(CALIPER * y[3] / (2 * math.pi), rel=1e-15)
 
 
 def test_initial_state_below_the_core_is_refused(paper_scene) -> None:
-    y0 = WinderSystem(paper_scene).initial_state()
-    y0[4] = R_CORE - 1e-9
+    system = MachineSystem(paper_scene)
+    y0 = system.initial_state()
+    y0[system.index("roll.radius")] = R_CORE - 1e-9
     with pytest.raises(winder.ArgumentError, match=r"initial_state.*roll.radius >= 0.075 m"):
         winder.simulate(paper_scene, initial_state=y0, t_end=1.0)

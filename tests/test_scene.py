@@ -62,7 +62,7 @@ def test_paper_scene_values(paper_scene) -> None:
             s.friction.min_speed) == (0.3, 0.05, 0.01, 0.1)
     assert s.scene.duration == 700.0
     assert s.effects.enabled() == winder._scene.EFFECT_NAMES  # all on, in spec order
-    assert set(winder.EFFECTS) <= set(winder._scene.EFFECT_NAMES)
+    assert set(winder.FORCES) == set(winder._scene.EFFECT_NAMES)
 
 
 def test_replace_validates(paper_scene) -> None:
@@ -195,8 +195,9 @@ def test_nip_too_soft_for_the_roll(tmp_path, models_dir) -> None:
     # 4000 N/m carries it with 0.0736 m < 0.075 m
     ok = _write(tmp_path, models_dir, lambda d: d["contact"].update(stiffness=4000.0,
                                                                     damping=0.0))
-    y0 = winder.WinderSystem(winder.load_scene(ok)).initial_state()
-    assert y0[0] - 0.5 == pytest.approx(0.075 - 30 * 9.81 / 4000.0, rel=1e-12)
+    system = winder.MachineSystem(winder.load_scene(ok))
+    y0 = system.initial_state()
+    assert y0[system.index("roll.z")] - 0.5 == pytest.approx(0.075 - 30 * 9.81 / 4000.0, rel=1e-12)
 
 
 def test_output_grid_too_large(tmp_path, models_dir) -> None:

@@ -88,16 +88,19 @@ def outcome(path: Path, data: dict, keys: list[str]) -> str:
     except Exception as exc:  # noqa: BLE001 - the contract forbids any other error
         return f"bad: {type(exc).__name__} while loading: {str(exc)[:200]}"
     try:
-        system = winder.WinderSystem(scene)
-        y0 = system.initial_state()
+        from winder.core.equilibrium import static_state
+
+        machine = winder.Machine(scene)
+        y0 = static_state(machine).state
     except winder.WinderError as exc:
         return f"bad: {type(exc).__name__} building the system: {str(exc)[:200]}"
     except Exception as exc:  # noqa: BLE001
         return f"bad: {type(exc).__name__} building the system: {str(exc)[:200]}"
     if not np.all(np.isfinite(y0)):
         return f"bad: non-finite initial state {y0}"
-    if y0[0] <= scene.drum.radius:
-        return f"bad: roll axis at z = {y0[0]!r} m inside the drum (R = {scene.drum.radius})"
+    z = y0[machine.index("roll.z")]
+    if z <= scene.drum.radius:
+        return f"bad: roll axis at z = {z!r} m inside the drum (R = {scene.drum.radius})"
     try:
         res = winder.simulate(scene, t_end=T_SHORT, output_step=T_SHORT / 2, max_rhs=20_000,
                               max_wall=120.0)

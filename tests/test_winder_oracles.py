@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 import pytest
-from conftest import random_states, scene_variant, state_regions
+from conftest import random_states, scene_variant, state_regions, to_machine, to_old
 from scipy.optimize import brentq
 
 import winder
-from winder._system import WinderSystem
+from winder.solve.system import MachineSystem
 
 DRUM_TORQUE = -75.0  # input torque of the free drum in these tests [N·m]
 
@@ -75,14 +75,14 @@ def test_pinocchio_equals_spec_equations(paper_scene, variant) -> None:
     written out by hand, on states in and out of contact, pulling and pressing, slipping
     both ways, with either drive and either contact law."""
     scene = scene_variant(paper_scene, variant)
-    sys_ = WinderSystem(scene)
+    sys_ = MachineSystem(scene, backend="pinocchio")
     if scene.drum.drive.kind == "torque":
         sys_.set_drum_torque(DRUM_TORQUE)
     states = list(random_states(sys_, np.random.default_rng(3), 150))
     regions = state_regions(sys_, states)
     assert min(regions.values()) >= 150 // 40, regions  # every region of the nip drawn
-    got = np.array([sys_.rhs(t, y) for t, y in states])
-    spec = [_spec_rhs(scene, t, y) for t, y in states]
+    got = np.array([to_old(sys_, sys_.rhs(t, y)) for t, y in states])
+    spec = [_spec_rhs(scene, t, to_old(sys_, y)) for t, y in states]
     ref = np.array([d for d, _ in spec])
     # each component relative to its largest value: measured 1.1e-12 (roll acceleration
     # without contact, where it is a small difference), ≤ 3e-15 elsewhere
@@ -98,13 +98,13 @@ def test_pinocchio_equals_spec_equations(paper_scene, variant) -> None:
 
 def test_drum_torque_rnea_equals_balance(paper_scene) -> None:
     """τ_d = J_d Ω̇ + R F_t (spec §5) from RNEA, on random states during the ramp."""
-    sys_ = WinderSystem(paper_scene)
+    sys_ = MachineSystem(paper_scene)
     rng = np.random.default_rng(4)
     y = sys_.initial_state()
     T = rng.uniform(0, 40, 10)
     Y = np.repeat(y[:, None], 10, axis=1)
-    Y[3] = rng.uniform(0, 200, 10)
-    Y[5] = rng.normal(0, 300, 10)
+    Y[sys_.index("roll.theta_dot")] = -rng.uniform(0, 200, 10)
+    Y[sys_.index("nip.friction")] = rng.normal(0, 300, 10)
     ch = sys_.channels(T, Y)
     expected = paper_scene.drum.inertia * 0.5 / 0.5 + 0.5 * ch["friction_force"]
     np.testing.assert_allclose(ch["drum_torque"], expected, rtol=1e-12, atol=1e-9)
@@ -112,13 +112,13 @@ def test_drum_torque_rnea_equals_balance(paper_scene) -> None:
 
 def test_static_equilibrium_at_start(paper_scene) -> None:
     scene = paper_scene.replace(effects={"imbalance": False})
-    sys_ = WinderSystem(scene)
-    y0 = sys_.initial_state()
-    dy = sys_.rhs(0.0, y0)
+    sys_ = MachineSystem(scene)
+    y0 = to_old(sys_, sys_.initial_state())
+    dy = to_old(sys_, sys_.rhs(0.0, to_machine(sys_, y0)))
     m0 = scene.roll.core_mass
     # round-off floor: δ = R + r − z loses ulp(z), i.e. k·ε·z/m of acceleration
     assert abs(dy[2]) < 4 * 2e7 * np.finfo(float).eps * y0[0] / m0
-    ch = sys_.channels(np.array([0.0]), y0[:, None])
+    ch = sys_.channels(np.array([0.0]), to_machine(sys_, y0)[:, None])
     # same round-off floor in force: k·ulp(z)
     assert abs(ch["normal_force"][0] - m0 * 9.81) < 4 * 2e7 * np.finfo(float).eps * y0[0]
     assert y0[0] == pytest.approx(0.5 + 0.075 - m0 * 9.81 / 2e7, rel=1e-15)

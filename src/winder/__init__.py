@@ -28,9 +28,10 @@ _LAZY = {
     "Scene": "._scene", "load_scene": "._scene", "scene_from_dict": "._scene",
     "DEFAULT_METHOD": "._simulate", "simulate": "._simulate",
     "Stepper": "._stepper",
-    "CHANNELS": "._system", "EXTRA_CHANNELS": "._system", "WinderSystem": "._system",
+    "CHANNELS": ".solve.system", "EXTRA_CHANNELS": ".solve.system",
+    "MachineSystem": ".solve.system", "Machine": ".core.machine",
     "VariableMassModel": "._variable_mass",
-    "EFFECTS": ".effects", "Effect": ".effects",
+    "FORCES": ".forces", "ForceElement": ".forces",
     "sweep": "._sweep", "SweepTable": "._sweep_table",  # Dask, pandas, pyarrow
 }
 
@@ -46,9 +47,10 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from ._stepper import Stepper
     from ._sweep import sweep
     from ._sweep_table import SweepTable
-    from ._system import CHANNELS, EXTRA_CHANNELS, WinderSystem
     from ._variable_mass import VariableMassModel
-    from .effects import EFFECTS, Effect
+    from .core.machine import Machine
+    from .forces import FORCES, ForceElement
+    from .solve.system import CHANNELS, EXTRA_CHANNELS, MachineSystem
 
 
 def __getattr__(name: str) -> Any:
@@ -72,15 +74,16 @@ __all__ = [
     "BudgetExceeded",
     "CHANNELS",
     "DEFAULT_METHOD",
-    "EFFECTS",
     "EXTRA_CHANNELS",
-    "Effect",
+    "FORCES",
+    "ForceElement",
+    "Machine",
+    "MachineSystem",
     "Mode",
     "ModeMap",
     "Result",
     "Scene",
     "Stepper",
-    "WinderSystem",
     "build_fmu",
     "jacobian",
     "load_result",

@@ -889,7 +889,7 @@ def _check_rest_on_nip(scene: Scene) -> None:
     if not scene.effects.contact or scene.roll.initial_height is not None:
         return
     from ._mass_law import PaperRollLaw
-    from .effects.contact import make_contact_law
+    from .forces.contact import static_penetration
 
     roll = scene.roll
     r = roll.initial_radius
@@ -898,7 +898,7 @@ def _check_rest_on_nip(scene: Scene) -> None:
         * (scene.scene.gravity if scene.effects.gravity else 0.0)
     r_dot = scene.paper.caliper / (2 * math.pi) * roll.initial_speed
     try:
-        delta = make_contact_law(scene).static_penetration(weight, r_dot)
+        delta = static_penetration(scene.contact, weight, r_dot)
     except ValueError:
         delta = math.inf
     if not delta < r:

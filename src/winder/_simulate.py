@@ -250,7 +250,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
                   max_step: float | None, guards: _Guards, stats: np.ndarray,
                   at: list[Any]) -> int:
     """Integrate ``y`` in place with a compiled method in chunks of
-    :data:`~winder._integrators.CHUNK` evaluations (progress and budgets between chunks).
+    :data:`~winder.solve.integrators.CHUNK` evaluations (progress and budgets between chunks).
     Returns the samples written; ``at`` holds ``[t, step, samples]`` of the last chunk
     (for a budget error)."""
     t, h, k = float(t_out[0]), 0.0, 0

@@ -25,7 +25,8 @@ from ..core.equilibrium import Equilibrium, static_state
 from ..core.machine import AT_CORE, AUTO, CORE_AUTO, WINDING, Machine
 from . import integrators as integ
 
-__all__ = ["MachineSystem", "LEGACY_CHANNELS", "NoCompilerWarning"]
+__all__ = ["MachineSystem", "LEGACY_CHANNELS", "CHANNELS", "EXTRA_CHANNELS",
+           "NoCompilerWarning"]
 
 #: Channel names of a scene in the single-drum format (winder-model §8 and winder's
 #: extras), from the machine's channels of drum "drum", roll "roll" and nip "nip".
@@ -39,6 +40,12 @@ LEGACY_CHANNELS = {
     "web_speed": "web_speed", "z_accel": "roll_z_accel", "web_force": "web_force",
     "penetration": "nip_penetration",
 }
+
+#: Result channels of a single-drum scene (winder-model §8), in order (first column ``t``).
+CHANNELS = ("t", *list(LEGACY_CHANNELS)[:15])
+#: Its extra channels (winder's own): drum angle, web speed, roll vertical acceleration,
+#: web momentum force, penetration.
+EXTRA_CHANNELS = tuple(list(LEGACY_CHANNELS)[15:])
 
 
 class NoCompilerWarning(UserWarning):
