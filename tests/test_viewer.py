@@ -34,7 +34,8 @@ def _short_result(scene: winder.Scene) -> winder.Result:
 
 def test_placements_come_from_pinocchio(paper_scene) -> None:
     graph = WinderGraph(paper_scene)
-    Td, Tr = graph.poses(0.3, 1.2, 0.7)
+    T = graph.poses({"drum": (0.0, 0.0, 0.3), "roll": (0.0, 1.2, -0.7)})  # θ = sense·angle
+    Td, Tr = T["drum"], T["roll"]
     np.testing.assert_allclose(Tr[:3, 3], [0.0, 0.0, 1.2], atol=1e-15)
     # roll about −y by φ: x-axis → (cos φ, 0, sin φ) (spec §1: CoM at (e cos φ, ·, z + e sin φ))
     np.testing.assert_allclose(Tr[:3, 0], [np.cos(0.7), 0.0, np.sin(0.7)], atol=1e-15)
