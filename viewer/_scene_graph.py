@@ -26,7 +26,8 @@ from winder.core.machine import Machine
 
 from ._motion import WEB_ARC_POINTS, Motion
 
-__all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN", "WEB_THICKNESS", "Pose"]
+__all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN", "WEB_THICKNESS", "FOV", "Pose",
+           "apply_poses"]
 
 #: Colours (hex RGB) of the parts; the browser tests look for them.
 COLOURS = {"drum": 0x3A6EA5, "paper": 0xF2E6C9, "core": 0x8B5A2B, "mark": 0xC0392B,
@@ -37,7 +38,7 @@ COM_MARKER_GAIN = 100.0
 #: Drawn thickness of the web strip [m] (its centre line is the web's path).
 WEB_THICKNESS = 0.02
 #: Vertical field of view of meshcat's camera [deg] and the aspect the framing assumes.
-_FOV, _ASPECT = 75.0, 4.0 / 3.0
+FOV, _ASPECT = 75.0, 4.0 / 3.0
 
 #: A pose command: ("transform", path, 4×4) or ("scale", path, [sx, sy, sz]); paths are
 #: relative to the graph's root.
@@ -130,17 +131,26 @@ class WinderGraph:
               for v in (b.centre[1] - _radius0(b), b.centre[1] + _radius0(b))]
         return min(xs), max(xs), min(zs), max(zs)
 
-    def set_camera(self, vis: meshcat.Visualizer,
-                   extent: tuple[float, float, float, float]) -> None:
-        """Look along the cross-machine axis (world ``+y``) at ``extent`` (``x_min, x_max,
-        z_min, z_max`` [m]) and the floor, all in view at a 4:3 aspect."""
+    def camera(self, extent: tuple[float, float, float, float]
+               ) -> tuple[float, float, float]:
+        """Camera ``(x, z, d)`` [m] framing ``extent`` (``x_min, x_max, z_min, z_max``
+        [m]) and the floor at a 4:3 aspect: it sits at ``(x, −d, z)`` in the machine's
+        coordinates and looks along ``+y`` with ``z`` up (vertical field of view 75°)."""
         x0, x1, z0, z1 = extent
         z0 = min(z0, self.floor_z)
         half = max(0.5 * (z1 - z0), 0.5 * (x1 - x0) / _ASPECT) * 1.1 + 0.1
-        d = half / math.tan(math.radians(_FOV / 2)) + 0.55 * self.length
+        d = half / math.tan(math.radians(FOV / 2)) + 0.55 * self.length
+        return 0.5 * (x0 + x1), 0.5 * (z0 + z1), d
+
+    def set_camera(self, vis: meshcat.Visualizer,
+                   extent: tuple[float, float, float, float]) -> None:
+        """Point meshcat's camera as :meth:`camera` says. meshcat 0.3.2's orbit controls
+        always aim at the world origin, so the machine (the root node) is shifted by
+        ``(−x, 0, −z)`` and the camera sits at ``(0, −d, 0)``."""
+        x, z, d = self.camera(extent)
+        vis[self.root].set_transform(_translation([-x, 0.0, -z]))
+        vis["/Cameras/default"].set_transform(np.eye(4))
         # the camera node is in three.js coordinates (y up): world (x, y, z) → (x, z, −y)
-        vis["/Cameras/default"].set_transform(_translation([0.5 * (x0 + x1), 0.0,
-                                                            0.5 * (z0 + z1)]))
         vis["/Cameras/default/rotated/<object>"].set_property("position", [0.0, 0.0, d])
 
     # ---- poses ----------------------------------------------------------------------
