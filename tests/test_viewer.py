@@ -396,3 +396,31 @@ def test_two_drum_snapshots_are_where_the_camera_projects_them(tmp_path: Path,
         assert abs(rows.max() - bottom) <= 4.0, (k, bottom)
         assert abs(cols.min() - left) <= 4.0, (k, left)
         assert _colour_mask(img, COLOURS["web"], tol=60)[:, -1].sum() > 5  # off-screen
+
+
+@pytest.mark.browser
+def test_readout_follows_the_animation_in_chromium(tmp_path: Path, two_drum,
+                                                   two_drum_run) -> None:
+    """After a few seconds of (virtual) playback in headless Chromium the readout shows the
+    text of a later frame, exactly one of the frames' texts: the overlay script follows
+    meshcat's animation clock."""
+    _needs_chromium()
+    import html as html_lib
+    import re
+    import subprocess
+
+    from winder.viewer._export import CHROMIUM_FLAGS
+
+    page = export_html(WinderGraph(two_drum), two_drum_run, tmp_path / "td.html",
+                       playback=10.0, fps=10)
+    texts = _embedded_readout(page.read_text())
+    profile = tmp_path / "profile"
+    dom = subprocess.run([find_chromium(), *CHROMIUM_FLAGS, f"--user-data-dir={profile}",
+                          "--window-size=800,600", "--virtual-time-budget=4000",
+                          "--dump-dom", page.resolve().as_uri()],
+                         capture_output=True, text=True, timeout=120,
+                         env=dict(os.environ, HOME=str(profile))).stdout
+    shown = html_lib.unescape(re.search(r'<pre id="winder-readout">(.*?)</pre>', dom,
+                                        re.S).group(1))
+    assert shown in texts
+    assert texts.index(shown) > 5, shown  # it moved on from the first frame

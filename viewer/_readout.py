@@ -18,7 +18,7 @@ __all__ = ["readout_text", "with_readout", "READOUT_ID"]
 
 READOUT_ID = "winder-readout"
 
-_STYLE = (f"#{READOUT_ID} {{position: fixed; left: 10px; bottom: 10px; margin: 0; "
+_STYLE = (f"#{READOUT_ID} {{position: fixed; left: 10px; top: 10px; margin: 0; "
           "padding: 6px 9px; background: rgba(255,255,255,0.82); color: #111; "
           "font: 13px/1.3 monospace; white-space: pre; border-radius: 4px; "
           "pointer-events: none; z-index: 10;}}")
