@@ -142,8 +142,8 @@ class BodyMotion:
 @dataclass(frozen=True)
 class Motion:
     """Every body and nip of a machine at ``times`` [s]: ``bodies`` by name, nip normal
-    forces [N] by nip name (``None`` when the result has no such channel), the entry nip
-    ``(a, b)`` body names (``None`` without a web) and the entry drum's sense."""
+    forces [N] by nip name (``None`` when the result has no such channel) and the entry
+    nip's ``(a, b)`` body names (``None`` without a web)."""
 
     times: np.ndarray
     bodies: dict[str, BodyMotion]
