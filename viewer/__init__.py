@@ -1,6 +1,7 @@
-"""winder.viewer: meshcat scene graph, animation of results, standalone HTML, snapshots."""
+"""winder.viewer: meshcat scene graph of any machine of parts, animation of results with
+an on-screen readout, standalone HTML, snapshots."""
 
-from ._animation import AnimationPlan, animate, check_drawable, plan_animation
+from ._animation import AnimationPlan, animate, plan_animation
 from ._export import (
     export_html,
     find_chromium,
@@ -9,8 +10,11 @@ from ._export import (
     snapshot_names,
     snapshots,
 )
+from ._motion import BodyMotion, Motion, check_drawable, motion, web_path
+from ._readout import readout_text
 from ._scene_graph import COLOURS, COM_MARKER_GAIN, WinderGraph
 
-__all__ = ["AnimationPlan", "COLOURS", "COM_MARKER_GAIN", "WinderGraph", "animate",
-           "check_drawable", "export_html", "find_chromium", "plan_animation", "screenshot",
-           "snapshot_html", "snapshot_names", "snapshots"]
+__all__ = ["AnimationPlan", "BodyMotion", "COLOURS", "COM_MARKER_GAIN", "Motion",
+           "WinderGraph", "animate", "check_drawable", "export_html", "find_chromium",
+           "motion", "plan_animation", "readout_text", "screenshot", "snapshot_html",
+           "snapshot_names", "snapshots", "web_path"]

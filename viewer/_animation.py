@@ -1,11 +1,11 @@
 """Animation of a result: time compression and a spin rate that is visible, not aliased.
 
 Playback: the whole run in ``playback`` seconds (default 30 s) at ``fps`` frames per
-second. Rotation: a real roll turns at up to ~125 rad/s; sampled at 30 frames per second of
-compressed time it would alias into random jitter. Drawn angles are therefore the real
-angles times one gain ``spin_gain`` (same for drum and roll, so their ratio is kept),
+second. Rotation: a real roll turns at up to ~300 rad/s; sampled at 30 frames per second
+of compressed time it would alias into random jitter. Drawn angles are therefore the real
+angles times one gain ``spin_gain`` (same for every body, so their ratios are kept),
 chosen so that the fastest body turns at most ``max_turns_per_second`` (default 0.5)
-turns per second of playback. Radius, height and the drum are otherwise true.
+turns per second of playback. Radii, centres and the web are otherwise true.
 """
 
 from __future__ import annotations
@@ -19,37 +19,14 @@ from meshcat.animation import Animation
 
 from winder._errors import WinderError
 from winder._result import Result
+from winder._scene import Scene
 
-from ._scene_graph import WinderGraph
+from ._motion import Motion, body_channels, check_drawable, motion, scene_of
+from ._readout import readout_text
+from ._scene_graph import WinderGraph, apply_poses
 
-__all__ = ["AnimationPlan", "DRAWN_CHANNELS", "check_drawable", "plan_animation", "animate"]
-
-#: Channels the viewer draws (``drum_angle`` is optional: the drum is then still).
-DRAWN_CHANNELS = ("radius", "z", "roll_angle", "roll_speed", "drum_speed")
-
-
-def check_drawable(result: Result, where: str = "result") -> None:
-    """Raise :class:`~winder.WinderError` (prefixed by ``where``, e.g. the file) unless
-    ``result`` can be drawn: at least two samples on an increasing, finite time axis, the
-    channels of :data:`DRAWN_CHANNELS` present and finite, and the radius > 0."""
-    t = np.asarray(result.t, dtype=float)
-    if len(t) < 2:
-        raise WinderError(f"{where}: {len(t)} sample(s); the viewer needs at least 2")
-    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-        raise WinderError(f"{where}: the time axis is not finite and increasing")
-    missing = [c for c in DRAWN_CHANNELS if c not in result]
-    if missing:
-        raise WinderError(f"{where}: no channel {', '.join(missing)} (the viewer draws "
-                          f"{', '.join(DRAWN_CHANNELS)})")
-    for c in (*DRAWN_CHANNELS, *(("drum_angle",) if "drum_angle" in result else ())):
-        bad = np.flatnonzero(~np.isfinite(result[c]))
-        if len(bad):
-            raise WinderError(f"{where}: channel {c!r} is not finite at t = {t[bad[0]]:g} s "
-                              f"(sample {bad[0]}: {float(result[c][bad[0]])!r})")
-    small = np.flatnonzero(result["radius"] <= 0)
-    if len(small):
-        raise WinderError(f"{where}: radius {float(result['radius'][small[0]])!r} m at t = "
-                          f"{t[small[0]]:g} s; a roll radius is > 0")
+__all__ = ["AnimationPlan", "check_drawable", "plan_animation", "animate",
+           "animation_motion"]
 
 
 @dataclass(frozen=True)
@@ -68,43 +45,46 @@ class AnimationPlan:
 
 
 def plan_animation(result: Result, *, playback: float = 30.0, fps: int = 30,
-                   max_turns_per_second: float = 0.5) -> AnimationPlan:
-    """Frame times and spin gain of an animation of ``result`` (see the module text)."""
-    check_drawable(result)
+                   max_turns_per_second: float = 0.5,
+                   scene: Scene | None = None) -> AnimationPlan:
+    """Frame times and spin gain of an animation of ``result`` (see the module text);
+    ``scene`` defaults to the one stored in the result."""
+    check_drawable(result, scene=scene)
     if not (math.isfinite(playback) and playback > 0):
         raise WinderError(f"playback must be finite and > 0 [s], got {playback!r}")
     t = result.t
     n = max(2, int(round(playback * fps)) + 1)
     times = np.linspace(t[0], t[-1], n)
     compression = (t[-1] - t[0]) / playback
-    w_max = max(float(np.max(np.abs(result["roll_speed"]))),
-                float(np.max(np.abs(result["drum_speed"]))), 1e-9)
+    scene = scene_of(result, scene)
+    if scene is None:
+        speeds = ["roll_speed", "drum_speed"]
+    else:
+        from winder.core.machine import Machine
+
+        speeds = [body_channels(scene, b)["speed"] for b in Machine(scene).bodies]
+    w_max = max(max(float(np.max(np.abs(result[c]))) for c in speeds if c in result), 1e-9)
     gain = min(1.0, 2 * math.pi * max_turns_per_second / (w_max * compression))
     return AnimationPlan(times, fps, gain)
 
 
-def _sample(result: Result, name: str, times: np.ndarray) -> np.ndarray:
-    return np.interp(times, result.t, result[name])
+def animation_motion(graph: WinderGraph, result: Result, plan: AnimationPlan) -> Motion:
+    """The machine of ``graph`` at the frame times of ``plan`` (angles times the gain)."""
+    return motion(graph.scene, result, plan.times, spin_gain=plan.spin_gain)
 
 
 def animate(vis: meshcat.Visualizer, graph: WinderGraph, result: Result,
-            plan: AnimationPlan) -> None:
-    """Send the animation of ``result`` to ``vis`` (playing, looped)."""
-    times = plan.times
-    z = _sample(result, "z", times)
-    r = _sample(result, "radius", times)
-    phi = _sample(result, "roll_angle", times) * plan.spin_gain
-    drum = result["drum_angle"] if "drum_angle" in result else None
-    theta = (np.interp(times, result.t, drum) if drum is not None
-             else np.zeros_like(times)) * plan.spin_gain
+            plan: AnimationPlan) -> list[str]:
+    """Send the animation of ``result`` to ``vis`` (playing, looped); the camera frames
+    every body over the whole run. Returns the readout text of every frame."""
+    m = animation_motion(graph, result, plan)
     anim = Animation(default_framerate=plan.fps)
-    graph.show(vis, drum_angle=theta[0], z=z[0], roll_angle=phi[0], radius=r[0])
+    graph.set_camera(vis, m.extent())
+    graph.show(vis, m, 0)
     root = graph.root
-    for k in range(len(times)):
-        Td, Tr = graph.poses(theta[k], z[k], phi[k])
+    for k in range(len(m.times)):
         with anim.at_frame(vis, k) as frame:
-            frame[root]["drum"].set_transform(Td)
-            frame[root]["roll"].set_transform(Tr)
-            frame[root]["roll"]["paper"].set_property("scale", "vector3",
-                                                      [float(r[k]), 1.0, float(r[k])])
+            apply_poses(frame[root], graph.pose_commands(m, k),
+                        lambda node, v: node.set_property("scale", "vector3", v))
     vis.set_animation(anim, play=True, repetitions=1000)
+    return [readout_text(m, k) for k in range(len(m.times))]

@@ -22,7 +22,9 @@ from winder._files import atomic_write, scratch_dir
 from winder._interrupt import deferred, on_abort
 from winder._result import Result
 
-from ._animation import animate, check_drawable, plan_animation
+from ._animation import animate, plan_animation
+from ._motion import check_drawable, motion
+from ._readout import readout_text, with_readout
 from ._scene_graph import WinderGraph
 
 __all__ = ["export_html", "snapshot_html", "find_chromium", "screenshot", "snapshots",
@@ -68,19 +70,25 @@ def served(graph: WinderGraph) -> Iterator[meshcat.Visualizer]:
 
 def export_html(graph: WinderGraph, result: Result, path: str | Path, *,
                 playback: float = 30.0, fps: int = 30) -> Path:
-    """Write a standalone HTML file (three.js embedded, no network) that plays ``result``."""
-    plan = plan_animation(result, playback=playback, fps=fps)
+    """Write a standalone HTML file (three.js embedded, no network) that plays ``result``,
+    with the readout (:mod:`._readout`) of the frame shown."""
+    plan = plan_animation(result, playback=playback, fps=fps, scene=graph.scene)
     with served(graph) as vis:
-        animate(vis, graph, result, plan)
-        html = vis.static_html()
+        texts = animate(vis, graph, result, plan)
+        html = with_readout(vis.static_html(), texts, plan.fps)
     return atomic_write(path, lambda tmp: tmp.write_text(html, encoding="utf-8"))
 
 
-def snapshot_html(graph: WinderGraph, state: dict[str, float]) -> str:
-    """Static HTML of the winder at one state (keys drum_angle, z, roll_angle, radius)."""
+def snapshot_html(graph: WinderGraph, result: Result, t: float) -> str:
+    """Static HTML of the machine at time ``t`` [s] of ``result`` (true angles), with its
+    readout; the camera frames every body over the whole run."""
+    check_drawable(result, scene=graph.scene)
+    extent = motion(graph.scene, result, result.t).extent()
+    m = motion(graph.scene, result, np.array([t]))
     with served(graph) as vis:
-        graph.show(vis, **state)
-        return vis.static_html()
+        graph.set_camera(vis, extent)
+        graph.show(vis, m, 0)
+        return with_readout(vis.static_html(), [readout_text(m, 0)])
 
 
 def find_chromium() -> str | None:
@@ -156,18 +164,19 @@ def snapshots(graph: WinderGraph, result: Result, out_dir: str | Path, *, every:
               size: tuple[int, int] = (1000, 750)) -> list[Path]:
     """PNG images at t = 0, every, 2·every, … (like the paper's Figs. 9–16), named by
     :func:`snapshot_names`."""
-    check_drawable(result)
+    check_drawable(result, scene=graph.scene)
     plan = snapshot_names(float(result.t[-1]), every)
     out = Path(out_dir)
-    t = result.t
+    # one camera for all pictures (same scale in each): every body over the whole run
+    extent = motion(graph.scene, result, result.t).extent()
+    m = motion(graph.scene, result, np.array([ti for ti, _ in plan]))
     paths = []
     with scratch_dir("winder-snap-") as tmp, served(graph) as vis:
-        for k, (ti, name) in enumerate(plan):  # one meshcat server, re-posed for each page
-            def at(channel: str, ti: float = ti) -> float:
-                return float(np.interp(ti, t, result[channel]))
-            graph.show(vis, drum_angle=at("drum_angle") if "drum_angle" in result else 0.0,
-                       z=at("z"), roll_angle=at("roll_angle"), radius=at("radius"))
+        graph.set_camera(vis, extent)
+        for k, (_, name) in enumerate(plan):  # one meshcat server, re-posed for each page
+            graph.show(vis, m, k)
             page = tmp / f"page{k}.html"
-            page.write_text(vis.static_html(), encoding="utf-8")
+            page.write_text(with_readout(vis.static_html(), [readout_text(m, k)]),
+                            encoding="utf-8")
             paths.append(screenshot(page, out / name, size=size, wait_ms=1500))
     return paths

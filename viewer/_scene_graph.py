@@ -1,12 +1,19 @@
-"""meshcat scene graph of a winder: drum, roll (core, paper, face mark, CoM marker), floor.
+"""meshcat scene graph of any machine of parts: every drum, paper roll and rider roll as a
+cylinder along ``y`` with a radial mark (so that rotation shows), the web into its entry
+nip as a strip of segments, a floor and the far side frames.
 
-Placements come from the Pinocchio model's joint frames (``data.oMi``), never from
-re-derived formulas. The roll's paper grows by scaling its node (meshcat scales via the
-``scale`` property; set_transform's scale is dropped by animations in meshcat 0.3.2).
+Placements of the bodies come from the Pinocchio model of the machine
+(:class:`winder.core.machine.Machine`: per body prismatic ``x``/``z`` where free, then a
+revolute joint about ``+y``), posed by forward kinematics, never from re-derived formulas.
+A paper roll grows by scaling its ``paper`` node (meshcat scales via the ``scale``
+property; set_transform's scale is dropped by animations in meshcat 0.3.2); so does each
+web segment along its own ``x`` axis.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import meshcat
@@ -14,94 +21,195 @@ import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
 
-from winder._model import DRUM, ROLL, WinderModel
 from winder._scene import Scene
+from winder.core.machine import Machine
 
-__all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN"]
+from ._motion import WEB_ARC_POINTS, Motion
 
-#: Colours (hex RGB) of the parts; the browser test looks for them.
+__all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN", "WEB_THICKNESS", "FOV", "Pose",
+           "apply_poses"]
+
+#: Colours (hex RGB) of the parts; the browser tests look for them.
 COLOURS = {"drum": 0x3A6EA5, "paper": 0xF2E6C9, "core": 0x8B5A2B, "mark": 0xC0392B,
-           "com": 0x27AE60, "floor": 0x9E9E9E, "frame": 0x555555}
+           "com": 0x27AE60, "floor": 0x9E9E9E, "frame": 0x555555, "rider": 0x7D3C98,
+           "web": 0xD4AC0D}
 #: The CoM offset (1 mm) is drawn this many times larger so that it can be seen.
 COM_MARKER_GAIN = 100.0
+#: Drawn thickness of the web strip [m] (its centre line is the web's path).
+WEB_THICKNESS = 0.02
+#: Vertical field of view of meshcat's camera [deg] and the aspect the framing assumes.
+FOV, _ASPECT = 75.0, 4.0 / 3.0
+
+#: A pose command: ("transform", path, 4×4) or ("scale", path, [sx, sy, sz]); paths are
+#: relative to the graph's root.
+Pose = tuple[str, tuple[str, ...], object]
 
 
 @dataclass
 class WinderGraph:
-    """Builds the meshcat objects of a scene and poses them from a state.
+    """Builds the meshcat objects of a scene and poses them from a :class:`Motion`.
 
     Parameters
     ----------
-    scene: the winder scene (sizes). ``root`` is the meshcat path of the winder.
+    scene: the scene (parts and sizes). ``root`` is the meshcat path of the machine.
     """
 
     scene: Scene
     root: str = "winder"
 
     def __post_init__(self) -> None:
-        self.model = WinderModel(self.scene).model
+        self.machine = Machine(self.scene)
+        self.model = self.machine.model
         self.data = self.model.createData()
+        rolls = [b.part for b in self.machine.bodies if b.kind == "roll"]
+        #: Length of the drums [m]: the widest roll's width.
+        self.length = max((r.width for r in rolls), default=1.0)
+        drums = [b for b in self.machine.bodies if b.kind == "drum"] or self.machine.bodies
+        #: Height of the floor [m]: 0.35 m below the lowest drum.
+        self.floor_z = min(b.centre[1] - _radius0(b) for b in drums) - 0.35
+        entry = self.machine.entry
+        self.web_width = 1.12 * (entry.b.part.width if entry is not None else self.length)
 
     # ---- objects --------------------------------------------------------------------
     def build(self, vis: meshcat.Visualizer) -> None:
-        """Create all objects (unit-radius paper, scaled later) and the camera."""
-        s, root = self.scene, vis[self.root]
-        R, L = s.drum.radius, s.roll.width
-        rc = s.roll.core_radius
+        """Create all objects (unit-radius paper, unit-length web segments) and a camera
+        on the machine's initial layout."""
+        root, L = vis[self.root], self.length
         lam = g.MeshLambertMaterial
+        width = {b.name: b.part.width for b in self.machine.bodies if b.kind == "roll"}
         # meshcat cylinders lie along their local y axis: the machine's cross axis
-        root["drum"]["shell"].set_object(g.Cylinder(1.05 * L, R), lam(color=COLOURS["drum"]))
-        root["drum"]["mark"].set_object(g.Box([0.9 * R, 1.06 * L, 0.04 * R]),
-                                        lam(color=COLOURS["frame"]))
-        root["drum"]["mark"].set_transform(_translation([0.45 * R, 0.0, 0.0]))
-        root["roll"]["core"].set_object(g.Cylinder(1.08 * L, rc), lam(color=COLOURS["core"]))
-        root["roll"]["paper"].set_object(g.Cylinder(L, 1.0), lam(color=COLOURS["paper"]))
-        # a radial stripe on the face, child of the scaled paper: grows with the roll
-        root["roll"]["paper"]["mark"].set_object(g.Box([1.0, 1.01 * L, 0.06]),
+        for b in self.machine.bodies:
+            node = root[b.name]
+            if b.kind == "roll":
+                w, rc = b.part.width, b.part.core_radius
+                node["core"].set_object(g.Cylinder(1.08 * w, rc), lam(color=COLOURS["core"]))
+                node["paper"].set_object(g.Cylinder(w, 1.0), lam(color=COLOURS["paper"]))
+                # a radial stripe on the face, child of the scaled paper: grows with it
+                node["paper"]["mark"].set_object(g.Box([1.0, 1.01 * w, 0.06]),
                                                  lam(color=COLOURS["mark"]))
-        root["roll"]["paper"]["mark"].set_transform(_translation([0.5, 0.0, 0.0]))
-        root["roll"]["com"].set_object(g.Sphere(0.03), lam(color=COLOURS["com"]))
-        e = s.roll.com_offset if s.effects.imbalance else 0.0
-        root["roll"]["com"].set_transform(
-            _translation([COM_MARKER_GAIN * e, -0.56 * L, 0.0]))
-        # context: floor and the far side frame carrying the drum bearing (the near one
-        # would hide the nip from the camera)
-        floor_z = -R - 0.35
-        root["floor"].set_object(g.Box([4.0, 2.0 * L, 0.05]), lam(color=COLOURS["floor"]))
-        root["floor"].set_transform(_translation([0.0, 0.0, floor_z]))
-        root["frame"]["far"].set_object(g.Box([0.25, 0.08, -floor_z]),
-                                        lam(color=COLOURS["frame"]))
-        root["frame"]["far"].set_transform(_translation([0.0, 0.62 * L, floor_z / 2]))
+                node["paper"]["mark"].set_transform(_translation([0.5, 0.0, 0.0]))
+                node["com"].set_object(g.Sphere(0.03), lam(color=COLOURS["com"]))
+                e = b.part.com_offset if self.scene.effects.imbalance else 0.0
+                node["com"].set_transform(_translation([COM_MARKER_GAIN * e, -0.56 * w, 0.0]))
+                continue
+            R = b.part.radius
+            length = 1.05 * L if b.kind == "drum" else width.get(b.part.rides, L)
+            colour = COLOURS["drum"] if b.kind == "drum" else COLOURS["rider"]
+            node["shell"].set_object(g.Cylinder(length, R), lam(color=colour))
+            node["mark"].set_object(g.Box([0.9 * R, 1.01 * length + 0.01, 0.04 * R]),
+                                    lam(color=COLOURS["frame"]))
+            node["mark"].set_transform(_translation([0.45 * R, 0.0, 0.0]))
+        if self.machine.entry is not None:
+            for i in range(WEB_ARC_POINTS):
+                root["web"][f"s{i:02d}"]["strip"].set_object(
+                    g.Box([1.0, self.web_width, WEB_THICKNESS]), lam(color=COLOURS["web"]))
+        # context: floor and the far side frames carrying the drum bearings (the near ones
+        # would hide the nips from the camera)
+        # (a base plate 0.5 m wider than the drums: the web comes in past its edge)
+        drums = [b for b in self.machine.bodies if b.kind == "drum"] or self.machine.bodies
+        x0 = min(b.centre[0] - _radius0(b) for b in drums) - 0.5
+        x1 = max(b.centre[0] + _radius0(b) for b in drums) + 0.5
+        root["floor"].set_object(g.Box([x1 - x0, 1.2 * L, 0.05]),
+                                 lam(color=COLOURS["floor"]))
+        root["floor"].set_transform(_translation([0.5 * (x0 + x1), 0.0, self.floor_z]))
+        for b in self.machine.bodies:
+            if b.kind == "drum":
+                h = b.centre[1] - self.floor_z
+                root["frame"][b.name].set_object(g.Box([0.25, 0.08, h]),
+                                                 lam(color=COLOURS["frame"]))
+                root["frame"][b.name].set_transform(
+                    _translation([b.centre[0], 0.62 * L, self.floor_z + 0.5 * h]))
         vis["/Grid"].set_property("visible", False)
         vis["/Axes"].set_property("visible", False)
-        self.set_camera(vis)
+        self.set_camera(vis, self.initial_extent())
 
-    def set_camera(self, vis: meshcat.Visualizer, distance: float | None = None) -> None:
-        """Look along the cross-machine axis (world ``y``) at the nip region."""
-        s = self.scene
-        top = s.drum.radius + 2.0 * 0.9  # roll top at full size (r ≈ 0.84 m)
-        d = distance or 4.4
+    def initial_extent(self) -> tuple[float, float, float, float]:
+        """``(x_min, x_max, z_min, z_max)`` [m] of the bodies at their scene centres."""
+        xs = [v for b in self.machine.bodies
+              for v in (b.centre[0] - _radius0(b), b.centre[0] + _radius0(b))]
+        zs = [v for b in self.machine.bodies
+              for v in (b.centre[1] - _radius0(b), b.centre[1] + _radius0(b))]
+        return min(xs), max(xs), min(zs), max(zs)
+
+    def camera(self, extent: tuple[float, float, float, float]
+               ) -> tuple[float, float, float]:
+        """Camera ``(x, z, d)`` [m] framing ``extent`` (``x_min, x_max, z_min, z_max``
+        [m]) and the floor at a 4:3 aspect: it sits at ``(x, −d, z)`` in the machine's
+        coordinates and looks along ``+y`` with ``z`` up (vertical field of view 75°)."""
+        x0, x1, z0, z1 = extent
+        z0 = min(z0, self.floor_z)
+        half = max(0.5 * (z1 - z0), 0.5 * (x1 - x0) / _ASPECT) * 1.1 + 0.1
+        d = half / math.tan(math.radians(FOV / 2)) + 0.55 * self.length
+        return 0.5 * (x0 + x1), 0.5 * (z0 + z1), d
+
+    def set_camera(self, vis: meshcat.Visualizer,
+                   extent: tuple[float, float, float, float]) -> None:
+        """Point meshcat's camera as :meth:`camera` says. meshcat 0.3.2's orbit controls
+        always aim at the world origin, so the machine (the root node) is shifted by
+        ``(−x, 0, −z)`` and the camera sits at ``(0, −d, 0)``."""
+        x, z, d = self.camera(extent)
+        vis[self.root].set_transform(_translation([-x, 0.0, -z]))
+        vis["/Cameras/default"].set_transform(np.eye(4))
         # the camera node is in three.js coordinates (y up): world (x, y, z) → (x, z, −y)
-        vis["/Cameras/default"].set_transform(_translation([0.0, 0.0, 0.5 * top]))
         vis["/Cameras/default/rotated/<object>"].set_property("position", [0.0, 0.0, d])
 
     # ---- poses ----------------------------------------------------------------------
-    def poses(self, drum_angle: float, z: float, roll_angle: float
-              ) -> tuple[np.ndarray, np.ndarray]:
-        """World placements (4×4) of the drum and roll frames, from Pinocchio FK."""
-        q = np.array([drum_angle, z, roll_angle])
+    def poses(self, frame: dict[str, tuple[float, float, float]]) -> dict[str, np.ndarray]:
+        """World placements (4×4) of the bodies from ``frame`` = body name → centre ``x``,
+        ``z`` [m] and model angle ``θ`` about ``+y`` [rad], by Pinocchio FK."""
+        q = np.zeros(self.model.nq)
+        for b in self.machine.bodies:
+            x, z, theta = frame[b.name]
+            for coord, value in (("x", x), ("z", z), ("theta", theta)):
+                if coord in b.joints:
+                    q[self.model.joints[b.joints[coord]].idx_q] = value
         pin.forwardKinematics(self.model, self.data, q)
-        return (self.data.oMi[DRUM].homogeneous.copy(),
-                self.data.oMi[ROLL].homogeneous.copy())
+        return {b.name: self.data.oMi[b.joints["theta"]].homogeneous.copy()
+                for b in self.machine.bodies}
 
-    def show(self, vis: meshcat.Visualizer, *, drum_angle: float, z: float,
-             roll_angle: float, radius: float) -> None:
-        """Pose the graph at one state (live view, snapshots)."""
-        Td, Tr = self.poses(drum_angle, z, roll_angle)
-        root = vis[self.root]
-        root["drum"].set_transform(Td)
-        root["roll"].set_transform(Tr)
-        root["roll"]["paper"].set_property("scale", [radius, 1.0, radius])
+    def pose_commands(self, m: Motion, k: int) -> list[Pose]:
+        """What to set to show sample ``k`` of ``m``: body placements, paper scales, the
+        web's segments (placement, and length as the ``x`` scale of the unit strip)."""
+        bodies = m.bodies
+        T = self.poses({n: (b.x[k], b.z[k], b.theta[k]) for n, b in bodies.items()})
+        out: list[Pose] = []
+        for b in self.machine.bodies:
+            out.append(("transform", (b.name,), T[b.name]))
+            if b.kind == "roll":
+                r = float(bodies[b.name].radius[k])
+                out.append(("scale", (b.name, "paper"), [r, 1.0, r]))
+        path = m.web(k)
+        if path is not None:
+            for i, (p, q) in enumerate(zip(path[:-1], path[1:], strict=True)):
+                d = q - p
+                length = max(float(np.hypot(*d)), 1e-9)
+                S = pin.SE3(pin.utils.rotate("y", math.atan2(-d[1], d[0])),
+                            np.array([0.5 * (p[0] + q[0]), 0.0, 0.5 * (p[1] + q[1])]))
+                out.append(("transform", ("web", f"s{i:02d}"), S.homogeneous))
+                out.append(("scale", ("web", f"s{i:02d}", "strip"), [length, 1.0, 1.0]))
+        return out
+
+    def show(self, vis: meshcat.Visualizer, m: Motion, k: int) -> None:
+        """Pose the graph at sample ``k`` of ``m`` (live view, snapshots)."""
+        apply_poses(vis[self.root], self.pose_commands(m, k),
+                    lambda node, v: node.set_property("scale", v))
+
+
+def apply_poses(root, commands: list[Pose], scale: Callable[[object, list], None]) -> None:
+    """Send ``commands`` below ``root`` (a visualizer or an animation frame); ``scale``
+    sets a node's scale (the two APIs differ)."""
+    for kind, path, value in commands:
+        node = root
+        for part in path:
+            node = node[part]
+        if kind == "transform":
+            node.set_transform(value)
+        else:
+            scale(node, [float(v) for v in value])
+
+
+def _radius0(b) -> float:
+    return b.part.initial_radius if b.kind == "roll" else b.part.radius
 
 
 def _translation(p: list[float]) -> np.ndarray:

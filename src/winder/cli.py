@@ -199,7 +199,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
                 raise WinderError(f"--every: {exc}") from None
 
     scene, result = _load_for_view(args.source, check_span)
-    check_drawable(result, args.source)
+    check_drawable(result, args.source, scene=scene)
     check_span(float(result.t[-1]))
     graph = WinderGraph(scene)
     if html is not None:
@@ -215,7 +215,8 @@ def _cmd_view(args: argparse.Namespace) -> int:
         from winder.viewer._export import served
 
         with served(graph) as vis:
-            animate(vis, graph, result, plan_animation(result, playback=args.playback))
+            animate(vis, graph, result, plan_animation(result, playback=args.playback,
+                                                       scene=scene))
             print(f"live view at {vis.url()}  (Ctrl-C to stop)", flush=True)
             try:
                 while True:

@@ -1,0 +1,221 @@
+"""What a result says about where every body of a machine is: centres, angles, radii,
+speeds and nip forces at chosen times, read from the result's channels, and the path of
+the web into its entry nip.
+
+A scene of parts (machines spec §9) names its channels per body (``NAME_angle``,
+``NAME_speed``, ``NAME_x``/``NAME_z`` where free, ``NAME_radius`` for a paper roll) and
+per nip (``NIP_normal_force``); a scene in the old single-drum format keeps the names of
+winder-model §8 (``drum_angle``, ``drum_speed``, ``z``, ``roll_angle``, ``roll_speed``,
+``radius``, ``normal_force``). The model's rotation about ``+y`` of a body is
+``θ = sense · angle`` (spec §1).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from winder._errors import WinderError
+from winder._result import Result
+from winder._scene import Scene
+from winder.core.machine import Body, Machine
+
+__all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
+           "check_drawable", "scene_of", "motion", "web_path", "WEB_LEAD", "WEB_ARC_POINTS"]
+
+#: Length of the web's straight run drawn before it meets the entry drum [m] (off-screen).
+WEB_LEAD = 20.0
+#: Points on the web's arc around the entry drum (the last one is replaced by ``p_b``).
+WEB_ARC_POINTS = 25
+#: Where the web meets the entry drum: this far past the drum's lowest point, against the
+#: drum's motion [rad] (for sense +1 at the lower rear: the web comes from below, behind).
+WEB_MEET = math.radians(15.0)
+
+# old single-drum format (winder-model §8): role -> channel, per body name
+_LEGACY = {"drum": {"angle": "drum_angle", "speed": "drum_speed"},
+           "roll": {"z": "z", "angle": "roll_angle", "speed": "roll_speed",
+                    "radius": "radius"}}
+_LEGACY_NIP = "normal_force"
+
+
+def scene_of(result: Result, scene: Scene | None = None) -> Scene | None:
+    """``scene``, else the scene stored in ``result.meta["scene_dict"]``, else ``None``
+    (the result is then read with the single-drum channel names)."""
+    if scene is not None:
+        return scene
+    stored = result.meta.get("scene_dict")
+    if isinstance(stored, dict):
+        from winder._scene import scene_from_dict
+
+        return scene_from_dict(stored)
+    return None
+
+
+def _legacy(scene: Scene | None) -> bool:
+    return scene is None or bool(scene.legacy)
+
+
+def body_channels(scene: Scene | None, body: Body) -> dict[str, str]:
+    """Channel of each role (``x``, ``z``, ``angle``, ``speed``, ``radius``) of ``body``
+    that the result carries; a role without a channel is constant (fixed coordinate,
+    constant radius)."""
+    if _legacy(scene):
+        return dict(_LEGACY[body.kind])
+    roles = [*body.free, "angle", "speed", *(("radius",) if body.kind == "roll" else ())]
+    return {role: f"{body.name}_{role}" for role in roles}
+
+
+def nip_channels(scene: Scene | None, machine: Machine) -> dict[str, str]:
+    """Normal-force channel of every nip [N]."""
+    if _legacy(scene):
+        return {n.name: _LEGACY_NIP for n in machine.nips}
+    return {n.name: f"{n.name}_normal_force" for n in machine.nips}
+
+
+def _optional(scene: Scene | None, role: str, body: Body) -> bool:
+    # the old format's drum angle is optional (the drum is then drawn still)
+    return _legacy(scene) and body.kind == "drum" and role == "angle"
+
+
+def drawn_channels(scene: Scene | None, machine: Machine) -> list[str]:
+    """Channels the viewer needs (optional ones and nip forces excluded)."""
+    return [ch for b in machine.bodies for role, ch in body_channels(scene, b).items()
+            if not _optional(scene, role, b)]
+
+
+def check_drawable(result: Result, where: str = "result", scene: Scene | None = None
+                   ) -> None:
+    """Raise :class:`~winder.WinderError` (prefixed by ``where``, e.g. the file) unless
+    ``result`` can be drawn: at least two samples on an increasing, finite time axis, the
+    channels of :func:`drawn_channels` present and finite, and every roll radius > 0.
+    ``scene`` defaults to the one stored in the result; without one the single-drum
+    channel names are checked."""
+    t = np.asarray(result.t, dtype=float)
+    if len(t) < 2:
+        raise WinderError(f"{where}: {len(t)} sample(s); the viewer needs at least 2")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise WinderError(f"{where}: the time axis is not finite and increasing")
+    scene = scene_of(result, scene)
+    if scene is None:
+        required = [c for roles in _LEGACY.values() for c in roles.values()
+                    if c != "drum_angle"]
+        radii = ["radius"]
+    else:
+        m = Machine(scene)
+        required = drawn_channels(scene, m)
+        radii = [body_channels(scene, b)["radius"] for b in m.bodies if b.kind == "roll"]
+    missing = [c for c in required if c not in result]
+    if missing:
+        raise WinderError(f"{where}: no channel {', '.join(missing)} (the viewer draws "
+                          f"{', '.join(required)})")
+    optional = [c for c in ("drum_angle",) if _legacy(scene) and c in result]
+    for c in (*required, *optional):
+        bad = np.flatnonzero(~np.isfinite(result[c]))
+        if len(bad):
+            raise WinderError(f"{where}: channel {c!r} is not finite at t = {t[bad[0]]:g} s "
+                              f"(sample {bad[0]}: {float(result[c][bad[0]])!r})")
+    for c in radii:
+        small = np.flatnonzero(result[c] <= 0)
+        if len(small):
+            raise WinderError(f"{where}: {c} {float(result[c][small[0]])!r} m at t = "
+                              f"{t[small[0]]:g} s; a roll radius is > 0")
+
+
+@dataclass(frozen=True)
+class BodyMotion:
+    """One body at the sample times: centre ``x``, ``z`` [m], model angle ``theta`` about
+    ``+y`` [rad] (``sense · angle``), ``radius`` [m], ``speed`` [rad/s] (operation
+    sense)."""
+
+    name: str
+    kind: str
+    sense: int
+    x: np.ndarray
+    z: np.ndarray
+    theta: np.ndarray
+    radius: np.ndarray
+    speed: np.ndarray
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Every body and nip of a machine at ``times`` [s]: ``bodies`` by name, nip normal
+    forces [N] by nip name (``None`` when the result has no such channel) and the entry
+    nip's ``(a, b)`` body names (``None`` without a web)."""
+
+    times: np.ndarray
+    bodies: dict[str, BodyMotion]
+    normal_forces: dict[str, np.ndarray | None]
+    entry: tuple[str, str] | None
+
+    def web(self, k: int) -> np.ndarray | None:
+        """The web's path at sample ``k`` (:func:`web_path`), or ``None``."""
+        if self.entry is None:
+            return None
+        a, b = (self.bodies[n] for n in self.entry)
+        return web_path((a.x[k], a.z[k]), a.radius[k], a.sense, (b.x[k], b.z[k]),
+                        b.radius[k])
+
+    def extent(self) -> tuple[float, float, float, float]:
+        """``(x_min, x_max, z_min, z_max)`` [m] of every body over all samples."""
+        xs = [v for b in self.bodies.values() for v in (np.min(b.x - b.radius),
+                                                         np.max(b.x + b.radius))]
+        zs = [v for b in self.bodies.values() for v in (np.min(b.z - b.radius),
+                                                         np.max(b.z + b.radius))]
+        return float(min(xs)), float(max(xs)), float(min(zs)), float(max(zs))
+
+
+def motion(scene: Scene, result: Result, times: np.ndarray, *,
+           spin_gain: float = 1.0) -> Motion:
+    """The bodies of ``scene`` at ``times`` [s], interpolated linearly in ``result``;
+    drawn angles are the true ones times ``spin_gain``."""
+    times = np.asarray(times, dtype=float)
+    m = Machine(scene)
+
+    def sample(name: str) -> np.ndarray:
+        return np.interp(times, result.t, result[name])
+
+    bodies = {}
+    for b in m.bodies:
+        ch = body_channels(scene, b)
+        const = {"x": b.centre[0], "z": b.centre[1], "angle": 0.0, "speed": 0.0,
+                 "radius": b.part.radius if b.kind != "roll" else math.nan}
+
+        def get(role: str, ch: dict = ch, const: dict = const) -> np.ndarray:
+            if role in ch and ch[role] in result:
+                return sample(ch[role])
+            return np.full_like(times, const[role])
+        bodies[b.name] = BodyMotion(b.name, b.kind, b.sense, get("x"), get("z"),
+                                    b.sense * get("angle") * spin_gain, get("radius"),
+                                    get("speed"))
+    forces = {n: (sample(c) if c in result else None)
+              for n, c in nip_channels(scene, m).items()}
+    entry = (m.entry.a.name, m.entry.b.name) if m.entry is not None else None
+    return Motion(times, bodies, forces, entry)
+
+
+def web_path(c_a: tuple[float, float], r_a: float, sense_a: int,
+             c_b: tuple[float, float], r_b: float) -> np.ndarray:
+    """Points ``(x, z)`` [m] of the web entering the nip between drum ``a`` (centre
+    ``c_a``, radius ``r_a``, sense ``sense_a``) and roll ``b``: a straight run of
+    :data:`WEB_LEAD` coming tangentially from off-screen, meeting the drum
+    :data:`WEB_MEET` past its lowest point, wrapping it in its direction of motion
+    (``θ̇ = sense · speed > 0``: clockwise seen from ``−y``) up to the nip direction
+    ``n = (c_b − c_a)/|c_b − c_a|``, ending at the roll's contact point
+    ``p_b = c_b − r_b n`` (machines spec §2)."""
+    ca, cb = np.asarray(c_a, dtype=float), np.asarray(c_b, dtype=float)
+    d = cb - ca
+    n = d / max(float(np.hypot(*d)), 1e-12)
+    s = 1.0 if sense_a >= 0 else -1.0
+    alpha_n = math.atan2(n[1], n[0])
+    alpha_s = -0.5 * math.pi - s * WEB_MEET
+    wrap = (s * (alpha_s - alpha_n)) % (2.0 * math.pi)
+    alpha = alpha_s - s * wrap * np.linspace(0.0, 1.0, WEB_ARC_POINTS)
+    arc = ca + r_a * np.column_stack([np.cos(alpha), np.sin(alpha)])
+    arc[-1] = cb - r_b * n
+    # travel direction of the drum surface at the meeting point (θ̇ > 0 about +y moves
+    # the point at angle α along (sin α, −cos α))
+    travel = s * np.array([math.sin(alpha_s), -math.cos(alpha_s)])
+    return np.vstack([arc[0] - WEB_LEAD * travel, arc])

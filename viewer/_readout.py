@@ -1,0 +1,70 @@
+"""On-screen readout: time, roll radii, body speeds and nip normal forces, as an HTML
+overlay on meshcat's page.
+
+meshcat 0.3.2 animates only numeric properties of objects, so the text is not part of the
+3-D scene: the page gets a ``<div id="winder-readout">`` and, for an animation, one text
+per frame and a script that shows the text of the frame the animation is at
+(``viewer.animator.time`` [s of playback] times the frame rate).
+"""
+
+from __future__ import annotations
+
+import html
+import json
+
+from ._motion import Motion
+
+__all__ = ["readout_text", "with_readout", "READOUT_ID"]
+
+READOUT_ID = "winder-readout"
+
+_STYLE = (f"#{READOUT_ID} {{position: fixed; left: 10px; top: 10px; margin: 0; "
+          "padding: 6px 9px; background: rgba(255,255,255,0.82); color: #111; "
+          "font: 13px/1.3 monospace; white-space: pre; border-radius: 4px; "
+          "pointer-events: none; z-index: 10;}}")
+
+
+def readout_text(m: Motion, k: int) -> str:
+    """The readout of sample ``k`` of ``m``: ``t`` [s]; per paper roll its radius [m];
+    per body its speed [rad/s] and surface speed [m/s]; per nip its normal force [kN]."""
+    lines = [f"t  {m.times[k]:10.2f} s"]
+    width = max(len(n) for n in (*m.bodies, *m.normal_forces))
+    for b in m.bodies.values():
+        if b.kind == "roll":
+            lines.append(f"{b.name:<{width}}  r {b.radius[k]:8.4f} m")
+    for b in m.bodies.values():
+        w = b.speed[k]
+        lines.append(f"{b.name:<{width}}  {w:8.2f} rad/s {w * b.radius[k]:7.2f} m/s")
+    for name, f in m.normal_forces.items():
+        value = "      -" if f is None else f"{f[k] / 1e3:8.3f}"
+        lines.append(f"{name:<{width}}  N {value} kN")
+    return "\n".join(lines)
+
+
+def with_readout(page: str, texts: list[str], fps: int | None = None) -> str:
+    """``page`` (meshcat's static HTML) with the readout overlay: ``texts[0]`` fixed
+    (``fps`` None) or ``texts[k]`` while the animation shows frame ``k``."""
+    first = html.escape(texts[0])
+    parts = [f"<style>{_STYLE}</style>", f'<pre id="{READOUT_ID}">{first}</pre>']
+    if fps is not None and len(texts) > 1:
+        data = json.dumps(texts).replace("</", "<\\/")
+        parts.append(
+            "<script>(function () {\n"
+            f"  var texts = {data}, fps = {int(fps)};\n"
+            f"  var el = document.getElementById('{READOUT_ID}');\n"
+            "  function tick() {\n"
+            "    var k = 0;\n"
+            "    if (typeof viewer !== 'undefined' && viewer.animator) {\n"
+            "      k = Math.round(viewer.animator.time * fps);\n"
+            "    }\n"
+            "    k = Math.max(0, Math.min(texts.length - 1, k));\n"
+            "    if (el.textContent !== texts[k]) { el.textContent = texts[k]; }\n"
+            "    window.requestAnimationFrame(tick);\n"
+            "  }\n"
+            "  tick();\n"
+            "})();</script>")
+    overlay = "\n".join(parts)
+    at = page.rfind("</body>")
+    if at < 0:
+        return page + overlay
+    return page[:at] + overlay + "\n" + page[at:]
