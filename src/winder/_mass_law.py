@@ -13,6 +13,7 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -21,24 +22,23 @@ from ._args import number
 from ._errors import ArgumentError, ModelError
 from ._scene import max_com_offset
 
-__all__ = ["MassLaw", "MassProperties", "FunctionMassLaw", "PaperRollLaw", "skew",
-           "spatial_inertia_matrix"]
+__all__ = ["MassLaw", "MassProperties", "FunctionMassLaw", "PaperRollLaw", "paper_roll_mass",
+           "skew"]
+
+
+def paper_roll_mass(r: Any, core_radius: Any, core_mass: Any, core_inertia: Any,
+                    k: Any) -> tuple[Any, Any, Any, Any]:
+    """``(m, J, dm/dr, dJ/dr)`` of a paper roll of radius ``r`` [m] (winder-model §2):
+    ``k = π ρ L`` [kg/m³·m]; ``J`` about the roll axis [kg·m²]. Plain arithmetic: floats
+    or CasADi symbols (the generated code of every machine uses it)."""
+    rc2, r2 = core_radius * core_radius, r * r
+    return (core_mass + k * (r2 - rc2), core_inertia + 0.5 * k * (r2 * r2 - rc2 * rc2),
+            2.0 * k * r, 2.0 * k * r2 * r)
 
 
 def skew(x: np.ndarray) -> np.ndarray:
     """Cross-product matrix ``[x]`` with ``[x] y = x × y``."""
     return np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
-
-
-def spatial_inertia_matrix(mass: float, com: np.ndarray, inertia_c: np.ndarray) -> np.ndarray:
-    """6×6 spatial inertia (Pinocchio order: linear, angular) about the frame origin."""
-    C = skew(com)
-    Y = np.empty((6, 6))
-    Y[:3, :3] = mass * np.eye(3)
-    Y[:3, 3:] = -mass * C
-    Y[3:, :3] = mass * C
-    Y[3:, 3:] = inertia_c - mass * C @ C
-    return Y
 
 
 @dataclass(frozen=True)
@@ -145,9 +145,9 @@ class PaperRollLaw(MassLaw):
 
     The laws are defined for ``r >= r_c`` (finite): :meth:`mass`, :meth:`polar_inertia`,
     their derivatives, :meth:`properties`, :meth:`inertia` and :meth:`rate` raise
-    :class:`~winder.ArgumentError` for any other ``r``. The fast paths :meth:`scalars`,
-    :meth:`write_inertia` and :meth:`rate_into` do not check (an integrator's trial states
-    may probe a little below the core, where the polynomials continue smoothly).
+    :class:`~winder.ArgumentError` for any other ``r``. The fast path :meth:`scalars` does
+    not check (an integrator's trial states may probe a little below the core, where the
+    polynomials continue smoothly).
     """
 
     core_radius: float
@@ -182,12 +182,9 @@ class PaperRollLaw(MassLaw):
     # scalar laws (fast path used by the winder) ---------------------------------------
     def scalars(self, r: float) -> tuple[float, float, float, float]:
         """Fast path, unchecked: ``(m, J, dm/dr, dJ/dr)`` at ``r`` [kg, kg·m², kg/m,
-        kg·m]."""
-        k = math.pi * self.density * self.width
-        rc2, r2 = self.core_radius**2, r * r
-        return (self.core_mass + k * (r2 - rc2),
-                self.core_inertia + 0.5 * k * (r2 * r2 - rc2 * rc2),
-                2.0 * k * r, 2.0 * k * r2 * r)
+        kg·m] (:func:`paper_roll_mass`, the law the machines use)."""
+        return paper_roll_mass(r, self.core_radius, self.core_mass, self.core_inertia,
+                               math.pi * self.density * self.width)
 
     def mass(self, r: float) -> float:
         """``m(r)`` [kg]."""
@@ -205,13 +202,6 @@ class PaperRollLaw(MassLaw):
         """``dJ/dr`` [kg·m]."""
         return self.scalars(self._radius("polar_inertia_derivative", r))[3]
 
-    def write_inertia(self, r: float, Y: pin.Inertia) -> None:
-        """Fast path, unchecked: overwrite mass and rotational inertia of ``Y`` (lever
-        ``(e,0,0)`` must already be set) with ``Y(r)``."""
-        m, J, _, _ = self.scalars(r)
-        Y.mass = m
-        Y.inertia = np.diag(self._about_com(m, J))
-
     def _about_com(self, m: float, J: float) -> tuple[float, float, float]:
         """Diagonal of the rotational inertia about the centre of mass [kg·m²] from ``m``
         and ``J`` (linear in both: the same map takes ``(dm/dr, dJ/dr)`` to its
@@ -219,19 +209,6 @@ class PaperRollLaw(MassLaw):
         It = 0.5 * J + m * self.width**2 / 12.0
         me2 = m * self.com_offset**2
         return It, J - me2, It - me2
-
-    def rate_into(self, r: float, r_dot: float, out: np.ndarray) -> None:
-        """Fast path, unchecked: write ``Ẏ = dY/dr · ṙ`` into the 6×6 array ``out`` (only
-        the structurally non-zero entries are written; the others must be zero)."""
-        _, _, dm, dJ = self.scalars(r)
-        dm, dJ = dm * r_dot, dJ * r_dot
-        dIt = self._about_com(dm, dJ)[0]  # transverse, about the roll axis
-        dme = dm * self.com_offset
-        out[0, 0] = out[1, 1] = out[2, 2] = dm
-        out[1, 5] = out[5, 1] = dme
-        out[2, 4] = out[4, 2] = -dme
-        out[3, 3] = out[5, 5] = dIt
-        out[4, 4] = dJ
 
     def properties(self, r: float) -> MassProperties:
         m, J, dm, dJ = self.scalars(self._radius("properties", r))

@@ -134,11 +134,6 @@ class VariableMassModel:
         j = self._check_joint(joint_id)
         return self._rates.get(j, np.zeros((6, 6))).copy()
 
-    @property
-    def variable_joints(self) -> tuple[int, ...]:
-        """Joints whose body currently has a non-zero rate ``Ẏ``."""
-        return tuple(sorted(self._rates))
-
     # forces ----------------------------------------------------------------------------
     def _check_fext(self, fext: Sequence[pin.Force] | None) -> Sequence[pin.Force]:
         if fext is None:

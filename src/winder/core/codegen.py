@@ -7,7 +7,7 @@ generated as C, wrapped with flat entry points ``int NAME(const double* t, const
 x, const double* p, const double* m, double* out)`` and compiled with the system C
 compiler. The cache key is everything that changes the generated code: the machine's
 structure (:meth:`~winder.core.machine.Machine.structure_key`), the source of the physics
-(:mod:`winder.core`, :mod:`winder.forces`), the CasADi version and the compiler flags.
+(:mod:`winder.core`, :mod:`winder.forces`, the mass law), the CasADi version and the compiler flags.
 Writes are atomic (a temporary file, then ``os.replace``), so processes building the same
 model at once all succeed. Parameter values are run-time inputs: changing one compiles
 nothing.
@@ -55,10 +55,12 @@ def cache_dir() -> Path:
 def _source_hash() -> str:
     h = hashlib.sha256()
     root = Path(__file__).resolve().parent.parent
+    files = [root / "_mass_law.py"]
     for sub in ("core", "forces"):
-        for f in sorted([*(root / sub).glob("*.py"), *(root / sub).glob("*.cpp")]):
-            h.update(f.name.encode())
-            h.update(f.read_bytes())
+        files += sorted([*(root / sub).glob("*.py"), *(root / sub).glob("*.cpp")])
+    for f in files:
+        h.update(f.name.encode())
+        h.update(f.read_bytes())
     return h.hexdigest()
 
 
@@ -66,9 +68,16 @@ _SOURCE: str | None = None
 
 
 def _compiler() -> str:
-    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    """The C compiler: ``$CC``, else ``cc`` or ``gcc`` on the PATH."""
+    env = os.environ.get("CC")
+    if env:
+        cc = shutil.which(env)
+        if cc is None:
+            raise CompilerMissing(f"the C compiler CC={env!r} is not found")
+        return cc
+    cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
-        raise CompilerMissing("no C compiler (cc or gcc) on PATH")
+        raise CompilerMissing("no C compiler (cc or gcc) on the PATH")
     return cc
 
 

@@ -33,22 +33,14 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from .._mass_law import paper_roll_mass
+
 __all__ = ["Machine", "Body", "Nip", "Evaluation", "AUTO", "FREE", "IN_CONTACT", "CORE_AUTO",
-           "WINDING", "AT_CORE", "paper_roll_mass"]
+           "WINDING", "AT_CORE"]
 
 AUTO, FREE, IN_CONTACT = -1, 0, 1
 CORE_AUTO, WINDING, AT_CORE = -1, 0, 1
 _COORDS = ("x", "z")
-
-
-def paper_roll_mass(r: Any, core_radius: Any, core_mass: Any, core_inertia: Any,
-                    k: Any) -> tuple[Any, Any, Any, Any]:
-    """``(m, J, dm/dr, dJ/dr)`` of a paper roll of radius ``r`` [m] (winder-model §2):
-    ``k = π ρ L`` [kg/m³·m]; ``J`` about the roll axis [kg·m²]. Plain arithmetic: floats
-    or CasADi symbols."""
-    rc2, r2 = core_radius * core_radius, r * r
-    return (core_mass + k * (r2 - rc2), core_inertia + 0.5 * k * (r2 * r2 - rc2 * rc2),
-            2.0 * k * r, 2.0 * k * r2 * r)
 
 
 @dataclass
