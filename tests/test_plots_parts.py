@@ -49,6 +49,7 @@ def _drawn(monkeypatch: pytest.MonkeyPatch) -> dict[str, list[tuple[str, dict]]]
                                               np.asarray(ln.get_ydata(), float))
                              for ln in a.get_lines() if not ln.get_label().startswith("_")})
             for a in fig.axes]
+        drawn[Path(path).name + ":ylim"] = [(a.get_ylim(), ()) for a in fig.axes]
         return save(fig, path)
 
     monkeypatch.setattr(_plots, "_save", capture)
@@ -63,6 +64,7 @@ def test_parts_figures_draw_the_channels(short_run, two_drum, tmp_path, monkeypa
     names = [f"{stem}_{k}.png" for k in ("drums", "rolls", "nip_forces", "positions", "slip")]
     assert [p.name for p in paths] == names
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
+    assert len(drawn) == 2 * len(names)
     assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in paths)
     r, t = short_run, short_run.t
 
@@ -97,6 +99,9 @@ def test_parts_figures_draw_the_channels(short_run, two_drum, tmp_path, monkeypa
         same(lines[lab], f / 1e3)
         np.testing.assert_allclose(lines["mean over 0.5 s"][1], mean(f) / 1e3, rtol=1e-12)
     assert set(closeup) == set(labels.values())
+    top = max(r[f"{n}_normal_force"].max() for n in labels) / 1e3
+    for (lo, hi), _ in drawn[names[2] + ":ylim"][:3]:  # one scale with 0 and every nip
+        assert lo <= 0.0 and top <= hi <= 1.1 * top
     coords = drawn[names[3]]
     assert [next(iter(lines)) for _, lines in coords] == ["set x", "set z", "rider z"]
     for _, lines in coords:
@@ -122,9 +127,13 @@ def test_parts_figures_find_their_scene_in_the_result(short_run, tmp_path) -> No
 # ---- run summary: static balance; a scene with none -----------------------------------------
 def test_run_prints_the_static_balance(tmp_path, capsys) -> None:
     out = tmp_path / "r.npz"
-    assert main(["run", str(TWO_DRUM), "--out", str(out), "--t-end", "0.05"]) == 0
+    plots = tmp_path / "plots"
+    assert main(["run", str(TWO_DRUM), "--out", str(out), "--t-end", "0.05", "--plots",
+                 str(plots)]) == 0
     meta = winder.load_result(out).meta
     text = capsys.readouterr().out
+    figures = sorted(plots.iterdir())
+    assert len(figures) == 5 and all(f"  figure {p}" in text for p in figures)
     assert (f"initial static balance: residual {meta['static_residual']:.1e} N of "
             f"{meta['static_scale']:.1e} N") in text
     # the balance carries the set, rider and rider load: scale ≥ the set's core weight
@@ -183,11 +192,12 @@ tension = 1000.0
 
 def test_no_static_balance_names_the_body(tmp_path, capsys) -> None:
     """A light roll free in x and z on one drum, pulled along the tangent by a web tension
-    of 1000 N above its weight (40.4 kg · 9.81 = 396 N): no position on the drum balances
-    it (m g sin φ = T has no solution)."""
+    of 1000 N above its weight (core only, 40 kg · 9.81 = 392 N): no position on the drum
+    balances it (m g sin φ = T has no solution); the residual left is the tension."""
     path = tmp_path / "no_balance.toml"
     path.write_text(NO_BALANCE)
-    with pytest.raises(EquilibriumError, match=r"body 'set'") as info:
+    with pytest.raises(EquilibriumError, match=r"body 'set' along x: force residual -1e\+03 N") \
+            as info:
         winder.simulate(path)
     assert isinstance(info.value, ValueError)
     out = tmp_path / "r.npz"

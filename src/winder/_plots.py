@@ -257,7 +257,9 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
         ax[i].legend(fontsize=8, loc="upper left")
         if i:
             ax[i].sharex(ax[0])
-            ax[i].sharey(ax[0])
+    top = max([float(np.max(f)) / 1e3 for f in forces.values()] + [0.0])
+    for a in ax[:-1]:  # one scale, from 0 (nip open) to the largest force of any nip
+        a.set_ylim(-0.04 * top - 1e-3, 1.06 * top + 1e-3)
     ax[len(forces) - 1].set_xlabel("t [s]")
     opens = [(tt, n) for n, f in forces.items() if (tt := _first_open(t, f)) is not None]
     if opens:
