@@ -205,7 +205,8 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     ``STEM_rolls.png``: speed and radius of every paper roll (and the rider speeds);
     ``STEM_nip_forces.png``: a row per nip with its normal force and its mean over 0.5 s,
     then a close-up of the first opening of a nip; ``STEM_positions.png``: a row per free
-    coordinate (``x``, ``z``) of every body; ``STEM_slip.png``: a row per nip with its slip
+    coordinate (``x``, ``z``) of every body, each ``z`` followed by its bounce (``z`` less
+    its mean over 0.5 s, in mm); ``STEM_slip.png``: a row per nip with its slip
     velocity. ``STEM`` is the scene name made file-safe; part names appear only in
     titles and legends. A nip keeps its colour in every figure. Returns the paths.
     """
@@ -283,12 +284,21 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     coords = [(b.name, c) for b in (*scene.drums, *scene.rolls, *scene.riders)
               for c in ("x", "z") if f"{b.name}_{c}" in result]
     if coords:
-        fig, ax = _rows(len(coords))
-        for i, (body, c) in enumerate(coords):
-            _panel(ax[i], t, [(f"{body} {c}", result[f"{body}_{c}"])], f"{c} [m]",
+        heights = [c for _, c in coords if c == "z"]
+        fig, ax = _rows(len(coords) + len(heights), 2.0)
+        i = 0
+        for body, c in coords:
+            y = result[f"{body}_{c}"]
+            _panel(ax[i], t, [(f"{body} {c}", y)], f"{c} [m]",
                    (f"{name}: free coordinates [m]\n" if i == 0 else "")
                    + f"{body}: {'horizontal' if c == 'x' else 'vertical'} position {c} [m]",
                    lw=0.5)
+            i += 1
+            if c == "z":  # the rise with the radius hides the bounce: show it apart
+                _panel(ax[i], t, [(f"{body} z − mean", 1e3 * (y - np.interp(
+                    t, *window_mean(t, y))))], "[mm]",
+                    f"{body}: bounce, z less its mean over 0.5 s [mm]", lw=0.4)
+                i += 1
         ax[-1].set_xlabel("t [s]")
         paths.append(_save(fig, out / f"{stem}_positions.png"))
 
