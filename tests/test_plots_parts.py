@@ -134,7 +134,7 @@ def test_parts_figures_find_their_scene_in_the_result(short_run, tmp_path) -> No
 # ---- run summary: static balance; a scene with none -----------------------------------------
 def test_run_prints_the_static_balance(tmp_path, capsys) -> None:
     out = tmp_path / "r.npz"
-    plots = tmp_path / "plots"
+    plots = tmp_path / "plots"  # a run shorter than the 0.5 s windows of the means
     assert main(["run", str(TWO_DRUM), "--out", str(out), "--t-end", "0.05", "--plots",
                  str(plots)]) == 0
     meta = winder.load_result(out).meta

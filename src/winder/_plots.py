@@ -184,9 +184,10 @@ def _first_open(t: np.ndarray, force: np.ndarray) -> float | None:
 def window_mean(t: np.ndarray, y: np.ndarray, window: float = 0.5
                 ) -> tuple[np.ndarray, np.ndarray]:
     """``(mid time, mean)`` of ``y`` over consecutive windows of ``window`` [s] (the
-    samples left over at the end are dropped)."""
+    samples left over at the end are dropped; a run shorter than one window is one
+    window)."""
     dt = float(np.median(np.diff(t))) if len(t) > 1 else window
-    w = max(1, int(round(window / dt)))
+    w = max(1, min(int(round(window / dt)), len(t)))
     n = len(t) // w
     return t[:n * w].reshape(n, w).mean(axis=1), y[:n * w].reshape(n, w).mean(axis=1)
 
