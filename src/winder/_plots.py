@@ -1,4 +1,5 @@
-"""The paper's figures from a result (matplotlib, PNG)."""
+"""Figures from a result (matplotlib, PNG): the paper's figures for a single-drum scene,
+the machine figures for a scene of parts (drums, rolls, nips, free coordinates)."""
 
 from __future__ import annotations
 
@@ -15,7 +16,8 @@ from ._files import atomic_write, safe_stem  # noqa: E402
 from ._result import Result  # noqa: E402
 from ._scene import Scene  # noqa: E402
 
-__all__ = ["paper_figures", "campbell_figure", "normal_force_envelope"]
+__all__ = ["paper_figures", "machine_figures", "campbell_figure", "normal_force_envelope",
+           "window_mean"]
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
@@ -46,8 +48,11 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     (Fig. 6), roll angular velocity + acceleration (Fig. 7), nip normal force with a
     close-up of the first lift-off (Fig. 8; ``closeup`` is a finely sampled result of
     that window, re-simulated from ``scene`` when not given). Without contact: the free
-    spin ω with the conserved ``J ω`` (Fig. 2).
+    spin ω with the conserved ``J ω`` (Fig. 2). A result of a scene of parts gets
+    :func:`machine_figures` instead.
     """
+    if "normal_force" not in result:  # a scene of parts: channels of machines.md §9
+        return machine_figures(result, out_dir, scene=scene)
     out = Path(out_dir)
     name = _label(result.meta.get("scene", "result"))  # for titles
     stem = safe_stem(result.meta.get("scene", "result"))  # no scene text picks the directory
@@ -146,6 +151,167 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     for a in ax:
         a.grid(True, alpha=0.3)
     paths.append(_save(fig, out / f"{stem}_fig8_normal_force.png"))
+    return paths
+
+
+def _parts_scene(result: Result, scene: Scene | None) -> Scene:
+    """The scene of ``result``: ``scene`` or the one stored in its meta."""
+    if scene is not None:
+        return scene
+    from ._scene import scene_from_dict
+
+    return scene_from_dict(result.meta["scene_dict"])
+
+
+def _panel(ax: plt.Axes, t: np.ndarray, lines: list[tuple[str, np.ndarray]], ylabel: str,
+           title: str, *, lw: float = 0.8, colors: list[str] | None = None) -> None:
+    """One axes: a line per ``(label, values)``, legend naming the parts."""
+    for i, (label, y) in enumerate(lines):
+        ax.plot(t, y, lw=lw, label=label, color=None if colors is None else colors[i])
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, alpha=0.3)
+    if lines:
+        ax.legend(fontsize=8, loc="best")
+
+
+def _first_open(t: np.ndarray, force: np.ndarray) -> float | None:
+    """First time [s] a nip carries no force (open), or None."""
+    idx = np.flatnonzero(force <= 0.0)
+    return float(t[idx[0]]) if len(idx) else None
+
+
+def window_mean(t: np.ndarray, y: np.ndarray, window: float = 0.5
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """``(mid time, mean)`` of ``y`` over consecutive windows of ``window`` [s] (the
+    samples left over at the end are dropped; a run shorter than one window is one
+    window)."""
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else window
+    w = max(1, min(int(round(window / dt)), len(t)))
+    n = len(t) // w
+    return t[:n * w].reshape(n, w).mean(axis=1), y[:n * w].reshape(n, w).mean(axis=1)
+
+
+def _rows(n: int, height: float = 2.3) -> tuple[plt.Figure, np.ndarray]:
+    fig, axes = plt.subplots(n, 1, figsize=(9, 1.6 + height * n), sharex=True, squeeze=False)
+    return fig, axes[:, 0]
+
+
+def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = None
+                    ) -> list[Path]:
+    """Figures of a run of a scene of parts (channels of machines.md §9) into ``out_dir``.
+
+    ``STEM_drums.png``: the speed of every drum, then a row per drum with its torque and
+    its mean over 0.5 s;
+    ``STEM_rolls.png``: speed and radius of every paper roll (and the rider speeds);
+    ``STEM_nip_forces.png``: a row per nip with its normal force and its mean over 0.5 s,
+    then a close-up of the first opening of a nip; ``STEM_positions.png``: a row per free
+    coordinate (``x``, ``z``) of every body, each ``z`` followed by its bounce (``z`` less
+    its mean over 0.5 s, in mm); ``STEM_slip.png``: a row per nip with its slip
+    velocity. ``STEM`` is the scene name made file-safe; part names appear only in
+    titles and legends. A nip keeps its colour in every figure. Returns the paths.
+    """
+    scene = _parts_scene(result, scene)
+    out = Path(out_dir)
+    name = _label(result.meta.get("scene", scene.name))
+    stem = safe_stem(result.meta.get("scene", scene.name))
+    t = result.t
+    paths: list[Path] = []
+    color = {n.name: f"C{i % 10}" for i, n in enumerate(scene.nips)}
+    nip_label = {n.name: f"nip {n.name} ({n.a}–{n.b})" for n in scene.nips}
+
+    # drums: speeds, then one torque row per drum
+    fig, ax = _rows(1 + len(scene.drums))
+    _panel(ax[0], t, [(f"drum {d.name}", result[f"{d.name}_speed"]) for d in scene.drums],
+           "speed Ω [rad/s]", f"{name}: drum speeds [rad/s]")
+    for a, d in zip(ax[1:], scene.drums, strict=True):
+        _panel(a, t, [(f"drum {d.name}", result[f"{d.name}_torque"] / 1e3)], "torque [kN m]",
+               f"drum {d.name}: drive torque [kN m]", lw=0.4)
+        a.plot(*window_mean(t, result[f"{d.name}_torque"] / 1e3), color="k", lw=0.8,
+               label="mean over 0.5 s")
+        a.legend(fontsize=8, loc="upper left")
+        a.axhline(0.0, color="k", lw=0.5)
+    ax[-1].set_xlabel("t [s]")
+    paths.append(_save(fig, out / f"{stem}_drums.png"))
+
+    # rolls: speed and radius
+    fig, ax = _rows(2, 3.0)
+    _panel(ax[0], t, [(f"roll {r.name}", result[f"{r.name}_speed"]) for r in scene.rolls]
+           + [(f"rider {r.name}", result[f"{r.name}_speed"]) for r in scene.riders],
+           "speed ω [rad/s]", f"{name}: roll and rider speeds [rad/s]")
+    _panel(ax[1], t, [(f"roll {r.name}", result[f"{r.name}_radius"]) for r in scene.rolls],
+           "radius r [m]", "paper roll radii [m]")
+    ax[1].set_xlabel("t [s]")
+    paths.append(_save(fig, out / f"{stem}_rolls.png"))
+
+    # nips: one row per nip (same scale), then a close-up of the first opening
+    forces = {n.name: result[f"{n.name}_normal_force"] for n in scene.nips}
+    fig, axes = plt.subplots(len(forces) + 1, 1, figsize=(9, 3.2 + 2.3 * len(forces)),
+                             squeeze=False)
+    ax = axes[:, 0]
+    for i, (n, f) in enumerate(forces.items()):
+        _panel(ax[i], t, [(nip_label[n], f / 1e3)], "F_n [kN]",
+               (f"{name}: nip normal forces [kN] (F_n = 0: nip open)\n" if i == 0 else "")
+               + f"{nip_label[n]}: {np.mean(f <= 0.0):.1%} of samples open", lw=0.4,
+               colors=[color[n]])
+        tm, fm = window_mean(t, f / 1e3)
+        ax[i].plot(tm, fm, color="k", lw=0.8, label="mean over 0.5 s")
+        ax[i].legend(fontsize=8, loc="upper left")
+        if i:
+            ax[i].sharex(ax[0])
+    top = max([float(np.max(f)) / 1e3 for f in forces.values()] + [0.0])
+    for a in ax[:-1]:  # one scale, from 0 (nip open) to the largest force of any nip
+        a.set_ylim(-0.04 * top - 1e-3, 1.06 * top + 1e-3)
+    ax[len(forces) - 1].set_xlabel("t [s]")
+    opens = [(tt, n) for n, f in forces.items() if (tt := _first_open(t, f)) is not None]
+    if opens:
+        t_open, which = min(opens)
+        w = (t >= t_open - 0.3) & (t <= t_open + 1.0)
+        title = f"close-up: first opening, {nip_label[which]} at t ≈ {t_open:.2f} s [kN]"
+    else:
+        w = t <= min(t[-1], t[0] + 5.0)
+        title = "first 5 s [kN] (no nip opens in this run)"
+    _panel(ax[-1], t[w], [(nip_label[n], f[w] / 1e3) for n, f in forces.items()], "F_n [kN]",
+           title + f" (samples every {np.median(np.diff(t)) if len(t) > 1 else 0:g} s)",
+           colors=[color[n] for n in forces])
+    for line in ax[-1].get_lines():
+        line.set_marker(".")
+        line.set_markersize(3)
+    ax[-1].legend(fontsize=7, loc="upper right", framealpha=0.9)
+    ax[-1].set_xlabel("t [s]")
+    paths.append(_save(fig, out / f"{stem}_nip_forces.png"))
+
+    # free coordinates of every body, one row each
+    coords = [(b.name, c) for b in (*scene.drums, *scene.rolls, *scene.riders)
+              for c in ("x", "z") if f"{b.name}_{c}" in result]
+    if coords:
+        heights = [c for _, c in coords if c == "z"]
+        fig, ax = _rows(len(coords) + len(heights), 2.0)
+        i = 0
+        for body, c in coords:
+            y = result[f"{body}_{c}"]
+            _panel(ax[i], t, [(f"{body} {c}", y)], f"{c} [m]",
+                   (f"{name}: free coordinates [m]\n" if i == 0 else "")
+                   + f"{body}: {'horizontal' if c == 'x' else 'vertical'} position {c} [m]",
+                   lw=0.5)
+            i += 1
+            if c == "z":  # the rise with the radius hides the bounce: show it apart
+                _panel(ax[i], t, [(f"{body} z − mean", 1e3 * (y - np.interp(
+                    t, *window_mean(t, y))))], "[mm]",
+                    f"{body}: bounce, z less its mean over 0.5 s [mm]", lw=0.4)
+                i += 1
+        ax[-1].set_xlabel("t [s]")
+        paths.append(_save(fig, out / f"{stem}_positions.png"))
+
+    # slip velocities, one row per nip
+    fig, ax = _rows(len(scene.nips))
+    for i, n in enumerate(scene.nips):
+        _panel(ax[i], t, [(nip_label[n.name], result[f"{n.name}_slip_velocity"])],
+               "slip [m/s]", (f"{name}: nip slip velocities [m/s]\n" if i == 0 else "")
+               + nip_label[n.name], lw=0.4, colors=[color[n.name]])
+        ax[i].axhline(0.0, color="k", lw=0.5)
+    ax[-1].set_xlabel("t [s]")
+    paths.append(_save(fig, out / f"{stem}_slip.png"))
     return paths
 
 

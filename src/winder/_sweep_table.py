@@ -30,7 +30,7 @@ from ._errors import WinderError
 from ._files import atomic_write
 from ._result import Result
 from ._sweep_grid import Axis
-from ._sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS
+from ._sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS, nip_columns, scene_nip_names
 
 __all__ = ["SweepTable", "RunStore", "row_schema", "table_meta", "RUN_COLUMNS",
            "SUMMARY_FILE"]
@@ -66,8 +66,9 @@ def row_schema(axes: Sequence[Axis], meta: Mapping[str, Any] | None = None) -> p
     fields += [pa.field(a.key, _value_type(a.values)) for a in axes]
     fields += [pa.field(c, pa.float64() if c.endswith("_time") else pa.string())
                for c in RUN_COLUMNS]
-    fields += [pa.field(c, pa.float64()) for c in SCALAR_COLUMNS]
-    fields += [pa.field(c, pa.list_(pa.float64())) for c in BAND_COLUMNS]
+    scalars, bands = nip_columns(scene_nip_names((meta or {}).get("base_scene", {})))
+    fields += [pa.field(c, pa.float64()) for c in (*SCALAR_COLUMNS, *scalars)]
+    fields += [pa.field(c, pa.list_(pa.float64())) for c in (*BAND_COLUMNS, *bands)]
     metadata = {_META_KEY: json.dumps(meta, allow_nan=True).encode()} if meta else None
     return pa.schema(fields, metadata=metadata)
 
@@ -137,7 +138,8 @@ class SweepTable:
         swept key, ``run_id`` (hash of the run's scene and settings), ``scene_hash``,
         ``status`` (``ok``, ``failed`` or ``budget``), ``message``, ``wall_time`` [s]
         (integration), ``task_time`` [s] (the whole task on its worker), ``worker``, the
-        scalar summary columns and per-band list columns (``winder._sweep_summary``).
+        scalar summary columns and per-band list columns (``winder._sweep_summary``; a
+        scene of parts also has them per nip, ``NIP.column``).
     keys: the swept key paths.
     band_edges: radius band edges [m] of the per-band columns.
     base_scene: the base scene as nested tables (:meth:`winder.Scene.to_dict`).
@@ -170,9 +172,10 @@ class SweepTable:
 
     def bands(self, column: str) -> np.ndarray:
         """A per-band column as an array ``(runs, bands)``."""
-        if column not in BAND_COLUMNS:
+        per_band = (*BAND_COLUMNS, *nip_columns(scene_nip_names(self.base_scene))[1])
+        if column not in per_band:
             raise WinderError(f"column {column!r} is not per band; per-band columns: "
-                              + ", ".join(BAND_COLUMNS))
+                              + ", ".join(per_band))
         n = len(self.band_edges) - 1
         return np.array([np.asarray(v, dtype=float) if v is not None else np.full(n, np.nan)
                          for v in self.frame[column]]).reshape(len(self.frame), n)

@@ -112,6 +112,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from ._errors import BudgetExceeded
     from ._scene import load_scene
     from ._simulate import simulate
+    from .core.equilibrium import EquilibriumError
 
     scene = load_scene(args.scene)
     progress = sys.stderr.isatty() if args.progress is None else args.progress
@@ -119,6 +120,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         result = simulate(scene, t_end=args.t_end, method=args.method, rtol=args.rtol,
                           atol=args.atol, progress=progress, backend=args.backend,
                           max_rhs=args.max_evals, max_wall=args.max_wall)
+    except EquilibriumError as exc:  # machines.md §7: no initial balance, a scene error
+        raise WinderError(f"{args.scene}: {exc}") from None
     except BudgetExceeded as exc:
         partial = getattr(exc, "partial", None)
         if not args.keep_partial:
@@ -135,6 +138,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
     m = result.meta
     print(f"{scene.name}: {len(result.t)} samples to {out} ({m['method']}, rtol {m['rtol']:g}, "
           f"{m['rhs_evaluations']} RHS evaluations, {m['wall_time']:.2f} s integration)")
+    if m.get("static_residual") is not None:
+        print(f"  initial static balance: residual {m['static_residual']:.1e} N of "
+              f"{m['static_scale']:.1e} N")
     if plots is not None:
         from ._plots import paper_figures
 
@@ -389,7 +395,8 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--keep-partial", action="store_true",
                      help="when a budget stops the run, write the result up to that time "
                      "to --out (the exit status stays 2)")
-    run.add_argument("--plots", help="directory for the paper's figures (PNG)")
+    run.add_argument("--plots", help="directory for the figures (PNG): the paper's for a "
+                     "single-drum scene, drums, rolls, nips and positions for a scene of parts")
     run.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                      help="progress bar on stderr (default: when stderr is a terminal)")
     run.set_defaults(func=_cmd_run)
