@@ -343,3 +343,14 @@ def test_torque_drive_and_fixed_roll(tmp_path) -> None:
                                                 r"between two bodies with fixed centres "
                                                 r"\(drum 'front' and roll 'set'\)"):
         _load(tmp_path, fixed)
+
+
+def test_replace_sets_a_list_valued_key(models_dir) -> None:
+    """A rider's load schedule is a list of values, not an array of tables: replace sets
+    it whole (it used to fail with an AttributeError)."""
+    scene = winder.load_scene(models_dir / "two_drum_winder.toml")
+    flat = scene.replace(rider={"rider": {"load": [[0.05, 3000.0], [0.6, 3000.0]]}})
+    assert flat.riders[0].load == ((0.05, 3000.0), (0.6, 3000.0))
+    assert scene.riders[0].load == ((0.05, 3000.0), (0.3, 300.0))
+    with pytest.raises(winder.SceneError, match=r"\[rider 'rider'\] load"):
+        scene.replace(rider={"rider": {"load": 5}})

@@ -320,9 +320,12 @@ def _merge(node: Any, values: Any, table: str, path: tuple[str, ...]) -> None:
             _merge(node[names.index(name)], sub, table, (*path, name))
         return
     for key, value in values.items():
-        if isinstance(node.get(key), dict | list):
+        old = node.get(key)
+        tables = isinstance(old, dict) or (
+            isinstance(old, list) and bool(old) and all(isinstance(e, dict) for e in old))
+        if tables:  # a sub-table or an array of named tables: merge into it
             _merge(node[key], value, table, (*path, key))
-        else:
+        else:  # a value, or a list of values (a rider's load schedule): replace it
             node[key] = value
 
 
