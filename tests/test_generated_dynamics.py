@@ -297,6 +297,150 @@ def test_symmetric_valley_static_balance() -> None:
         assert abs(ev.rates[f"{c}_dot"]) < 1e-10
 
 
+# ---- nip and web forces against the spec's formulas --------------------------------------------
+def _spec_body(m: Machine, b: Any, t: float,
+               x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float, float]:
+    """Centre [m], centre velocity [m/s], joint rate [rad/s], radius [m] and its rate [m/s]
+    of body ``b`` from the state, by the spec (machines.md §1, §6; winder-model §2)."""
+    c = np.array([x[m.index(f"{b.name}.{k}")] if k in b.free else b.centre[i]
+                  for i, k in enumerate("xz")])
+    cd = np.array([x[m.index(f"{b.name}.{k}_dot")] if k in b.free else 0.0 for k in "xz"])
+    if b.prescribed:
+        dr = b.part.drive
+        w = b.sense * dr.ratio * min(dr.web_acceleration * t, dr.web_speed) / b.part.radius
+    else:
+        w = x[m.index(f"{b.name}.theta_dot")]
+    if b.kind == "roll":
+        return c, cd, w, x[m.index(f"{b.name}.radius")], \
+            b.part.caliper / (2 * math.pi) * b.sense * w
+    return c, cd, w, b.part.radius, 0.0
+
+
+@pytest.mark.parametrize("variant", ["two_drum", "single_drum_xz_torque_hc"])
+def test_nip_channels_against_the_spec_formulas(variant: str) -> None:
+    """machines.md §2 and winder-model §4 written out here from the state: ``δ``, ``δ̇``,
+    ``v_s``, ``F_n`` (clamped law) and ``F_t = μ F_n tanh(v_s/v_ref)`` equal the generated
+    channels (slip relaxation off, contact modes AUTO, core WINDING)."""
+    make = VARIANTS[variant]
+    sc = make()
+    sc.effects.slip_relaxation = False
+    m = Machine(sc)
+    g = _generate(m)
+    p = m.parameters()
+    rng = np.random.default_rng(14)
+    worst, seen = 0.0, set()
+    for _ in range(200):
+        t, x, _ = random_state(m, rng)
+        modes = np.array([AUTO if n.endswith(".contact") else WINDING for n in m.mode_names],
+                         dtype=float)
+        out = dict(zip(m.channel_names, g.call("out", t, x, p, modes), strict=True))
+
+        for nip in m.nips:
+            ca_, cad, wa, ra, rda = _spec_body(m, nip.a, t, x)
+            cb, cbd, wb, rb, rdb = _spec_body(m, nip.b, t, x)
+            d = cb - ca_
+            n = d / np.linalg.norm(d)
+            tt = np.array([n[1], -n[0]])
+            delta = ra + rb - np.linalg.norm(d)
+            ddot = rda + rdb - n @ (cbd - cad)
+            vs = (cad @ tt + wa * ra) - (cbd @ tt - wb * rb)
+            c = nip.part.contact
+            if c.law == "linear":
+                fu = c.stiffness * delta + c.damping * ddot
+            else:
+                fu = c.stiffness * np.sign(delta) * abs(delta) ** c.exponent \
+                    * (1 + c.hc_damping * ddot)
+            fn = max(fu, 0.0) if delta > 0 else 0.0
+            f = nip.part.friction
+            ft = f.mu * fn * math.tanh(vs / f.slip_velocity)
+            seen.add((delta > 0, ddot > 0, fn > 0))
+            for ch, val, scale in (("penetration", delta, 1e-3), ("slip_velocity", vs, 1.0),
+                                   ("normal_force", fn, c.stiffness * 1e-4 ** (
+                                       c.exponent if c.law != "linear" else 1.0)),
+                                   ("friction_force", ft, c.stiffness * 1e-4 ** (
+                                       c.exponent if c.law != "linear" else 1.0))):
+                worst = max(worst, abs(out[f"{nip.name}_{ch}"] - val) / max(abs(val), scale))
+    assert {(True, True, True), (True, False, True), (False, True, False),
+            (False, False, False)} <= seen
+    # measured: 0 (two_drum), 3.0e-16 (single drum, Hunt-Crossley)
+    assert worst < 5e-15
+
+
+def test_web_forces_on_the_roll() -> None:
+    """machines.md §3 on a roll on top of one drum (``n = +z``, ``t = +x``): the tension
+    adds ``−T`` along x and ``+r T`` about +y (joint sense); the web momentum adds
+    ``ṁ u_a`` along x and ``−r ṁ u_a`` about +y, ``u_a = Ω R``."""
+    vals = {"roll.com_offset": 0.0, "roll.caliper": 1e-3}
+    base = Machine(mc.single_drum(free=("x", "z"), web_momentum=False, values=vals))
+    mom = Machine(mc.single_drum(free=("x", "z"), values=vals))
+    gb, gm = _generate(base), _generate(mom)
+    x = np.array(base.state_initial, dtype=float)
+    r = 0.2
+    x[base.index("roll.radius")] = r
+    x[base.index("roll.z")] = 0.5 + r - 1e-4
+    x[base.index("roll.theta_dot")] = -30.0
+    modes = np.array([AUTO, WINDING] if base.mode_names[0].endswith(".contact")
+                     else [WINDING, AUTO], dtype=float)
+    t = 10.0
+    p0 = base.parameters()
+    p1 = p0.copy()
+    T = 700.0
+    p1[base.param_index("web.tension")] = T
+    p0[base.param_index("web.tension")] = 0.0
+    roll = mom.body["roll"].part
+    k = math.pi * roll.density * roll.width
+    mass = roll.core_mass + k * (r * r - roll.core_radius ** 2)
+    J = roll.core_inertia + 0.5 * k * (r ** 4 - roll.core_radius ** 4)
+    ia, ith = base.index("roll.x_dot"), base.index("roll.theta_dot")
+    d_tension = gb.call("rhs", t, x, p1, modes) - gb.call("rhs", t, x, p0, modes)
+    mdot = 2 * k * r * roll.caliper / (2 * math.pi) * 30.0  # ṙ = h/2π · speed, speed 30
+    drive = mom.body["drum"].part.drive
+    u_a = drive.web_acceleration * t  # Ω R on the ramp
+    d_mom = gm.call("rhs", t, x, p0, modes) - gb.call("rhs", t, x, p0, modes)
+    got = np.array([d_tension[ia] * mass, d_tension[ith] * J, d_mom[ia] * mass, d_mom[ith] * J])
+    want = np.array([-T, r * T, mdot * u_a, -r * mdot * u_a])
+    # measured: 4.4e-16 relative
+    np.testing.assert_allclose(got, want, rtol=5e-15)
+
+
+def test_imbalanced_roll_against_lagrange() -> None:
+    """A roll free in z only, its centre of mass at ``(e, 0, 0)`` in its frame (joint about
+    +y: world offset ``(e cos θ, −e sin θ)``), gravity, constant radius (caliper 0). From
+    ``T = ½ m ż² − m e cos θ ż θ̇ + ½ J θ̇²`` (``J`` about the axis) and
+    ``V = m g (z − e sin θ)``:
+    ``m z̈ − m e cos θ θ̈ = −m g − m e sin θ θ̇²``, ``−m e cos θ z̈ + J θ̈ = m g e cos θ``."""
+    e = 0.02
+    sc = mc.free_roll(free=("z",), contact=False, slip_relaxation=False,
+                      values={"roll.caliper": 0.0, "roll.com_offset": e,
+                              "roll.initial_radius": 0.3})
+    m = Machine(sc)
+    g = _generate(m)
+    p = m.parameters()
+    roll = sc.rolls[0]
+    k = math.pi * roll.density * roll.width
+    r, rc = roll.initial_radius, roll.core_radius
+    mass = roll.core_mass + k * (r * r - rc * rc)
+    J = roll.core_inertia + 0.5 * k * (r ** 4 - rc ** 4)
+    grav = sc.scene.gravity
+    rng = np.random.default_rng(7)
+    modes = np.full(len(m.mode_names), float(WINDING))
+    worst = 0.0
+    for _ in range(50):
+        x = np.array(m.state_initial, dtype=float)
+        th, w = rng.uniform(-math.pi, math.pi), rng.uniform(-50.0, 50.0)
+        x[m.index("roll.theta")], x[m.index("roll.theta_dot")] = th, w
+        x[m.index("roll.z_dot")] = rng.uniform(-1.0, 1.0)
+        A = np.array([[mass, -mass * e * math.cos(th)], [-mass * e * math.cos(th), J]])
+        b = np.array([-mass * grav - mass * e * math.sin(th) * w * w,
+                      mass * grav * e * math.cos(th)])
+        want = np.linalg.solve(A, b)
+        dx = g.call("rhs", 0.0, x, p, modes)
+        got = np.array([dx[m.index("roll.z_dot")], dx[m.index("roll.theta_dot")]])
+        worst = max(worst, float(np.max(np.abs(got - want) / np.abs(want).max())))
+    # measured: 1.1e-15
+    assert worst < 1e-14
+
+
 # ---- integration helper ----------------------------------------------------------------------
 def _integrate(system: Any, y0: np.ndarray, t_out: np.ndarray, rtol: float,
                atol: float) -> np.ndarray:
