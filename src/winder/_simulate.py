@@ -252,7 +252,8 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     """Integrate ``y`` in place with a compiled method in chunks of
     :data:`~winder.solve.integrators.CHUNK` evaluations (progress and budgets between chunks).
     Returns the samples written; ``at`` holds ``[t, step, samples]`` of the last chunk
-    (for a budget error)."""
+    (for a budget error). Where an unwinding roll runs out of web the run ends there
+    (:meth:`MachineSystem.ended`)."""
     t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
     fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
@@ -283,6 +284,9 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
                 raise guards.error(f"step size underflow with method {meth!r} (the problem "
                                    "is too stiff or discontinuous for it): try "
                                    "method='Radau' or 'LSODA'", t, y)
+            if status == integ.EXHAUSTED:
+                system.ended(t, y)
+                return k
             guards.tick(t)
     return k
 
@@ -421,6 +425,13 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     finally:
         if bar is not None:
             bar.close()
+    if system.end is not None:  # an unwinding roll ran out of web: the result ends there
+        t_end_at, y_end = system.end[0], system.end[1]
+        t_out, Ys = t_out[:filled], Ys[:, :filled]
+        if not filled or t_out[-1] < t_end_at:
+            t_out = np.append(t_out, t_end_at)
+            Ys = np.concatenate((Ys, y_end[:, None]), axis=1)
+        filled = len(t_out)
     if filled != len(t_out):
         raise SimulationError(f"internal error: {filled} of {len(t_out)} output samples")
     wall = time.perf_counter() - guards.wall0
@@ -444,5 +455,6 @@ def _meta(scene: Scene, system: MachineSystem, meth: str, rtol: float, atol: flo
             "t_start": t_s, "t_end": T, "effects": list(scene.effects.enabled()),
             "drum_radius": scene.drums[0].radius, "scene_dict": scene.to_dict(),
             "static_residual": None if eq is None else eq.residual,
+            "ended": system.end[2] if system.end is not None else None,
             "static_scale": None if eq is None else eq.scale,
             "partial": partial}

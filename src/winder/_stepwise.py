@@ -156,7 +156,8 @@ def run_stepwise(system: MachineSystem, meth: str, y0: np.ndarray, t_s: float,
     """scipy's solvers and RK4, one step at a time: contact events of every nip (restart
     at lift-off and touch-down, stepping over grazing contacts) and core events of every
     wound roll (spec §2: land on the core, ``ṙ = 0`` locked until the roll turns
-    forwards). Returns ``(samples, events)``."""
+    forwards); an unwinding roll reaching its core ends the run there
+    (:meth:`MachineSystem.ended`). Returns ``(samples, events)``."""
     rhs, limit = system.rhs, guards.limit
 
     def fun(t: float, y: np.ndarray) -> np.ndarray:
@@ -187,6 +188,7 @@ def run_stepwise(system: MachineSystem, meth: str, y0: np.ndarray, t_s: float,
     table = system.table
     cores = [s for s in range(len(table)) if table[s, 0] == integ.K_CORE]
     contacts = [s for s in range(len(table)) if table[s, 0] == integ.K_CONTACT]
+    ends = [s for s in range(len(table)) if table[s, 0] == integ.K_END]
     contact_events = events and system.scene.effects.contact and meth != "RK4"
     filled, n_events, t0, y = 0, 0, t_s, np.array(y0, dtype=float)
     g = system.switches(t0, y)
@@ -205,6 +207,9 @@ def run_stepwise(system: MachineSystem, meth: str, y0: np.ndarray, t_s: float,
                 gi = table[s, 1] if system.modes[s] == WINDING else table[s, 2]
                 evs.append((switch(gi), True))
                 slots.append(s)
+            for s in ends:  # an unwinding roll running out of web ends the run
+                evs.append((switch(table[s, 1]), True))
+                slots.append(s)
             if contact_events and not stepping_over:
                 if not touching:
                     g = system.switches(t0, y)
@@ -217,6 +222,10 @@ def run_stepwise(system: MachineSystem, meth: str, y0: np.ndarray, t_s: float,
             if hit >= 0:
                 n_events += 1
                 s = slots[hit]
+                if table[s, 0] == integ.K_END:
+                    y[table[s, 3]] = system.params[table[s, 4]]
+                    system.ended(t1, y)
+                    return filled, n_events
                 if table[s, 0] == integ.K_CORE:  # land on the core, or leave it
                     if system.modes[s] == WINDING:
                         y[table[s, 3]] = system.params[table[s, 4]]

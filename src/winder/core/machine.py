@@ -56,7 +56,9 @@ class Body:
     part: Any
     joints: dict[str, int] = field(default_factory=dict)
     prescribed: bool = False  # a drum with a speed profile
-    torque_input: bool = False  # a drum with a torque drive
+    torque_input: bool = False  # a drum or an unwinding roll with a torque drive
+    unwinding: bool = False  # a paper roll that pays off its web (machines.md §1)
+    controlled: bool = False  # an unwinding roll under tension control
 
 
 @dataclass
@@ -80,7 +82,7 @@ class Machine:
     """
 
     def __init__(self, scene: Any) -> None:
-        from ..forces import FORCES
+        from ..forces import DRIVES, FORCES
 
         self.scene = scene
         fx = scene.effects
@@ -90,8 +92,12 @@ class Machine:
                                     prescribed=d.drive.kind == "speed_profile",
                                     torque_input=d.drive.kind == "torque"))
         for r in scene.rolls:
+            drive = getattr(r, "drive", None)
+            kind = drive.kind if drive is not None else None
             self.bodies.append(Body(r.name, "roll", int(r.sense), tuple(r.free),
-                                    tuple(r.centre), r))
+                                    tuple(r.centre), r, torque_input=kind == "torque",
+                                    unwinding=r.kind == "unwinding",
+                                    controlled=kind == "tension_control"))
         self.body = {b.name: b for b in self.bodies}
         for x in scene.riders:  # initial guess: on top of the roll it rides
             ridden = self.body[x.rides]
@@ -104,6 +110,8 @@ class Machine:
         self.web = scene.web
         self.entry = self.nip[scene.web.entry_nip] if scene.web is not None else None
         self.rolls = [b for b in self.bodies if b.kind == "roll"]
+        self.span = getattr(scene.web, "span", None) if scene.web is not None else None
+        self.unwind = self.body[self.span.source] if self.span is not None else None
         self.model = self._build_model()
         self.param_names: list[str] = []
         self.param_values: list[float] = []
@@ -113,8 +121,9 @@ class Machine:
         self.mode_names: list[str] = []
         self.switch_names: list[str] = []
         self._declare_base()
-        self.forces = sorted((FORCES[n]() for n in fx.enabled() if n in FORCES),
-                             key=lambda f: f.order)
+        drives = {b.part.drive.kind for b in self.bodies if b.controlled}
+        self.forces = sorted([*(FORCES[n]() for n in fx.enabled() if n in FORCES),
+                              *(DRIVES[k]() for k in sorted(drives))], key=lambda f: f.order)
         for f in self.forces:
             f.declare(self)
         self._index = {n: i for i, n in enumerate(self.state_names)}
@@ -196,7 +205,12 @@ class Machine:
                 self.parameter(f"{b.name}.width", part.width)
                 self.parameter(f"{b.name}.density", part.density)
                 self.parameter(f"{b.name}.caliper", part.caliper)
-                self.mode(f"{b.name}.core", (f"{b.name}.unwound", f"{b.name}.forward"))
+                if b.unwinding:  # the run ends where it reaches its core
+                    self.mode(f"{b.name}.end", (f"{b.name}.exhausted",))
+                else:
+                    self.mode(f"{b.name}.core", (f"{b.name}.unwound", f"{b.name}.forward"))
+                if b.torque_input:
+                    self.parameter(f"{b.name}.torque", part.drive.torque)
             else:
                 self.parameter(f"{b.name}.radius", part.radius)
                 self.parameter(f"{b.name}.inertia", part.inertia)
@@ -263,7 +277,9 @@ class Machine:
         for group in (self.state_names, self.param_names, self.mode_names,
                       self.switch_names, self.channel_names,
                       [f.name for f in self.forces],
-                      [f"{b.name}:{b.kind}:{b.sense}:{b.prescribed}" for b in self.bodies],
+                      [f"{b.name}:{b.kind}:{b.sense}:{b.prescribed}:{b.torque_input}:"
+                       f"{b.unwinding}:{b.controlled}" for b in self.bodies],
+                      [self.span.source if self.span is not None else ""],
                       [f"{n.name}:{n.a.name}:{n.b.name}:{n.part.contact.law}"
                        for n in self.nips],
                       [self.entry.name if self.entry else ""],
@@ -344,6 +360,9 @@ class Evaluation:
         self.bodies: dict[str, BodyState] = {}
         self.nips: dict[str, NipState] = {}
         self.fext_extra: dict[str, list[Any]] = {}  # local-frame spatial forces by body
+        #: actuator torques about the bodies' axes [N·m], operation sense (drives)
+        self.drive_torques: dict[str, Any] = {}
+        self.span_rate: Any = 0.0  # dT/dt of the web span [N/s] (web_tension sets it)
         self.gravity: Any = 0.0  # [m/s²], set by the gravity effect
 
     # access by name
@@ -419,14 +438,18 @@ class Evaluation:
                     r, rc, self.p(f"{n}.core_mass"), self.p(f"{n}.core_inertia"), k)
                 h2pi = self.p(f"{n}.caliper") / (2.0 * math.pi)
                 speed = bs.speed
-                core = self.mode(f"{n}.core")
-                at_core = M.logic_or(core == AT_CORE, M.logic_and(
-                    core == CORE_AUTO, M.logic_and(r <= rc, speed < 0.0)))
                 bs.r = r
-                bs.r_dot = M.if_else(at_core, 0.0, h2pi * speed)
+                if b.unwinding:  # machines.md §1: ṙ = −h·speed/2π, down to the core
+                    bs.r_dot = -h2pi * speed
+                    self.switches[f"{n}.exhausted"] = rc - r
+                else:
+                    core = self.mode(f"{n}.core")
+                    at_core = M.logic_or(core == AT_CORE, M.logic_and(
+                        core == CORE_AUTO, M.logic_and(r <= rc, speed < 0.0)))
+                    bs.r_dot = M.if_else(at_core, 0.0, h2pi * speed)
+                    self.switches[f"{n}.unwound"] = rc - r
+                    self.switches[f"{n}.forward"] = speed
                 self.set_rate(f"{n}.radius", bs.r_dot)
-                self.switches[f"{n}.unwound"] = rc - r
-                self.switches[f"{n}.forward"] = speed
             else:
                 bs.r = self.p(f"{n}.radius")
                 bs.r_dot = 0.0
@@ -494,7 +517,9 @@ class Evaluation:
             bs = self.bodies[b.name]
             j = b.joints["theta"] - 1
             if b.torque_input:
-                tau[j] = b.sense * self.p(f"{b.name}.torque")
+                self.drive_torques[b.name] = self.p(f"{b.name}.torque")
+            if b.name in self.drive_torques:
+                tau[j] = b.sense * self.drive_torques[b.name]
             dyn[10 * j:10 * j + 10] = self.inertia_parameters(bs)
             co, si = M.cos(bs.theta), M.sin(bs.theta)
             f6 = [co * bs.fx - si * bs.fz, 0.0, si * bs.fx + co * bs.fz, 0.0, bs.ty, 0.0]
@@ -535,8 +560,12 @@ class Evaluation:
             ch(f"{n}_speed", s * bs.omega)
             ch(f"{n}_angle", s * bs.theta)
             ch(f"{n}_accel", s * acc[j])
-            driven = b.prescribed or b.torque_input
-            ch(f"{n}_torque", s * tau[j] if driven else s * bs.ty)
+            if b.prescribed:
+                ch(f"{n}_torque", s * tau[j])  # inverse dynamics (RNEA)
+            elif b.name in self.drive_torques:
+                ch(f"{n}_torque", self.drive_torques[b.name])  # the input or the controller
+            else:
+                ch(f"{n}_torque", s * bs.ty)
             for c in b.free:
                 jc = b.joints[c] - 1
                 ch(f"{n}_{c}", self.q[jc])

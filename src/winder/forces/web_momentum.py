@@ -1,11 +1,15 @@
-"""Web momentum (machines.md §3): the paper entering a wound roll at its entry nip brings
-its momentum, force ``ṁ u_a t`` at ``p_b`` (``u_b`` instead of ``u_a`` with contact off)."""
+"""Web momentum (machines.md §3): paper entering a wound roll at its entry nip brings its
+momentum, force ``ṁ u_a t`` at ``p_b`` (``u_b`` instead of ``u_a`` with contact off);
+paper leaving an unwinding roll takes its own momentum with it (zero relative velocity),
+force ``ṁ_u u_u t_u`` at the exit point ``p_u`` (``ṁ_u < 0``), so that a freely spinning
+unwinding roll keeps its speed."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
 from ._base import ForceElement
+from .web_tension import exit_point
 
 if TYPE_CHECKING:
     from ..core.machine import Evaluation, Machine
@@ -14,7 +18,8 @@ __all__ = ["WebMomentum"]
 
 
 class WebMomentum(ForceElement):
-    """Momentum flux of the entering web on the wound roll; channel ``web_force`` [N]."""
+    """Momentum flux of the web at the entry nip and at the unwinding roll's exit point;
+    channel ``web_force`` [N] (at the entry)."""
 
     name = "web_momentum"
     order = 40
@@ -24,11 +29,16 @@ class WebMomentum(ForceElement):
             machine.channel("web_force")
 
     def apply(self, ev: Evaluation) -> None:
-        entry = ev.machine.entry
-        if entry is None:
-            return
-        ns, b = ev.nips[entry.name], ev.bodies[entry.b.name]
-        u = ns.u_a if ev.machine.scene.effects.contact else ns.u_b
-        f = b.mass_rate * u
-        ev.add_force(b.body.name, f * ns.tx, f * ns.tz, -b.r * ns.nx, -b.r * ns.nz)
-        ev.set_channel("web_force", f)
+        m = ev.machine
+        entry = m.entry
+        if entry is not None:
+            ns, b = ev.nips[entry.name], ev.bodies[entry.b.name]
+            u = ns.u_a if m.scene.effects.contact else ns.u_b
+            f = b.mass_rate * u
+            ev.add_force(b.body.name, f * ns.tx, f * ns.tz, -b.r * ns.nx, -b.r * ns.nz)
+            ev.set_channel("web_force", f)
+        if m.unwind is not None:
+            un = ev.bodies[m.unwind.name]
+            f = un.mass_rate * un.r * un.speed
+            tx, tz, ox, oz = exit_point(ev)
+            ev.add_force(un.body.name, f * tx, f * tz, ox, oz)

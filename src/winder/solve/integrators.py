@@ -12,14 +12,16 @@ core lands exactly on ``r_c``.
 
 The machine's functions are called through their addresses (:mod:`winder.core.ccall`):
 ``fns = [rhs, jac, out, sw]``. Mode slots are described by ``table`` rows ``(kind, g1,
-g2, state, param)``: kind :data:`K_CONTACT` (``g1`` its switching function) or
+g2, state, param)``: kind :data:`K_CONTACT` (``g1`` its switching function),
 :data:`K_CORE` (``g1`` = ``r_c − r``, ``g2`` = speed, ``state`` the radius, ``param``
-``r_c``).
+``r_c``) or :data:`K_END` (an unwinding roll: ``g1`` = ``r_c − r``; where it crosses
+zero the roll has run out of web, the radius lands on ``r_c`` and the integration stops
+with :data:`EXHAUSTED`).
 
 Both functions integrate ``y`` in place, write samples at output times into a caller's
 array and keep counters in ``stats = [nfev, accepted, rejected, events, stiff steps]``.
 Status codes: :data:`DONE`, :data:`PAUSED` (the evaluation budget of this call is spent;
-call again to resume), :data:`STEP_UNDERFLOW`, :data:`NON_FINITE`.
+call again to resume), :data:`STEP_UNDERFLOW`, :data:`NON_FINITE`, :data:`EXHAUSTED`.
 """
 
 from __future__ import annotations
@@ -33,10 +35,13 @@ from ..core.ccall import call
 from ..core.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
 
 __all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "DONE", "PAUSED",
-           "STEP_UNDERFLOW", "NON_FINITE", "CHUNK", "TIME_RESOLUTION", "K_CONTACT", "K_CORE"]
+           "STEP_UNDERFLOW", "NON_FINITE", "EXHAUSTED", "CHUNK", "TIME_RESOLUTION",
+           "K_CONTACT", "K_CORE", "K_END"]
 
-DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE = 0, 1, 2, 3
-K_CONTACT, K_CORE = 0, 1
+DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE, EXHAUSTED = 0, 1, 2, 3, 4
+K_CONTACT, K_CORE, K_END = 0, 1, 2
+#: The mode a :data:`K_END` slot switches to: the run ends (an unwinding roll at its core).
+END = 9
 F_RHS, F_JAC, F_OUT, F_SW = 0, 1, 2, 3
 #: Shortest step [s] relative to ``max(1 s, |t|)``; below it the time is not resolved.
 TIME_RESOLUTION = 1e-14
@@ -86,6 +91,8 @@ def modes_of(fns: np.ndarray, table: np.ndarray, tb: np.ndarray, t: float, y: np
                 m[s] = AUTO
             else:
                 m[s] = IN_CONTACT if g[table[s, 1]] > 0.0 else FREE
+        elif table[s, 0] == K_END:
+            m[s] = 0.0
         else:
             m[s] = AT_CORE if g[table[s, 1]] >= 0.0 and g[table[s, 2]] <= 0.0 else WINDING
 
@@ -172,6 +179,9 @@ def _next_event(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh
                 gi, pos, nm = table[s, 1], False, FREE
             elif m[s] == FREE and g[table[s, 1]] > 0.0:
                 gi, pos, nm = table[s, 1], True, IN_CONTACT
+        elif table[s, 0] == K_END:
+            if g[table[s, 1]] > 0.0:
+                gi, pos, nm = table[s, 1], True, END
         else:
             if m[s] == WINDING and g[table[s, 1]] > 0.0:
                 gi, pos, nm = table[s, 1], True, AT_CORE
@@ -302,8 +312,11 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
         if slot >= 0:  # event: restart at the crossing in the new mode
             _dense(rc, theta_end, y)
             t = t_end
-            if table[slot, 0] == K_CORE and new_mode == AT_CORE:
+            if new_mode == END or (table[slot, 0] == K_CORE and new_mode == AT_CORE):
                 y[table[slot, 3]] = p[table[slot, 4]]  # land exactly on the core
+            if new_mode == END:
+                status = EXHAUSTED
+                break
             m[slot] = new_mode
             evaluate(fns, F_RHS, tb, t, y, p, m, k1)
             nfev += 1
@@ -390,7 +403,7 @@ def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
                                             y1, yt, g, False)
             theta = 1.0
             if slot >= 0:
-                gi = table[slot, 1] if new_mode == AT_CORE else table[slot, 2]
+                gi = table[slot, 1] if new_mode in (AT_CORE, END) else table[slot, 2]
                 ta, tb_ = 0.0, 1.0
                 for _ in range(60):
                     th = 0.5 * (ta + tb_)
@@ -415,10 +428,13 @@ def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
             _hermite(y, k1, y1, k2, hs, theta, yt)
             for i in range(n):
                 y[i] = yt[i]
-            if new_mode == AT_CORE:
+            if new_mode in (AT_CORE, END):
                 y[table[slot, 3]] = p[table[slot, 4]]  # land exactly on the core
-            m[slot] = new_mode
             t = t_end if theta < 1.0 else tn
+            if new_mode == END:
+                status = EXHAUSTED
+                break
+            m[slot] = new_mode
             evaluate(fns, F_RHS, tb, t, y, p, m, k1)
             nfev += 1
             stats[3] += 1

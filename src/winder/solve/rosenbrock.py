@@ -19,6 +19,8 @@ from .._jit import njit
 from ..core.machine import AT_CORE
 from .integrators import (
     DONE,
+    END,
+    EXHAUSTED,
     F_JAC,
     F_RHS,
     K_CORE,
@@ -202,8 +204,11 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
         if slot >= 0:
             _dense(rc, theta_end, y)
             t = t_end
-            if table[slot, 0] == K_CORE and new_mode == AT_CORE:
+            if new_mode == END or (table[slot, 0] == K_CORE and new_mode == AT_CORE):
                 y[table[slot, 3]] = p[table[slot, 4]]
+            if new_mode == END:
+                status = EXHAUSTED
+                break
             m[slot] = new_mode
             evaluate(fns, F_RHS, tb, t, y, p, m, f0)
             nfev += 1

@@ -101,13 +101,18 @@ class MachineSystem:
         for name in m.mode_names:
             if name.endswith(".contact"):
                 rows.append((integ.K_CONTACT, m.switch_names.index(name), 0, 0, 0))
+            elif name.endswith(".end"):
+                roll = name[:-len(".end")]
+                rows.append((integ.K_END, m.switch_names.index(f"{roll}.exhausted"), 0,
+                             m.index(f"{roll}.radius"), m.param_index(f"{roll}.core_radius")))
             else:
                 roll = name[:-len(".core")]
                 rows.append((integ.K_CORE, m.switch_names.index(f"{roll}.unwound"),
                              m.switch_names.index(f"{roll}.forward"),
                              m.index(f"{roll}.radius"), m.param_index(f"{roll}.core_radius")))
         self.table = np.array(rows, dtype=np.int64).reshape(len(rows), 5)
-        self.modes = np.array([AUTO if r[0] == integ.K_CONTACT else CORE_AUTO for r in rows],
+        self.modes = np.array([AUTO if r[0] == integ.K_CONTACT else
+                               CORE_AUTO if r[0] == integ.K_CORE else 0.0 for r in rows],
                               dtype=float)
         self.radii = [(m.index(f"{b.name}.radius"), b.part.core_radius) for b in m.rolls]
         self.breakpoints = sorted({b.part.drive.web_speed / b.part.drive.web_acceleration
@@ -115,6 +120,8 @@ class MachineSystem:
                                    and b.part.drive.web_acceleration > 0})
         self.nfev = 0
         self._eq: Equilibrium | None = None
+        #: ``(t, state, message)`` where an unwinding roll ran out of web, else None
+        self.end: tuple[float, np.ndarray, str] | None = None
 
     # ---- state --------------------------------------------------------------------------
     @property
@@ -159,6 +166,14 @@ class MachineSystem:
             raise ArgumentError(f"core mode must be one of {CORE_AUTO}, {WINDING}, {AT_CORE}, "
                                 f"got {core!r}")
         self.modes[self.table[:, 0] == integ.K_CORE] = core
+
+    def ended(self, t: float, y: np.ndarray) -> None:
+        """Record that the run ends at ``t`` [s] in state ``y``: an unwinding roll reached
+        its core (machines.md §1)."""
+        roll = self.machine.unwind.name if self.machine.unwind is not None else "?"
+        self.end = (float(t), np.array(y, dtype=float),
+                    f"the unwinding roll {roll!r} ran out of web (its radius reached the "
+                    f"core) at t = {t:.6g} s: the run ends there")
 
     def clamp_radii(self, Y: np.ndarray) -> None:
         """Samples interpolated between a step's start and its core event may dip below
@@ -237,8 +252,9 @@ class MachineSystem:
             for i, ti in enumerate(t):
                 g = self.switches(float(ti), Y[:, i])
                 for s, row in enumerate(self.table):
-                    modes[s] = AUTO if row[0] == integ.K_CONTACT else (
-                        AT_CORE if g[row[1]] >= 0.0 and g[row[2]] <= 0.0 else WINDING)
+                    modes[s] = AUTO if row[0] == integ.K_CONTACT else 0.0 \
+                        if row[0] == integ.K_END else (
+                            AT_CORE if g[row[1]] >= 0.0 and g[row[2]] <= 0.0 else WINDING)
                 ev = self.evaluate_numeric(float(ti), Y[:, i], modes)
                 out[:, i] = [float(ev.channels.get(n, 0.0)) for n in names]
         ch = {"t": t.copy()}

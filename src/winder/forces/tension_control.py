@@ -1,0 +1,68 @@
+"""Tension control at the unwind (machines.md §6): the unwinding roll's torque holds the
+span's tension at its set-point ``T*`` [N].
+
+The controller is the industrial one, PI on the span tension with the inertia
+feed-forward, plus a tension-rate term, with its gains scheduled on the roll's inertia by
+one rule, so that the closed loop keeps the same bandwidth over the whole diameter range
+(the parent roll's inertia falls by 40× from full to empty)::
+
+    τ = J(r) ω̇_ref − r T*  −  k_p e − k_i ∫e dt + k_d dT/dt,      e = T* − T
+
+with ``ω_ref = v2 / r`` (the roll's speed at the entry drum's web speed ``v2``, its rate
+from the drum's acceleration and the shrinking radius). Linearised about the operating
+point the span and the roll give ``T'' = −g (δτ + r δT)`` with ``g = EA r / (L_s J)``; the
+gains
+
+    k_d = 3 ω_c / g,   k_p = 3 ω_c² / g − r,   k_i = ω_c³ / g
+
+put the three closed-loop poles at ``−ω_c``, for any radius (``ω_c`` is the scene's
+``bandwidth`` [rad/s]). The model has no bearing friction, so its feed-forward is zero.
+Channels: ``tension_error`` [N] (``e``) and the roll's ``NAME_torque`` [N·m].
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ._base import ForceElement
+
+if TYPE_CHECKING:
+    from ..core.machine import Evaluation, Machine
+
+__all__ = ["TensionControl"]
+
+
+class TensionControl(ForceElement):
+    """The unwind's tension controller; state ``ROLL.tension_integral`` [N·s]."""
+
+    name = "tension_control"
+    order = 45  # after web_tension (the span's tension and its rate)
+
+    def declare(self, machine: Machine) -> None:
+        b = machine.unwind
+        machine.parameter(f"{b.name}.tension_setpoint", b.part.drive.tension)
+        machine.parameter(f"{b.name}.bandwidth", b.part.drive.bandwidth)
+        machine.state(f"{b.name}.tension_integral", 0.0)
+        machine.channel("tension_error")
+
+    def apply(self, ev: Evaluation) -> None:
+        m = ev.machine
+        b = m.unwind
+        n = b.name
+        u, a = ev.bodies[n], ev.bodies[m.entry.a.name]
+        T = ev.x("span.tension")
+        T_set = ev.p(f"{n}.tension_setpoint")
+        wc = ev.p(f"{n}.bandwidth")
+        e = T_set - T
+        ev.set_rate(f"{n}.tension_integral", e)
+        r, J = u.r, u.inertia
+        g = ev.p("span.EA") * r / (ev.p("span.length") * J)
+        kd, kp, ki = 3.0 * wc / g, 3.0 * wc * wc / g - r, wc ** 3 / g
+        v2 = a.omega * a.r * a.body.sense
+        a_dot = a.alpha_prescribed if a.alpha_prescribed is not None else 0.0
+        v2_dot = a_dot * a.r * a.body.sense
+        w_ref_dot = (v2_dot * r - v2 * u.r_dot) / (r * r)
+        tau = (J * w_ref_dot - r * T_set - kp * e
+               - ki * ev.x(f"{n}.tension_integral") + kd * ev.span_rate)
+        ev.drive_torques[n] = tau
+        ev.set_channel("tension_error", e)
