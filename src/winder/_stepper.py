@@ -25,10 +25,14 @@ OUTPUTS = tuple(LEGACY_CHANNELS)
 
 
 def inputs_of(system: MachineSystem) -> dict[str, str]:
-    """The inputs of a scene: input name → run-time parameter (``DRUM.torque``)."""
+    """The inputs of a scene: input name → run-time parameter: ``DRUM_torque`` per
+    torque-driven drum or unwinding roll, ``ROLL_tension_setpoint`` [N] of a
+    tension-controlled unwind."""
     if getattr(system.scene, "legacy", False):
         return {"drum_torque": "drum.torque"}
-    return {n.replace(".", "_"): n for n in system.torque_inputs()}
+    names = system.torque_inputs() + [f"{b.name}.tension_setpoint"
+                                      for b in system.machine.bodies if b.controlled]
+    return {n.replace(".", "_"): n for n in names}
 
 
 def outputs_of(system: MachineSystem) -> tuple[str, ...]:
@@ -91,6 +95,7 @@ class Stepper:
         self.y = self.system.initial_state()
         self._h = 0.0
         self._stats = np.zeros(5, dtype=np.int64)
+        self.system.end = None
         self._outputs: dict[str, float] | None = None
 
     @property
@@ -110,13 +115,18 @@ class Stepper:
         if self.inputs[name] not in self.system.machine.param_names:
             raise ArgumentError(f"{name} is an input only with [drum.drive] kind = 'torque'; "
                                 "this scene prescribes the drum speed")
-        v = check_real(name, value, math.isfinite, "a finite number [N·m]")
+        v = check_real(name, value, math.isfinite,
+                       "a finite number [N]" if name.endswith("setpoint") else
+                       "a finite number [N·m]")
         self.system.set_input(self.inputs[name], v)
         self._outputs = None
 
     def step(self, dt: float) -> None:
         """Advance by ``dt`` [s]: finite, and at least the time resolution at ``t``
         (``1e-14·max(1 s, |t|)``).
+
+        Where an unwinding roll runs out of web the step stops there (``t`` < the step's
+        end; :attr:`ended` says why).
 
         Raises
         ------
@@ -125,6 +135,9 @@ class Stepper:
             reached (``.time``) and may go on from there.
         SimulationError: the integration failed.
         """
+        if self.ended is not None:
+            raise SimulationError(f"the run has ended: {self.ended}", time=self.t,
+                                  state=self.state)
         resolution = integ.TIME_RESOLUTION * max(1.0, abs(self.t))
         dt = check_real("dt", dt, lambda v: math.isfinite(v) and v >= resolution,
                         f"finite and >= {resolution:.3g} s (the time resolution at t = "
@@ -154,10 +167,21 @@ class Stepper:
                             else "the step size underflowed (too stiff or discontinuous)")
                     raise SimulationError(f"integration failed at t = {t:.6g} s: {what} "
                                           f"(state: {where})", time=t, state=self.state)
+                if status == integ.EXHAUSTED:  # the unwinding roll ran out of web
+                    self.system.ended(t, self.y)
+                    self.t, self._h = t, h
+                    self._outputs = None
+                    return
                 self.t, self._h = (tb if status == integ.DONE else t), h
                 self._outputs = None
         self.t = t_end
         self._outputs = None
+
+    @property
+    def ended(self) -> str | None:
+        """Why the machine cannot go on (an unwinding roll ran out of web), else None:
+        :meth:`step` then stops at that time, and further steps raise."""
+        return self.system.end[2] if self.system.end is not None else None
 
     def _over(self, kind: str, t_start: float, t_end: float, nfev: int, steps0: int,
               stiff0: int, wall0: float) -> Exception:

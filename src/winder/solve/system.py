@@ -148,7 +148,8 @@ class MachineSystem:
         self.params[self.machine.param_index(name)] = value
 
     def torque_inputs(self) -> list[str]:
-        """Names of the torque inputs (``DRUM.torque``, one per torque-driven drum)."""
+        """Names of the torque inputs (``BODY.torque``, one per torque-driven drum or
+        unwinding roll)."""
         return [f"{b.name}.torque" for b in self.machine.bodies if b.torque_input]
 
     def set_drum_torque(self, torque: float) -> None:
