@@ -208,8 +208,10 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     then a close-up of the first opening of a nip; ``STEM_positions.png``: a row per free
     coordinate (``x``, ``z``) of every body, each ``z`` followed by its bounce (``z`` less
     its mean over 0.5 s, in mm); ``STEM_slip.png``: a row per nip with its slip
-    velocity. ``STEM`` is the scene name made file-safe; part names appear only in
-    titles and legends. A nip keeps its colour in every figure. Returns the paths.
+    velocity; with a web span, ``STEM_span.png``: the span tension, the controller's
+    tension error, the unwind torque and the radii. ``STEM`` is the scene name made
+    file-safe; part names appear only in titles and legends. A nip keeps its colour in
+    every figure. Returns the paths.
     """
     scene = _parts_scene(result, scene)
     out = Path(out_dir)
@@ -312,7 +314,39 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
         ax[i].axhline(0.0, color="k", lw=0.5)
     ax[-1].set_xlabel("t [s]")
     paths.append(_save(fig, out / f"{stem}_slip.png"))
+    if "span_tension" in result:
+        paths.append(_span_figure(result, scene, out / f"{stem}_span.png", name))
     return paths
+
+
+def _span_figure(result: Result, scene: Scene, path: Path, name: str) -> Path:
+    """The winder line: span tension (and the controller's error), the unwind torque,
+    the radii of the unwinding and the wound roll."""
+    t = result.t
+    span = scene.web.span
+    unwind = next(r for r in scene.rolls if r.name == span.source)
+    wound = [r for r in scene.rolls if r.kind != "unwinding"]
+    fig, ax = _rows(4 if "tension_error" in result else 3)
+    _panel(ax[0], t, [("span tension", result["span_tension"])], "T [N]",
+           f"{name}: web span tension [N] (EA = {span.EA:.3g} N, L = {span.length:g} m)",
+           lw=0.6)
+    rows = 1
+    if "tension_error" in result:
+        _panel(ax[1], t, [("set-point − T", result["tension_error"])], "error [N]",
+               f"tension error of the unwind's controller [N]: peak "
+               f"{np.max(np.abs(result['tension_error'])):.3g} N, RMS "
+               f"{np.sqrt(np.mean(result['tension_error'] ** 2)):.3g} N", lw=0.6)
+        ax[1].axhline(0.0, color="k", lw=0.5)
+        rows = 2
+    _panel(ax[rows], t, [(f"roll {unwind.name}", result[f"{unwind.name}_torque"] / 1e3)],
+           "torque [kN m]", f"unwind torque of {unwind.name} [kN m] (negative: braking)",
+           lw=0.6)
+    ax[rows].axhline(0.0, color="k", lw=0.5)
+    _panel(ax[rows + 1], t, [(f"roll {r.name}", result[f"{r.name}_radius"])
+                             for r in [unwind, *wound]], "radius r [m]",
+           "radii of the unwinding and the wound rolls [m]")
+    ax[-1].set_xlabel("t [s]")
+    return _save(fig, path)
 
 
 def normal_force_envelope(result: Result, window: float = 0.5, *,
