@@ -60,7 +60,8 @@ def static_state(machine: Machine, p: np.ndarray | None = None) -> Equilibrium:
     modes = np.full(len(machine.mode_names), float(CORE_AUTO))
     modes[contact] = IN_CONTACT
     unknowns = []
-    for b in machine.bodies:
+    resting = bool(machine.scene.effects.contact)  # without contact, free bodies start
+    for b in machine.bodies if resting else []:  # at their centres (§7)
         fixed_z = b.kind == "roll" and getattr(b.part, "initial_height", None) is not None
         for c in b.free:
             if c == "z" and fixed_z:
