@@ -128,11 +128,12 @@ def case_cycles_instantiate(path: str, n: int = 220) -> dict:
 
     mem, radius = [], []
     with loaded_fmu(path, instance_name="host") as (fmu, refs, _):
+        name = "radius" if "radius" in refs else "set_radius"  # single drum / two drums
         for i in range(n):
             start_fmu(fmu, refs)
             for k in range(5):
                 fmu.doStep(currentCommunicationPoint=k * 1e-3, communicationStepSize=1e-3)
-            radius.append(fmu.getReal([refs["radius"]])[0])
+            radius.append(fmu.getReal([refs[name]])[0])
             fmu.terminate()
             fmu.freeInstance()
             if i in (19, n - 1):
