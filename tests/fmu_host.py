@@ -55,6 +55,61 @@ def case_torque(path: str) -> dict:
             "web_speed_reference": v_ref}
 
 
+def case_stepper(path: str, n: int = 100, dt: float = 0.01) -> dict:
+    """Every input driven by its own torque signal, every output compared with the
+    in-process Stepper of the FMU's scene after each step (same inputs, same steps)."""
+    import winder
+
+    md = fmpy.read_model_description(path)
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    with loaded_fmu(path, instance_name="host") as (fmu, refs, unzip):
+        start_fmu(fmu, refs)
+        sim = winder.Stepper(winder.load_scene(unzip / "resources" / "scene.toml"))
+        worst, echo = 0.0, 0.0
+        for i in range(n):
+            taus = [(300.0 + 100.0 * k) * np.sin(0.05 * (k + 1) * i) + 1500.0 + 500.0 * k
+                    for k in range(len(inputs))]
+            if inputs:
+                fmu.setReal([refs[k] for k in inputs], taus)
+            for name, tau in zip(inputs, taus, strict=True):
+                sim.set_input(name, tau)
+            fmu.doStep(currentCommunicationPoint=i * dt, communicationStepSize=dt)
+            sim.step(dt)
+            got = np.array(fmu.getReal([refs[k] for k in outputs]))
+            want = np.array([sim.output(k) for k in outputs])
+            worst = max(worst, float(np.max(np.abs(got - want) / (1.0 + np.abs(want)))))
+            # a torque-driven drum's torque channel is its input
+            echo = max([echo, *(abs(sim.output(k) - tau) for k, tau in zip(inputs, taus,
+                                                                            strict=True))])
+        fmu.terminate()
+        fmu.freeInstance()
+    return {"worst": worst, "echo": echo, "inputs": inputs, "outputs": outputs,
+            "t": sim.t, "state": sim.state}
+
+
+def case_free_drums(path: str, n: int = 20, dt: float = 0.01) -> dict:
+    """Contact off: each drum turns under its own constant input torque alone."""
+    md = fmpy.read_model_description(path)
+    inputs = sorted(v.name for v in md.modelVariables if v.causality == "input")
+    taus = {name: 300.0 - 420.0 * k for k, name in enumerate(inputs)}
+    with loaded_fmu(path, instance_name="host") as (fmu, refs, _):
+        start_fmu(fmu, refs)
+        drums = [name[:-len("_torque")] for name in inputs]
+        speeds = []
+        speed0 = fmu.getReal([refs[f"{d}_speed"] for d in drums])
+        fmu.setReal([refs[k] for k in inputs], [taus[k] for k in inputs])
+        accel = []
+        for i in range(n):
+            fmu.doStep(currentCommunicationPoint=i * dt, communicationStepSize=dt)
+            speeds.append(fmu.getReal([refs[f"{d}_speed"] for d in drums]))
+            accel.append(fmu.getReal([refs[f"{d}_accel"] for d in drums]))
+        fmu.terminate()
+        fmu.freeInstance()
+    return {"drums": drums, "torques": [taus[k] for k in inputs], "speed0": speed0,
+            "speeds": speeds, "accel": accel, "dt": dt}
+
+
 def case_bad_input(path: str) -> dict:
     with loaded_fmu(path, instance_name="host") as (fmu, refs, _):
         start_fmu(fmu, refs, speed_profile=False)
@@ -73,11 +128,12 @@ def case_cycles_instantiate(path: str, n: int = 220) -> dict:
 
     mem, radius = [], []
     with loaded_fmu(path, instance_name="host") as (fmu, refs, _):
+        name = "radius" if "radius" in refs else "set_radius"  # single drum / two drums
         for i in range(n):
             start_fmu(fmu, refs)
             for k in range(5):
                 fmu.doStep(currentCommunicationPoint=k * 1e-3, communicationStepSize=1e-3)
-            radius.append(fmu.getReal([refs["radius"]])[0])
+            radius.append(fmu.getReal([refs[name]])[0])
             fmu.terminate()
             fmu.freeInstance()
             if i in (19, n - 1):

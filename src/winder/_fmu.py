@@ -6,8 +6,8 @@ A host that loads the FMU must therefore be a Python process (FMPy, or any tool 
 embeds that Python) whose environment has winder installed; the scene travels inside the
 FMU (``resources/scene.toml``).
 
-Interface
----------
+Interface of a single-drum scene (the old format)
+-------------------------------------------------
 - parameters (:data:`FMU_PARAMETERS`): web speed and acceleration, imbalance, nip
   stiffness and damping, friction, caliper, density, width, and ``speed_profile``: true
   drives the drum along the built-in web-speed profile (``drum_torque`` is then an
@@ -18,6 +18,19 @@ Interface
 - outputs: every result channel (:data:`winder._stepper.OUTPUTS`) and
   ``web_speed_reference`` = ``min(a_w t, v_w)`` [m/s], the profile a speed controller
   follows.
+
+Interface of a machine from parts
+---------------------------------
+- parameters (:func:`fmu_parameters`), named by part: per drum ``DRUM_web_speed`` (and
+  ``DRUM_web_acceleration`` for a speed profile), per roll ``ROLL_com_offset``,
+  ``ROLL_width``, ``ROLL_density``, ``ROLL_caliper``, per nip ``NIP_contact_stiffness``,
+  ``NIP_contact_damping``, ``NIP_mu``, ``NIP_slip_reference_velocity``,
+  ``NIP_relaxation_length``, and ``web_tension``; the drives are the scene's.
+- inputs: the :class:`~winder.Stepper`'s, ``DRUM_torque`` [N·m] per torque-driven drum
+  (none when every drum follows a speed profile).
+- outputs: the Stepper's outputs (machines.md §9 channels) but the ``DRUM_torque``
+  channel of a torque-driven drum, which is its input (same name, same value).
+- ``rtol``: tolerance of the internal DOPRI5 (both kinds).
 """
 
 from __future__ import annotations
@@ -30,7 +43,8 @@ from typing import Any
 from ._errors import WinderError
 from ._scene import Scene, load_scene
 
-__all__ = ["build_fmu", "FMU_PARAMETERS", "scene_with_parameters", "FmuError"]
+__all__ = ["build_fmu", "FMU_PARAMETERS", "fmu_parameters", "parameter_value",
+           "scene_with_parameters", "FmuError"]
 
 #: FMU parameter name → (scene table, key, description with unit).
 FMU_PARAMETERS: dict[str, tuple[str, str, str]] = {
@@ -65,28 +79,100 @@ class FmuError(WinderError):
     """The FMU could not be built or does not run in this Python."""
 
 
-def scene_with_parameters(scene: Scene, values: dict[str, float], *,
-                          speed_profile: bool) -> Scene:
-    """The scene with FMU parameter values applied (validated like a file)."""
-    changes: dict[str, dict[str, Any]] = {}
-    drive: dict[str, Any] = {}
-    for name, value in values.items():
-        if name not in FMU_PARAMETERS:
-            raise FmuError(f"unknown FMU parameter {name!r}; valid: {', '.join(FMU_PARAMETERS)}")
-        table, key, _ = FMU_PARAMETERS[name]
-        if table == "drum.drive":
-            drive[key] = float(value)
+#: Parameters of a machine from parts, per part kind: FMU name suffix → key path in
+#: the part's table, description with unit.
+_PART_PARAMETERS: dict[str, dict[str, tuple[tuple[str, ...], str]]] = {
+    "roll": {
+        "com_offset": (("com_offset",), "centre of mass offset e [m]"),
+        "width": (("width",), "roll width L [m]"),
+        "density": (("density",), "paper density [kg/m3]"),
+        "caliper": (("caliper",), "paper thickness h [m]"),
+    },
+    "nip": {
+        "contact_stiffness": (("contact", "stiffness"), "nip stiffness k [N/m]"),
+        "contact_damping": (("contact", "damping"), "nip damping c [N s/m]"),
+        "mu": (("friction", "mu"), "friction coefficient [-]"),
+        "slip_reference_velocity": (("friction", "slip_velocity"),
+                                    "slip regularisation v_ref [m/s]"),
+        "relaxation_length": (("friction", "relaxation_length"), "relaxation length [m]"),
+    },
+}
+
+#: A parameter's place in the scene: the table, the element name for an array of tables
+#: (None for a single table) and the key path below it.
+ParameterPath = tuple[str, "str | None", tuple[str, ...]]
+
+
+def fmu_parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
+    """The FMU parameters of ``scene`` (besides ``rtol`` and, single-drum only,
+    ``speed_profile``): FMU name → (place in the scene, description with unit)."""
+    if scene.legacy:
+        out: dict[str, tuple[ParameterPath, str]] = {}
+        for name, (table, key, text) in FMU_PARAMETERS.items():
+            top, *sub = table.split(".")
+            out[name] = ((top, None, (*sub, key)), text)
+        return out
+    out = {}
+    for drum in scene.drums:
+        if drum.drive.kind == "speed_profile":
+            out[f"{drum.name}_web_acceleration"] = (
+                ("drum", drum.name, ("drive", "web_acceleration")),
+                f"web acceleration of drum {drum.name}'s profile [m/s2]")
+            text = f"final web speed of drum {drum.name}'s profile [m/s]"
         else:
-            changes.setdefault(table, {})[key] = float(value)
-    d = scene.drum.drive
-    a = drive.get("web_acceleration", d.web_acceleration)
-    v = drive.get("web_speed", d.web_speed)
-    if speed_profile:
-        drive.update(kind="speed_profile", web_acceleration=a, web_speed=v)
-    else:  # free drum, started at the profile's initial speed
-        drive.update(kind="torque", web_acceleration=a, web_speed=0.0 if a > 0 else v,
-                     torque=0.0)
-    changes["drum"] = {"drive": drive}
+            text = f"initial surface speed of drum {drum.name} [m/s]"
+        out[f"{drum.name}_web_speed"] = (("drum", drum.name, ("drive", "web_speed")), text)
+    for kind, parts in (("roll", scene.rolls), ("nip", scene.nips)):
+        for part in parts:
+            for suffix, (path, text) in _PART_PARAMETERS[kind].items():
+                out[f"{part.name}_{suffix}"] = ((kind, part.name, path),
+                                                f"{kind} {part.name}: {text}")
+    if scene.web is not None:
+        out["web_tension"] = (("web", None, ("tension",)), "web tension T [N]")
+    return out
+
+
+def parameter_value(scene: Scene, place: ParameterPath) -> float:
+    """The scene's value at a parameter's place (:func:`fmu_parameters`)."""
+    table, element, path = place
+    if element is None:
+        obj: Any = getattr(scene, table)
+    else:
+        obj = next(p for p in getattr(scene, f"{table}s") if p.name == element)
+    for key in path:
+        obj = getattr(obj, key)
+    return float(obj)
+
+
+def scene_with_parameters(scene: Scene, values: dict[str, float], *,
+                          speed_profile: bool | None = None) -> Scene:
+    """The scene with FMU parameter values applied (validated like a file).
+    ``speed_profile`` (single-drum scenes only, where it is required): true drives the
+    drum along its profile, false frees it at the profile's initial speed."""
+    places = fmu_parameters(scene)
+    if scene.legacy != (speed_profile is not None):
+        raise FmuError("speed_profile is a parameter of single-drum scenes only")
+    changes: dict[str, dict[str, Any]] = {}
+    for name, value in values.items():
+        if name not in places:
+            raise FmuError(f"unknown FMU parameter {name!r}; valid: {', '.join(places)}")
+        table, element, path = places[name][0]
+        node = changes.setdefault(table, {})
+        if element is not None:
+            node = node.setdefault(element, {})
+        for key in path[:-1]:
+            node = node.setdefault(key, {})
+        node[path[-1]] = float(value)
+    if scene.legacy:
+        drive = changes.setdefault("drum", {}).setdefault("drive", {})
+        d = scene.drum.drive
+        a = drive.get("web_acceleration", d.web_acceleration)
+        v = drive.get("web_speed", d.web_speed)
+        if speed_profile:
+            drive.update(kind="speed_profile", web_acceleration=a, web_speed=v)
+        else:  # free drum, started at the profile's initial speed
+            drive.update(kind="torque", web_acceleration=a, web_speed=0.0 if a > 0 else v,
+                         torque=0.0)
     return scene.replace(**changes)
 
 

@@ -7,12 +7,16 @@ import sys
 from pathlib import Path
 from typing import Any
 
+# scipy (its libgfortran) loaded with this module, not lazily inside the first
+# instantiate (the static balance of a body free in x and z calls scipy.optimize.root):
+# loaded there, the host process aborted at exit in libgfortran's finaliser ("corrupted
+# double-linked list") in 2-6 of 12-16 runs of a two-drum FMU; loaded here, 0 of 48.
+import scipy.optimize  # noqa: F401
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
-from ._drive import SpeedProfile
 from ._errors import WinderError
-from ._fmu import FMU_PARAMETERS, scene_with_parameters
+from ._fmu import fmu_parameters, parameter_value, scene_with_parameters
 from ._scene import load_scene
 from ._stepper import OUTPUTS, Stepper
 
@@ -22,11 +26,11 @@ _PINNED: list[dict[str, Any]] = []
 
 
 class WinderSlave(Fmi2Slave):
-    """Co-simulation slave: parameters, input ``drum_torque_command``, all channels as
-    outputs."""
+    """Co-simulation slave: parameters, torque inputs, all channels as outputs (the
+    interface of :mod:`winder._fmu`: single-drum scenes keep their own)."""
 
     author = "winder"
-    description = "Paper winder: driven drum and growing paper roll on a compliant nip"
+    description = "Paper winding machine from winder (scene in resources/scene.toml)"
 
     def __init__(self, **kwargs: Any) -> None:
         # pythonfmu 0.7's binary releases a *borrowed* reference to the slave module's
@@ -37,49 +41,71 @@ class WinderSlave(Fmi2Slave):
         if module is not None:
             _PINNED.append(vars(module))
         super().__init__(**kwargs)
-        self._scene = load_scene(Path(self.resources) / "scene.toml")
-        sc = self._scene
-        tables = {"drum.drive": sc.drum.drive, "roll": sc.roll, "contact": sc.contact,
-                  "friction": sc.friction, "paper": sc.paper}
-        for name, (table, key, text) in FMU_PARAMETERS.items():
-            setattr(self, name, float(getattr(tables[table], key)))
+        self._scene = sc = load_scene(Path(self.resources) / "scene.toml")
+        self._legacy = bool(sc.legacy)
+        self._places = fmu_parameters(sc)
+        for name, (place, text) in self._places.items():
+            setattr(self, name, parameter_value(sc, place))
             self.register_variable(Real(name, causality=Fmi2Causality.parameter,
                                         variability=Fmi2Variability.fixed, description=text))
-        self.speed_profile = sc.drum.drive.kind == "speed_profile"
-        self.register_variable(Boolean(
-            "speed_profile", causality=Fmi2Causality.parameter,
-            variability=Fmi2Variability.fixed,
-            description="true: drum follows the web-speed profile; false: driven by "
-                        "drum_torque_command"))
+        if self._legacy:
+            self.speed_profile = sc.drum.drive.kind == "speed_profile"
+            self.register_variable(Boolean(
+                "speed_profile", causality=Fmi2Causality.parameter,
+                variability=Fmi2Variability.fixed,
+                description="true: drum follows the web-speed profile; false: driven by "
+                            "drum_torque_command"))
         self.rtol = 1e-8
         self.register_variable(Real("rtol", causality=Fmi2Causality.parameter,
                                     variability=Fmi2Variability.fixed,
                                     description="tolerance of the internal DOPRI5 [-]"))
-        self.drum_torque_command = 0.0
-        self.register_variable(Real("drum_torque_command", causality=Fmi2Causality.input,
-                                    variability=Fmi2Variability.continuous,
-                                    description="drum drive torque [N m] (free drum)"))
         self._stepper: Stepper | None = None
+        self._built: tuple[Any, ...] | None = None
+        self._inputs: dict[str, str] = {}  # FMU input name → Stepper input name
         self._build()
-        for name in (*OUTPUTS, "web_speed_reference"):
+        st = self._stepper
+        assert st is not None
+        self._inputs = ({"drum_torque_command": "drum_torque"} if self._legacy
+                        else {name: name for name in st.inputs})
+        for name, stepper_name in self._inputs.items():
+            # start value: the scene's drive torque (legacy: 0, the freed drum's)
+            start = 0.0 if self._legacy else float(
+                st.system.params[st.system.machine.param_index(st.inputs[stepper_name])])
+            setattr(self, name, start)
+            self.register_variable(Real(name, causality=Fmi2Causality.input,
+                                        variability=Fmi2Variability.continuous,
+                                        description="drive torque [N m]"))
+        self._outputs = ((*OUTPUTS, "web_speed_reference") if self._legacy else
+                         tuple(k for k in st.output_names if k not in self._inputs))
+        for name in self._outputs:
             self.register_variable(Real(name, causality=Fmi2Causality.output,
                                         variability=Fmi2Variability.continuous,
                                         initial=Fmi2Initial.exact))
 
     def _build(self) -> None:
-        values = {name: getattr(self, name) for name in FMU_PARAMETERS}
-        scene = scene_with_parameters(self._scene, values, speed_profile=bool(self.speed_profile))
-        self._stepper = Stepper(scene, rtol=float(self.rtol))
-        self._profile = SpeedProfile(scene.drum.radius, float(self.web_acceleration),
-                                     float(self.profile_web_speed))
+        """A Stepper of the scene with the parameters' values (again only when they
+        changed since the last build)."""
+        values = {name: float(getattr(self, name)) for name in self._places}
+        profile = bool(self.speed_profile) if self._legacy else None
+        key = (tuple(values.values()), profile, float(self.rtol))
+        if key != self._built:
+            scene = scene_with_parameters(self._scene, values, speed_profile=profile)
+            self._stepper = Stepper(scene, rtol=float(self.rtol))
+            self._built = key
+        else:
+            assert self._stepper is not None
+            self._stepper.reset()
         self._publish()
 
     def _publish(self) -> None:
         st = self._stepper
         assert st is not None
         for name, value in st.outputs().items():
-            setattr(self, name, value)
-        self.web_speed_reference = float(self._profile.web_speed(st.t))
+            if name not in self._inputs:  # a parts scene's DRUM_torque is the input
+                setattr(self, name, value)
+        if self._legacy:  # the profile min(a_w t, v_w) [m/s] (a_w = 0: v_w from t = 0)
+            a, v = float(self.web_acceleration), float(self.profile_web_speed)
+            self.web_speed_reference = min(a * st.t, v) if a > 0 else v
 
     def exit_initialization_mode(self) -> None:
         self._build()  # parameters may have been set during initialisation
@@ -91,11 +117,13 @@ class WinderSlave(Fmi2Slave):
             if abs(current_time - st.t) > 1e-9 * max(1.0, abs(current_time)):
                 raise WinderError(f"do_step at t = {current_time} but the FMU is at "
                                   f"t = {st.t} (steps must be contiguous)")
-            if st.free_drum:
-                tau = float(self.drum_torque_command)
+            for name, stepper_name in self._inputs.items():
+                if stepper_name not in st.inputs:  # single-drum scene on its profile
+                    continue
+                tau = float(getattr(self, name))
                 if not math.isfinite(tau):
-                    raise WinderError(f"input drum_torque_command is not finite: {tau!r}")
-                st.set_input("drum_torque", tau)
+                    raise WinderError(f"input {name} is not finite: {tau!r}")
+                st.set_input(stepper_name, tau)
             st.step(step_size)
         except WinderError as exc:
             self.log(str(exc), status=Fmi2Status.error, category="logStatusError")

@@ -247,14 +247,18 @@ def _check_fmu(path: Path) -> str:
             start_fmu(fmu, refs)
             for i in range(10):
                 fmu.doStep(currentCommunicationPoint=i * 1e-3, communicationStepSize=1e-3)
-            radius = fmu.getReal([refs["radius"]])[0]
+            # the roll's radius: ``radius`` (single drum) or the first ``ROLL_radius``
+            name = "radius" if "radius" in refs else next(
+                (k for k in refs if k.endswith("_radius")), None)
+            radius = fmu.getReal([refs[name]])[0] if name is not None else None
             fmu.terminate()
         except Exception as exc:  # FMPy raises plain exceptions with the FMI status
             raise WinderError(f"{path} was built but does not run in this Python "
                               f"({sys.executable}): {exc}") from exc
         finally:
             fmu.freeInstance()
-    return f"run-checked with FMPy {fmpy.__version__}: 10 steps of 1 ms, radius {radius:.6g} m"
+    where = f", {name} {radius:.6g} m" if name is not None else ""
+    return f"run-checked with FMPy {fmpy.__version__}: 10 steps of 1 ms{where}"
 
 
 def _cmd_fmu(args: argparse.Namespace) -> int:
