@@ -61,13 +61,13 @@ def static_state(machine: Machine, p: np.ndarray | None = None) -> Equilibrium:
     modes[contact] = IN_CONTACT
     unknowns = []
     resting = bool(machine.scene.effects.contact)  # without contact, free bodies start
-    for b in machine.bodies if resting else []:  # at their centres (§7)
+    for b in machine.bodies:  # at their centres (§7)
         fixed_z = b.kind == "roll" and getattr(b.part, "initial_height", None) is not None
         for c in b.free:
             if c == "z" and fixed_z:
                 x[machine.index(f"{b.name}.z")] = b.part.initial_height
-                continue
-            unknowns.append((b.name, c, machine.index(f"{b.name}.{c}")))
+            elif resting:
+                unknowns.append((b.name, c, machine.index(f"{b.name}.{c}")))
     be = NumericBackend(machine.model)
     if not unknowns:
         return Equilibrium(x, 0.0, 0.0)
