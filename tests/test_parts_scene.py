@@ -303,13 +303,17 @@ BAD = [
     ("single drum table", lambda d: d.update(drum=d["drum"][0]),
      r"\[rider\]: a table of scenes of parts in a scene of the single-drum format"),
     ("unknown table", lambda d: d.update(span={}), r"\[span\]: unknown table; valid tables: "),
-    # not yet supported
-    ("unwinding roll", lambda d: d["roll"][0].update(kind="unwinding"),
-     r"\[roll 'set'\] kind: 'unwinding': not yet supported"),
+    # the line's parts in a winder without an unwind (more in test_line_scene.py)
+    ("unwinding set", lambda d: d["roll"][0].update(kind="unwinding"),
+     r"\[roll 'set'\] free: \['x', 'z'\]: an unwinding roll's centre is fixed"),
     ("roll drive", lambda d: d["roll"][0].update(drive={"kind": "torque", "torque": 1.0}),
-     r"\[roll 'set'\] drive: a roll drive \(unwinding rolls only\) is not yet supported"),
-    ("web span", lambda d: d["web"].update(span={"from": "set", "length": 3.0}),
-     r"\[web\] span: \[web.span\] .* is not yet supported"),
+     r"\[roll 'set'\] drive: .*: a drive on a wound roll; only unwinding rolls"),
+    ("web span and tension", lambda d: d["web"].update(span={"from": "set", "length": 3.0}),
+     r"\[web\] tension: 1000.0: with \[web.span\] the tension is the span's state"),
+    ("web span from the set", lambda d: d["web"].pop("tension") and d["web"].update(
+        span={"from": "set", "length": 3.0, "EA": 1e6}),
+     r"\[web.span\] from: 'set' is roll 'set' of kind 'wound', not an unwinding roll; "
+     r".*valid names: \(none: no roll has kind = unwinding\)"),
 ]
 
 

@@ -3,7 +3,8 @@ on construction.
 
 Two formats load: the single-drum format (tables ``[drum]``, ``[roll]``, ``[contact]``,
 ``[friction]``; :attr:`Scene.legacy`) and scenes of parts (arrays of tables ``[[drum]]``,
-``[[roll]]``, ``[[rider]]``, ``[[nip]]`` and ``[web]``). A single-drum scene is also
+``[[roll]]``, ``[[rider]]``, ``[[nip]]``, and ``[web]`` with its optional ``[web.span]``
+from an unwinding roll). A single-drum scene is also
 converted to parts (drum "drum", roll "roll", nip "nip", web entering at "nip"), so code
 written for parts reads both.
 
@@ -29,14 +30,18 @@ from .parts import (
     AXES,
     CONTACT_LAWS,
     ROLL_KINDS,
+    UNWIND_DRIVE_KINDS,
     ContactLaw,
     DrumPart,
     FrictionLaw,
     NipPart,
     RiderPart,
     RollPart,
+    SpanPart,
     SpeedProfileDrive,
+    TensionControl,
     TorqueDrive,
+    UnwindTorqueDrive,
     WebPart,
 )
 
@@ -204,6 +209,8 @@ class Scene:
     drum "drum" at the origin, sense +1; roll "roll" free in ``z`` at ``(0, R + r0)``,
     sense −1; nip "nip" (a = drum, b = roll); web entering at "nip" with tension 0. In a
     scene of parts those four are None, and ``paper`` is None unless ``[paper]`` is given.
+    A winder line has one unwinding roll (``rolls``, kind ``"unwinding"``) feeding the
+    span ``web.span`` (machines spec §5).
     """
 
     scene: SceneInfo
@@ -277,9 +284,19 @@ class Scene:
                 if self.paper is not None and roll[key] == getattr(self.paper, key):
                     del roll[key]
         if self.web is not None:
-            out["web"] = _table_dict(self.web)
+            out["web"] = _web_dict(self.web)
         out["solver"] = _table_dict(self.solver)
         return out
+
+
+def _web_dict(web: WebPart) -> dict[str, Any]:
+    """``[web]`` as a TOML table: with a span, ``[web.span]`` (its roll under the key
+    ``from``) and no ``tension`` (the span's state)."""
+    out = _table_dict(web)
+    if web.span is not None:
+        del out["tension"]
+        out["span"] = {"from": out["span"].pop("source"), **out["span"]}
+    return out
 
 
 def _table_dict(obj: Any) -> dict[str, Any]:
@@ -435,14 +452,22 @@ _PART_SPEC: dict[str, dict[str, tuple]] = {
               "friction": ("table", False, None)},
     "nip[].contact": _SPEC["contact"],
     "nip[].friction": _SPEC["friction"],
+    "roll[].drive": {"kind": ("str", True, None), "torque": ("num", False, None),
+                     "tension": ("num", False, _POS), "bandwidth": ("num", False, _POS)},
     "web": {"entry_nip": ("ref", True, None), "tension": ("num", False, _NONNEG),
             "span": ("table", False, None)},
+    "web.span": {"from": ("ref", True, None), "length": ("num", True, _POS),
+                 "EA": ("num", True, _POS), "T_in": ("num", False, _NONNEG),
+                 "initial_tension": ("num", False, _NONNEG)},
 }
 _PART_SPEC["roll[]"]["density"] = ("num", False, _NONNEG)  # default: [paper]
 _PART_SPEC["roll[]"]["caliper"] = ("num", False, _POS)
 #: Keys of each drive kind of a drum.
 _DRIVE_KEYS = {"speed_profile": ("kind", "web_acceleration", "web_speed", "ratio"),
                "torque": ("kind", "torque", "web_speed")}
+#: Keys of each drive kind of an unwinding roll.
+_UNWIND_DRIVE_KEYS = {"torque": ("kind", "torque"),
+                      "tension_control": ("kind", "tension", "bandwidth")}
 _MAX.update({("drum[]", k): _MAX[("drum", k)] for k in _SPEC["drum"]})
 _MAX.update({("drum[].drive", k): _MAX[("drum.drive", k)]
              for k in ("web_acceleration", "web_speed", "torque")})
@@ -451,8 +476,13 @@ _MAX.update({("nip[]." + t, k): v for (t, k), v in _MAX.items()
              if t in ("contact", "friction")})
 _MAX.update({("drum[].drive", "ratio"): 100.0, ("rider[]", "radius"): 10.0,
              ("rider[]", "mass"): 1e6, ("rider[]", "inertia"): 1e7,
-             ("rider[]", "x"): MAX_COORD, ("web", "tension"): 1e7})
+             ("rider[]", "x"): MAX_COORD, ("web", "tension"): 1e7,
+             ("roll[].drive", "torque"): 1e8, ("roll[].drive", "tension"): 1e7,
+             ("roll[].drive", "bandwidth"): 1e4, ("web.span", "length"): 1e3,
+             ("web.span", "EA"): 1e12, ("web.span", "T_in"): 1e7,
+             ("web.span", "initial_tension"): 1e7})
 _CHOICES.update({("drum[].drive", "kind"): DRIVE_KINDS, ("roll[]", "kind"): ROLL_KINDS,
+                 ("roll[].drive", "kind"): UNWIND_DRIVE_KINDS,
                  ("nip[].contact", "law"): CONTACT_LAWS})
 #: Arrays of tables of a scene of parts, and the tables of each format.
 _ARRAYS = ("drum", "roll", "rider", "nip")
@@ -732,9 +762,78 @@ def _elements(source: str, data: Mapping[str, Any], array: str
     return out
 
 
-def _not_yet(source: str, table: str, key: str, what: str) -> SceneError:
-    return _fail(source, table, key, f"{what} not yet supported (unwinding rolls and web "
-                                     "spans come in a later issue)")
+def _parse_drive_keys(source: str, table: str, drive: dict[str, Any],
+                      keys: Mapping[str, tuple[str, ...]]) -> None:
+    """Every key of a parsed drive belongs to its kind (``keys[kind]``)."""
+    for key in drive:
+        if key not in keys[drive["kind"]]:
+            raise _fail(source, table, key, f"not a key of kind {drive['kind']!r}; valid "
+                                            f"keys: {', '.join(keys[drive['kind']])}")
+
+
+def _parse_roll_drive(source: str, label: str, kw: dict[str, Any], raw: Mapping[str, Any]
+                      ) -> UnwindTorqueDrive | TensionControl | None:
+    """The drive of a roll (spec §6): only an unwinding roll may have one."""
+    if "drive" not in raw:
+        return None
+    if kw["kind"] != "unwinding":
+        raise _fail(source, label, "drive",
+                    f"{show(raw['drive'])}: a drive on a {kw['kind']} roll; only unwinding "
+                    "rolls (kind = 'unwinding') have a drive; a wound roll is turned by its "
+                    "nips; valid: remove drive")
+    dlabel = f"{label}.drive"
+    d = _parse_table(source, dlabel, raw["drive"], spec_name="roll[].drive",
+                     specs=_PART_SPEC)
+    _parse_drive_keys(source, dlabel, d, _UNWIND_DRIVE_KEYS)
+    if d["kind"] == "torque":
+        return UnwindTorqueDrive(**d)
+    if "tension" not in d:
+        raise _fail(source, dlabel, "tension",
+                    "missing required key (kind = 'tension_control': the set-point [N])")
+    return TensionControl(**d)
+
+
+def _parse_roll(source: str, label: str, raw: Mapping[str, Any], paper: Paper | None
+                ) -> RollPart:
+    """One ``[[roll]]`` element: its keys, paper defaults, core and drive (spec §1, §8)."""
+    kw = _parse_table(source, label, raw, spec_name="roll[]", specs=_PART_SPEC)
+    kw.setdefault("kind", "wound")
+    if kw["kind"] == "unwinding":
+        kw.setdefault("free", ())
+        if kw["free"]:
+            raise _fail(source, label, "free",
+                        f"{show(list(kw['free']))}: an unwinding roll's centre is fixed "
+                        "(spec §1); valid: [] (or leave free out)")
+    kw["drive"] = _parse_roll_drive(source, label, kw, raw)
+    kw.setdefault("initial_radius", kw["core_radius"])
+    for key in ("density", "caliper"):
+        if key not in kw:
+            if paper is None:
+                raise _fail(source, label, key, "missing required key (the scene has no "
+                                                f"[paper] {key} to default to)")
+            kw[key] = getattr(paper, key)
+    _check_roll_core(source, label, kw)
+    return RollPart(**kw)
+
+
+def _parse_web(source: str, data: Mapping[str, Any]) -> WebPart | None:
+    """``[web]`` and its ``[web.span]`` (spec §3, §5, §8)."""
+    web_raw = data.get("web")
+    if isinstance(web_raw, list):
+        raise SceneError(f"{source}: [[web]]: a scene has one web, got {len(web_raw)} "
+                         "([[web]] is an array); write a single [web] table")
+    if web_raw is None:
+        return None
+    kw = _parse_table(source, "web", web_raw, specs=_PART_SPEC)
+    if "span" in web_raw:
+        if "tension" in web_raw:
+            raise _fail(source, "web", "tension",
+                        f"{show(web_raw['tension'])}: with [web.span] the tension is the "
+                        "span's state (spec §5); valid: remove tension (the span's "
+                        "initial_tension sets where it starts)")
+        sp = _parse_table(source, "web.span", web_raw["span"], specs=_PART_SPEC)
+        kw["span"] = SpanPart(source=sp.pop("from"), **sp)
+    return WebPart(**kw)
 
 
 def _parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
@@ -747,10 +846,7 @@ def _parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
         kw = _parse_table(source, label, raw, spec_name="drum[]", specs=spec)
         dlabel = f"{label}.drive"
         d = _parse_table(source, dlabel, raw["drive"], spec_name="drum[].drive", specs=spec)
-        for key in d:
-            if key not in _DRIVE_KEYS[d["kind"]]:
-                raise _fail(source, dlabel, key, f"not a key of kind {d['kind']!r}; valid "
-                                                 f"keys: {', '.join(_DRIVE_KEYS[d['kind']])}")
+        _parse_drive_keys(source, dlabel, d, _DRIVE_KEYS)
         if d["kind"] == "speed_profile":
             if "web_speed" not in d:
                 raise _fail(source, dlabel, "web_speed",
@@ -759,22 +855,8 @@ def _parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
         else:
             drive = TorqueDrive(**d)
         drums.append(DrumPart(**kw, drive=drive))
-    rolls = []
-    for label, raw in _elements(source, data, "roll"):
-        kw = _parse_table(source, label, raw, spec_name="roll[]", specs=spec)
-        if kw.get("kind", "wound") != "wound":
-            raise _not_yet(source, label, "kind", f"{kw['kind']!r}:")
-        if "drive" in raw:
-            raise _not_yet(source, label, "drive", "a roll drive (unwinding rolls only) is")
-        kw.setdefault("initial_radius", kw["core_radius"])
-        for key in ("density", "caliper"):
-            if key not in kw:
-                if paper is None:
-                    raise _fail(source, label, key, "missing required key (the scene has no "
-                                                    f"[paper] {key} to default to)")
-                kw[key] = getattr(paper, key)
-        _check_roll_core(source, label, kw)
-        rolls.append(RollPart(**kw))
+    rolls = [_parse_roll(source, label, raw, paper)
+             for label, raw in _elements(source, data, "roll")]
     riders = [RiderPart(**_parse_table(source, label, raw, spec_name="rider[]", specs=spec))
               for label, raw in _elements(source, data, "rider")]
     nips = []
@@ -787,17 +869,7 @@ def _parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
             kw[key] = law(**_parse_table(source, f"{label}.{key}", raw.get(key, {}),
                                          spec_name=f"nip[].{key}", specs=spec))
         nips.append(NipPart(**kw))
-    web_raw = data.get("web")
-    if isinstance(web_raw, list):
-        raise SceneError(f"{source}: [[web]]: a scene has one web, got {len(web_raw)} "
-                         "([[web]] is an array); write a single [web] table")
-    web = None
-    if web_raw is not None:
-        kw = _parse_table(source, "web", web_raw, specs=spec)
-        if isinstance(web_raw, dict) and "span" in web_raw:
-            raise _not_yet(source, "web", "span", "[web.span] (a web span from an unwinding "
-                                                   "roll) is")
-        web = WebPart(**kw)
+    web = _parse_web(source, data)
     _check_references(source, drums, rolls, riders, nips, web)
     return {"drums": tuple(drums), "rolls": tuple(rolls), "riders": tuple(riders),
             "nips": tuple(nips), "web": web}
@@ -806,8 +878,9 @@ def _parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
 def _check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
                       riders: list[RiderPart], nips: list[NipPart], web: WebPart | None
                       ) -> None:
-    """Unique names, and every ``a``, ``b``, ``rides``, ``entry_nip`` naming a part of the
-    right kind; nips that can be assembled (machines spec §8)."""
+    """Unique names, and every ``a``, ``b``, ``rides``, ``entry_nip``, ``from`` naming a
+    part of the right kind; nips that can be assembled; one span per unwinding roll
+    (machines spec §8)."""
     kinds: dict[str, str] = {}
     for kind, parts in (("drum", drums), ("roll", rolls), ("rider", riders), ("nip", nips)):
         for i, p in enumerate(parts):
@@ -870,6 +943,7 @@ def _check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
             raise SceneError(f"{source}: [web]: missing required table: the scene has the "
                              f"wound roll {wound[0]!r}; add [web] with entry_nip = the nip "
                              f"where the web enters it; valid names: {valid}")
+        _check_span(source, kinds, rolls, web)
         return
     if web.entry_nip not in entries:
         ref = web.entry_nip
@@ -883,6 +957,40 @@ def _check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
                 "is not a nip of the scene"
         raise _fail(source, "web", "entry_nip", f"{show(ref)} {what}; valid names: "
                                                 f"{', '.join(entries) or '(none)'}")
+    _check_span(source, kinds, rolls, web)
+
+
+def _check_span(source: str, kinds: Mapping[str, str], rolls: list[RollPart],
+                web: WebPart | None) -> None:
+    """One span per scene, fed by the one unwinding roll its ``from`` names (spec §5);
+    ``kinds`` maps every part's name to its kind."""
+    unwinding = [r.name for r in rolls if r.kind == "unwinding"]
+    if len(unwinding) > 1:
+        raise _fail(source, f"roll {unwinding[1]!r}", "kind",
+                    f"'unwinding': one span per scene, fed by one unwinding roll, and roll "
+                    f"{unwinding[0]!r} already is one (unwinding rolls: "
+                    f"{', '.join(unwinding)}); valid: kind = 'wound' here, or one unwinding "
+                    "roll")
+    span = web.span if web is not None else None
+    if span is None:
+        if unwinding:
+            raise _fail(source, f"roll {unwinding[0]!r}", "kind",
+                        f"'unwinding': an unwinding roll feeds a web span, and the scene has "
+                        f"no [web.span]; add [web.span] with from = {unwinding[0]!r} (and "
+                        "[web] entry_nip, where the web enters the wound roll)")
+        return
+    if span.source not in unwinding:
+        ref = span.source
+        if kinds.get(ref) == "roll":
+            what = f"is roll {ref!r} of kind 'wound', not an unwinding roll"
+        elif ref in kinds:
+            what = f"is {kinds[ref]} {ref!r}, not an unwinding roll"
+        else:
+            what = "is not a roll of the scene"
+        raise _fail(source, "web.span", "from",
+                    f"{show(ref)} {what}; the span starts at the unwinding roll that feeds "
+                    "it; valid names: "
+                    f"{', '.join(unwinding) or '(none: no roll has kind = unwinding)'}")
 
 
 def _check_rest_on_nip(scene: Scene) -> None:
