@@ -141,6 +141,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if m.get("static_residual") is not None:
         print(f"  initial static balance: residual {m['static_residual']:.1e} N of "
               f"{m['static_scale']:.1e} N")
+    if m.get("ended"):
+        print(f"  {m['ended']}")
     if plots is not None:
         from ._plots import paper_figures
 
