@@ -154,3 +154,22 @@ def test_the_run_ends_where_the_parent_runs_out() -> None:
     # (0.7 t²/2 on the ramp) paid it off: h ∫v dt = π (R² − r_c²)
     t_end = math.sqrt(2 * math.pi * (0.402**2 - 0.4**2) / 70e-6 / 0.7)
     assert r.t[-1] == pytest.approx(t_end, rel=2e-3)
+
+
+def test_cli_run_says_where_the_parent_ran_out(tmp_path) -> None:
+    """`winder run` writes the result up to the end and names it (exit 0)."""
+    import subprocess
+    import sys
+
+    import tomli_w
+
+    scene = _line(parent={"initial_radius": 0.402}, duration=30.0)
+    path = tmp_path / "short_parent.toml"
+    path.write_text(tomli_w.dumps(scene.to_dict()))
+    out = tmp_path / "r.npz"
+    proc = subprocess.run([sys.executable, "-m", "winder", "run", str(path), "--out",
+                           str(out)], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert "ran out of web" in proc.stdout
+    r = winder.load_result(out)
+    assert r["parent_radius"][-1] == 0.4 and r.t[-1] < 30.0
