@@ -185,3 +185,8 @@ def test_tension_control_holds_across_the_diameter_range(radius) -> None:
                         output_step=0.01)
     e = np.max(np.abs(r["tension_error"]))
     assert e == pytest.approx(0.6311, rel=1e-3)
+
+
+def test_a_span_needs_the_web_tension_effect() -> None:
+    with pytest.raises(winder.ModelError, match=r"\[effects\] web_tension = false"):
+        winder.simulate(_line(effects={"web_tension": False}), t_end=0.1)

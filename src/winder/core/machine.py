@@ -112,6 +112,12 @@ class Machine:
         self.rolls = [b for b in self.bodies if b.kind == "roll"]
         self.span = getattr(scene.web, "span", None) if scene.web is not None else None
         self.unwind = self.body[self.span.source] if self.span is not None else None
+        if self.span is not None and not fx.web_tension:
+            from .._errors import ModelError
+
+            raise ModelError(f"{scene.source}: [effects] web_tension = false with a "
+                             "[web.span]: the span's tension is the web_tension effect; "
+                             "valid: web_tension = true, or no [web.span]")
         self.model = self._build_model()
         self.param_names: list[str] = []
         self.param_values: list[float] = []
