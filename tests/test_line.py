@@ -190,3 +190,12 @@ def test_tension_control_holds_across_the_diameter_range(radius) -> None:
 def test_a_span_needs_the_web_tension_effect() -> None:
     with pytest.raises(winder.ModelError, match=r"\[effects\] web_tension = false"):
         winder.simulate(_line(effects={"web_tension": False}), t_end=0.1)
+
+
+def test_small_line_model_runs_out_when_its_paper_is_paid_off() -> None:
+    """models/winder_line_small.toml: 1907 m of paper on the parent; at the drums' 2 m/s²
+    ramp to 41.7 m/s it is paid off at 20.85 + (1907 − 435)/41.7 = 56.17 s (+0.04 s for
+    the span's strain): measured 56.199 s."""
+    r = winder.simulate(MODELS / "winder_line_small.toml")
+    assert r.t[-1] == pytest.approx(56.2, abs=0.05)
+    assert r["parent_radius"][-1] == 0.4
