@@ -424,3 +424,145 @@ def test_readout_follows_the_animation_in_chromium(tmp_path: Path, two_drum,
                                         re.S).group(1))
     assert shown in texts
     assert texts.index(shown) > 5, shown  # it moved on from the first frame
+
+
+# ---- the winder line: the parent roll and the web span between it and the winder ---------
+
+@pytest.fixture(scope="module")
+def line() -> winder.Scene:
+    return winder.load_scene(MODELS / "winder_line.toml")
+
+
+def _synthetic_line(scene: winder.Scene) -> winder.Result:
+    """The parent shrinks 1.25 → 0.45 m about its fixed centre while the set grows
+    0.1 → 0.5 m between the drums; the span's tension varies."""
+    from winder.viewer._motion import drawn_channels, nip_channels
+
+    from winder.core.machine import Machine
+
+    t = np.linspace(0.0, 4.0, 5)
+    r = np.linspace(0.1, 0.5, 5)
+    m = Machine(scene)
+    ch = {c: np.zeros(5) for c in (*drawn_channels(scene, m),
+                                   *nip_channels(scene, m).values())}
+    z = np.sqrt((0.5 + r) ** 2 - 0.525**2)
+    ch.update(t=t, set_radius=r, set_z=z, set_x=0.01 * t, rider_z=z + r + 0.15,
+              parent_radius=np.linspace(1.25, 0.45, 5), parent_angle=0.3 * t,
+              parent_speed=np.full(5, 0.3), span_tension=np.array([1e3, 950.0, 1234.5,
+                                                                    0.0, 1001.25]))
+    return winder.Result(ch, {"scene": scene.name, "scene_dict": scene.to_dict()})
+
+
+def _web_segments(tracks: dict) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Ends ``(start, end)`` [m] (frames × xyz) of the web's segments, in path order."""
+    segs = sorted(p for p, name in tracks if p.startswith("/meshcat/winder/web/s")
+                  and name == ".position")
+    ends = []
+    for seg in segs:
+        mid = np.array([k["value"] for k in tracks[(seg, ".position")]])
+        quat = [k["value"] for k in tracks[(seg, ".quaternion")]]
+        length = np.array([k["value"][0] for k in tracks[(seg + "/strip", ".scale")]])
+        half = np.array([_quat_matrix(q)[:, 0] for q in quat]) * (0.5 * length)[:, None]
+        ends.append((mid - half, mid + half))
+    return ends
+
+
+def test_line_html_draws_the_parent_and_the_web_span(tmp_path: Path, line) -> None:
+    """In the HTML of a winder line, frame k (t_k = k·t_end/(playback·fps)): the parent
+    roll stays at its scene centre (3.2, 0.8) and its paper is scaled to parent_radius;
+    the web is one path whose first point is the parent's exit point
+    p_u = c_u + s·r_u·(−t_z, t_x) (t_u the unit vector from c_u to the rear drum's
+    centre, s = +1; machines spec §5), whose straight run touches the rear drum
+    tangentially, whose arc lies on the rear drum and whose last point is the entry nip
+    point p_b = c_b − r_b n; the readout shows the parent's radius and the span's
+    tension. Measured errors: radius 0, p_u 4e-16 m, tangency 4e-16 m², p_b 3e-16 m."""
+    from winder.viewer import plan_animation
+
+    res = _synthetic_line(line)
+    plan = plan_animation(res, playback=2.0, fps=10, scene=line)
+    text = export_html(WinderGraph(line), res, tmp_path / "line.html", playback=2.0,
+                       fps=10).read_text()
+    tracks = _tracks(text)
+    times = np.arange(21) * 4.0 / 20
+    np.testing.assert_allclose(plan.times, times, rtol=1e-15)
+
+    def ch(name: str) -> np.ndarray:
+        return np.interp(times, res.t, res[name])
+    r_u = ch("parent_radius")
+    assert np.ptp(r_u) > 0.7  # it shrinks visibly
+    scale = np.array([k["value"] for k in tracks[("/meshcat/winder/parent/paper", ".scale")]])
+    np.testing.assert_allclose(scale[:, 0], r_u, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(scale[:, 2], r_u, rtol=1e-12, atol=1e-12)
+    pos = np.array([k["value"] for k in tracks[("/meshcat/winder/parent", ".position")]])
+    np.testing.assert_allclose(pos, np.tile([3.2, 0.0, 0.8], (21, 1)), atol=1e-15)
+    ends = _web_segments(tracks)
+    for (_, b), (a, _) in zip(ends[:-1], ends[1:], strict=True):
+        np.testing.assert_allclose(a, b, atol=1e-12)  # one path: the segments join
+    c_u, c_a = np.array([3.2, 0.8]), np.array([0.525, 0.0])
+    t_u = (c_a - c_u) / np.hypot(*(c_a - c_u))
+    p_u = c_u + r_u[:, None] * np.array([-t_u[1], t_u[0]])  # s = +1
+    start = ends[0][0]
+    np.testing.assert_allclose(start[:, [0, 2]], p_u, atol=1e-12)
+    np.testing.assert_allclose(start[:, 1], 0.0, atol=1e-12)
+    touch = ends[0][1][:, [0, 2]]  # where the span meets the rear drum
+    np.testing.assert_allclose(np.hypot(*(touch - c_a).T), 0.5, atol=1e-12)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", touch - c_a, touch - p_u), 0.0,
+                               atol=1e-12)  # tangent: radius ⟂ span
+    assert np.all(touch[:, 1] < -0.45)  # on the drum's underside (the web runs below)
+    for _, b in ends[:-1]:
+        np.testing.assert_allclose(np.hypot(b[:, 0] - 0.525, b[:, 2]), 0.5, atol=1e-12)
+    c_b = np.column_stack([ch("set_x"), ch("set_z")])
+    n = (c_b - c_a) / np.hypot(*(c_b - c_a).T)[:, None]
+    np.testing.assert_allclose(ends[-1][1][:, [0, 2]], c_b - ch("set_radius")[:, None] * n,
+                               atol=1e-12)
+    texts = _embedded_readout(text)
+    for k in (0, 7, 13, 20):
+        lines = [line.split() for line in texts[k].splitlines()]
+        assert ["parent", "r", f"{r_u[k]:.4f}", "m"] in lines
+        assert lines[-1] == ["span", "T", f"{ch('span_tension')[k]:.1f}", "N"]
+    assert len({t.splitlines()[-1] for t in texts}) > 10  # the tension changes
+
+
+def test_line_camera_frames_the_parent_roll(line) -> None:
+    """Pinhole oracle: with the camera of WinderGraph.camera over the run's extent, the
+    parent roll's near face (y = −w/2) at its largest radius projects inside the
+    1000×750 image (75° vertical field of view), as do the set and both drums."""
+    from winder.viewer import motion
+
+    res = _synthetic_line(line)
+    graph = WinderGraph(line)
+    m = motion(line, res, res.t)
+    xc, zc, d = graph.camera(m.extent())
+    f = 375.0 / np.tan(np.radians(37.5))
+    for name, y in (("parent", -2.5), ("set", -2.5), ("front", -2.625), ("rear", -2.625)):
+        b = m.bodies[name]
+        for x, z in ((b.x - b.radius, b.z), (b.x + b.radius, b.z), (b.x, b.z - b.radius),
+                     (b.x, b.z + b.radius)):
+            u = 500.0 + f * (x - xc) / (y + d)
+            v = 375.0 - f * (z - zc) / (y + d)
+            assert np.all((0 < u) & (u < 1000) & (0 < v) & (v < 750)), (name, u, v)
+
+
+def test_line_run_motion_from_its_channels(line) -> None:
+    """On a real (1 s) run of the line: the drawn web starts at the engine's exit point
+    recomputed here from the channels and ends at p_b; the drawn parent radius is its
+    channel at the sampled frames; the readout prints span_tension. Measured: 0, 3e-16 m."""
+    from winder.viewer import check_drawable, motion, readout_text
+
+    res = winder.simulate(line.replace(scene={"duration": 1.0, "output_step": 0.05}))
+    check_drawable(res)
+    k = np.arange(0, len(res.t), 4)
+    m = motion(line, res, res.t[k])
+    np.testing.assert_allclose(m.bodies["parent"].radius, res["parent_radius"][k],
+                               rtol=1e-12, atol=1e-12)
+    c_u, c_a = np.array([3.2, 0.8]), np.array([0.525, 0.0])
+    t_u = (c_a - c_u) / np.hypot(*(c_a - c_u))
+    for i, j in enumerate(k):
+        path = m.web(i)
+        p_u = c_u + res["parent_radius"][j] * np.array([-t_u[1], t_u[0]])
+        np.testing.assert_allclose(path[0], p_u, atol=1e-12)
+        c_b = np.array([res["set_x"][j], res["set_z"][j]])
+        p_b = c_b - res["set_radius"][j] * (c_b - c_a) / np.hypot(*(c_b - c_a))
+        np.testing.assert_allclose(path[-1], p_b, atol=1e-12)
+        assert readout_text(m, i).splitlines()[-1].split() == [
+            "span", "T", f"{res['span_tension'][j]:.1f}", "N"]

@@ -1,6 +1,7 @@
 """What a result says about where every body of a machine is: centres, angles, radii,
 speeds and nip forces at chosen times, read from the result's channels, and the path of
-the web into its entry nip.
+the web into its entry nip: from off-screen, or, on a winder line (a ``[web.span]``), from
+the unwinding roll's exit point ``p_u`` along the span (machines spec §5).
 
 A scene of parts (machines spec §9) names its channels per body (``NAME_angle``,
 ``NAME_speed``, ``NAME_x``/``NAME_z`` where free, ``NAME_radius`` for a paper roll) and
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -21,9 +23,11 @@ from winder._errors import WinderError
 from winder._result import Result
 from winder._scene import Scene
 from winder.core.machine import Body, Machine
+from winder.forces.web_tension import exit_point
 
 __all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
-           "check_drawable", "scene_of", "motion", "web_path", "WEB_LEAD", "WEB_ARC_POINTS"]
+           "check_drawable", "scene_of", "motion", "web_path", "span_web_path", "exit_points",
+           "WEB_LEAD", "WEB_ARC_POINTS"]
 
 #: Length of the web's straight run drawn before it meets the entry drum [m] (off-screen).
 WEB_LEAD = 20.0
@@ -143,18 +147,28 @@ class BodyMotion:
 class Motion:
     """Every body and nip of a machine at ``times`` [s]: ``bodies`` by name, nip normal
     forces [N] by nip name (``None`` when the result has no such channel) and the entry
-    nip's ``(a, b)`` body names (``None`` without a web)."""
+    nip's ``(a, b)`` body names (``None`` without a web). On a winder line, ``unwind`` is
+    the unwinding roll's name, ``exit`` its exit points ``p_u`` [m] (``(len(times), 2)``,
+    :func:`exit_points`) and ``span_tension`` the span's tension [N] (``None`` when the
+    result has no ``span_tension`` channel); all three are ``None`` without a span."""
 
     times: np.ndarray
     bodies: dict[str, BodyMotion]
     normal_forces: dict[str, np.ndarray | None]
     entry: tuple[str, str] | None
+    unwind: str | None = None
+    exit: np.ndarray | None = None
+    span_tension: np.ndarray | None = None
 
     def web(self, k: int) -> np.ndarray | None:
-        """The web's path at sample ``k`` (:func:`web_path`), or ``None``."""
+        """The web's path at sample ``k`` (:func:`span_web_path` from the exit point
+        on a line, else :func:`web_path` from off-screen), or ``None``."""
         if self.entry is None:
             return None
         a, b = (self.bodies[n] for n in self.entry)
+        if self.exit is not None:
+            return span_web_path(self.exit[k], (a.x[k], a.z[k]), a.radius[k], a.sense,
+                                 (b.x[k], b.z[k]), b.radius[k])
         return web_path((a.x[k], a.z[k]), a.radius[k], a.sense, (b.x[k], b.z[k]),
                         b.radius[k])
 
@@ -193,7 +207,27 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
     forces = {n: (sample(c) if c in result else None)
               for n, c in nip_channels(scene, m).items()}
     entry = (m.entry.a.name, m.entry.b.name) if m.entry is not None else None
-    return Motion(times, bodies, forces, entry)
+    unwind = exit_ = tension = None
+    if getattr(m, "span", None) is not None and m.entry is not None:
+        unwind = m.unwind.name
+        exit_ = exit_points(m, bodies)
+        tension = sample("span_tension") if "span_tension" in result else None
+    return Motion(times, bodies, forces, entry, unwind, exit_, tension)
+
+
+def exit_points(machine: Machine, bodies: dict[str, BodyMotion]) -> np.ndarray:
+    """The unwinding roll's exit points ``p_u`` [m], one row ``(x, z)`` per sample of
+    ``bodies``: the engine's :func:`winder.forces.web_tension.exit_point` (direction
+    ``t_u`` towards the entry drum's centre, ``p_u = c_u + s·r_u·(−t_z, t_x)``) evaluated
+    on the drawn centres and radii with numpy."""
+    def kin(b: BodyMotion, body: Body) -> SimpleNamespace:
+        return SimpleNamespace(cx=b.x, cz=b.z, r=b.radius, body=body)
+
+    u, a = machine.unwind, machine.entry.a
+    ev = SimpleNamespace(machine=machine, M=np, bodies={
+        u.name: kin(bodies[u.name], u), a.name: kin(bodies[a.name], a)})
+    _, _, ox, oz = exit_point(ev)
+    return np.column_stack([bodies[u.name].x + ox, bodies[u.name].z + oz])
 
 
 def web_path(c_a: tuple[float, float], r_a: float, sense_a: int,
@@ -205,17 +239,47 @@ def web_path(c_a: tuple[float, float], r_a: float, sense_a: int,
     (``θ̇ = sense · speed > 0``: clockwise seen from ``−y``) up to the nip direction
     ``n = (c_b − c_a)/|c_b − c_a|``, ending at the roll's contact point
     ``p_b = c_b − r_b n`` (machines spec §2)."""
+    s = 1.0 if sense_a >= 0 else -1.0
+    alpha_s = -0.5 * math.pi - s * WEB_MEET
+    arc = _wrap(c_a, r_a, s, alpha_s, c_b, r_b)
+    return np.vstack([arc[0] - WEB_LEAD * _travel(s, alpha_s), arc])
+
+
+def span_web_path(p_u: tuple[float, float] | np.ndarray, c_a: tuple[float, float],
+                  r_a: float, sense_a: int, c_b: tuple[float, float], r_b: float
+                  ) -> np.ndarray:
+    """Points ``(x, z)`` [m] of the web of a winder line: from the unwinding roll's exit
+    point ``p_u`` straight along the span to where it touches drum ``a`` (the tangent from
+    ``p_u`` along which the drum's surface moves away from ``p_u``), then as
+    :func:`web_path` around the drum into the nip, ending at ``p_b = c_b − r_b n``."""
+    p, ca = np.asarray(p_u, dtype=float), np.asarray(c_a, dtype=float)
+    s = 1.0 if sense_a >= 0 else -1.0
+    v = p - ca
+    beta = math.atan2(v[1], v[0])
+    phi = math.acos(min(1.0, r_a / max(float(np.hypot(*v)), 1e-12)))
+    # of the two tangent points, the one where the web runs on in the drum's direction
+    alpha_s = max((beta + phi, beta - phi), key=lambda al: float(
+        np.dot(ca + r_a * np.array([math.cos(al), math.sin(al)]) - p, _travel(s, al))))
+    return np.vstack([p, _wrap(c_a, r_a, s, alpha_s, c_b, r_b)])
+
+
+def _travel(s: float, alpha: float) -> np.ndarray:
+    """Travel direction of a drum's surface at angle ``alpha`` [rad] (``θ̇ > 0`` about
+    ``+y`` moves the point at angle α along ``(sin α, −cos α)``), for sense ``s``."""
+    return s * np.array([math.sin(alpha), -math.cos(alpha)])
+
+
+def _wrap(c_a: tuple[float, float], r_a: float, s: float, alpha_s: float,
+          c_b: tuple[float, float], r_b: float) -> np.ndarray:
+    """:data:`WEB_ARC_POINTS` points around drum ``a`` from angle ``alpha_s`` [rad] in
+    its direction of motion up to the nip direction ``n = (c_b − c_a)/|c_b − c_a|``, the
+    last one replaced by the roll's contact point ``p_b = c_b − r_b n``."""
     ca, cb = np.asarray(c_a, dtype=float), np.asarray(c_b, dtype=float)
     d = cb - ca
     n = d / max(float(np.hypot(*d)), 1e-12)
-    s = 1.0 if sense_a >= 0 else -1.0
     alpha_n = math.atan2(n[1], n[0])
-    alpha_s = -0.5 * math.pi - s * WEB_MEET
     wrap = (s * (alpha_s - alpha_n)) % (2.0 * math.pi)
     alpha = alpha_s - s * wrap * np.linspace(0.0, 1.0, WEB_ARC_POINTS)
     arc = ca + r_a * np.column_stack([np.cos(alpha), np.sin(alpha)])
     arc[-1] = cb - r_b * n
-    # travel direction of the drum surface at the meeting point (θ̇ > 0 about +y moves
-    # the point at angle α along (sin α, −cos α))
-    travel = s * np.array([math.sin(alpha_s), -math.cos(alpha_s)])
-    return np.vstack([arc[0] - WEB_LEAD * travel, arc])
+    return arc

@@ -1,5 +1,5 @@
-"""On-screen readout: time, roll radii, body speeds and nip normal forces, as an HTML
-overlay on meshcat's page.
+"""On-screen readout: time, roll radii (the unwinding roll's too), body speeds, nip normal
+forces and, on a winder line, the span's tension, as an HTML overlay on meshcat's page.
 
 meshcat 0.3.2 animates only numeric properties of objects, so the text is not part of the
 3-D scene: the page gets a ``<div id="winder-readout">`` and, for an animation, one text
@@ -26,9 +26,10 @@ _STYLE = (f"#{READOUT_ID} {{position: fixed; left: 10px; top: 10px; margin: 0; "
 
 def readout_text(m: Motion, k: int) -> str:
     """The readout of sample ``k`` of ``m``: ``t`` [s]; per paper roll its radius [m];
-    per body its speed [rad/s] and surface speed [m/s]; per nip its normal force [kN]."""
+    per body its speed [rad/s] and surface speed [m/s]; per nip its normal force [kN]; on
+    a winder line the span's tension ``span  T … N`` [N] (``-`` without its channel)."""
     lines = [f"t  {m.times[k]:10.2f} s"]
-    width = max(len(n) for n in (*m.bodies, *m.normal_forces))
+    width = max(len(n) for n in (*m.bodies, *m.normal_forces, "span"))
     for b in m.bodies.values():
         if b.kind == "roll":
             lines.append(f"{b.name:<{width}}  r {b.radius[k]:8.4f} m")
@@ -38,6 +39,10 @@ def readout_text(m: Motion, k: int) -> str:
     for name, f in m.normal_forces.items():
         value = "      -" if f is None else f"{f[k] / 1e3:8.3f}"
         lines.append(f"{name:<{width}}  N {value} kN")
+    if m.unwind is not None:
+        T = m.span_tension
+        value = "      -" if T is None else f"{T[k]:8.1f}"
+        lines.append(f"{'span':<{width}}  T {value} N")
     return "\n".join(lines)
 
 

@@ -1,6 +1,7 @@
 """meshcat scene graph of any machine of parts: every drum, paper roll and rider roll as a
 cylinder along ``y`` with a radial mark (so that rotation shows), the web into its entry
-nip as a strip of segments, a floor and the far side frames.
+nip as a strip of segments (on a winder line from the unwinding roll), a floor and the far
+side frames of the fixed stands (drums, unwinding rolls).
 
 Placements of the bodies come from the Pinocchio model of the machine
 (:class:`winder.core.machine.Machine`: per body prismatic ``x``/``z`` where free, then a
@@ -64,9 +65,12 @@ class WinderGraph:
         rolls = [b.part for b in self.machine.bodies if b.kind == "roll"]
         #: Length of the drums [m]: the widest roll's width.
         self.length = max((r.width for r in rolls), default=1.0)
-        drums = [b for b in self.machine.bodies if b.kind == "drum"] or self.machine.bodies
-        #: Height of the floor [m]: 0.35 m below the lowest drum.
-        self.floor_z = min(b.centre[1] - _radius0(b) for b in drums) - 0.35
+        #: Bodies on stands (drums and unwinding rolls: fixed centres) or, without any,
+        #: every body: the floor spans them and each stand gets a far side frame.
+        self.stands = [b for b in self.machine.bodies
+                       if b.kind == "drum" or b.unwinding] or self.machine.bodies
+        #: Height of the floor [m]: 0.35 m below the lowest stand.
+        self.floor_z = min(b.centre[1] - _radius0(b) for b in self.stands) - 0.35
         entry = self.machine.entry
         self.web_width = 1.12 * (entry.b.part.width if entry is not None else self.length)
 
@@ -105,15 +109,14 @@ class WinderGraph:
                     g.Box([1.0, self.web_width, WEB_THICKNESS]), lam(color=COLOURS["web"]))
         # context: floor and the far side frames carrying the drum bearings (the near ones
         # would hide the nips from the camera)
-        # (a base plate 0.5 m wider than the drums: the web comes in past its edge)
-        drums = [b for b in self.machine.bodies if b.kind == "drum"] or self.machine.bodies
-        x0 = min(b.centre[0] - _radius0(b) for b in drums) - 0.5
-        x1 = max(b.centre[0] + _radius0(b) for b in drums) + 0.5
+        # (a base plate 0.5 m wider than the stands: the web comes in past its edge)
+        x0 = min(b.centre[0] - _radius0(b) for b in self.stands) - 0.5
+        x1 = max(b.centre[0] + _radius0(b) for b in self.stands) + 0.5
         root["floor"].set_object(g.Box([x1 - x0, 1.2 * L, 0.05]),
                                  lam(color=COLOURS["floor"]))
         root["floor"].set_transform(_translation([0.5 * (x0 + x1), 0.0, self.floor_z]))
         for b in self.machine.bodies:
-            if b.kind == "drum":
+            if b.kind == "drum" or b.unwinding:
                 h = b.centre[1] - self.floor_z
                 root["frame"][b.name].set_object(g.Box([0.25, 0.08, h]),
                                                  lam(color=COLOURS["frame"]))
