@@ -1,13 +1,14 @@
 """Work–precision study: error against wall time per method (writes docs/work_precision.*).
 
-Problems: the smooth paper scene (first 120 s and the full 700 s), free spin (closed
-form) and 0.5 s of the bouncing phase of the paper scene (from t = 25 s). Methods: the
-compiled DOPRI5 and fixed-step RK4, and scipy's RK45, DOP853, Radau, BDF and LSODA on
-the compiled right-hand side, plus LSODA on the Pinocchio backend and BDF/Radau with the
-Pinocchio-derivative Jacobian (instead of their finite differences). Errors are the largest
-deviation over the output grid, scaled by the channel's largest magnitude, against a
-DOP853 solution at rtol 1e-12 (the closed form for free spin; the compiled DOPRI5 at
-1e-12 where scipy's DOP853 cannot get through the bouncing or would take minutes).
+Problems: the smooth paper scene (first 120 s), 0.5 s of the bouncing phase of the paper
+scene (from t = 25 s), free spin (closed form) and the two-drum winder's first 30 s (the
+speed ramp, the set settling into the valley under the rider). Methods: the compiled
+DOPRI5, ROS2 (Rosenbrock, exact Jacobian) and fixed-step RK4, and scipy's RK45, DOP853,
+Radau, BDF and LSODA on the generated right-hand side (the implicit ones with the exact
+generated Jacobian, and Radau/BDF also with their finite differences), plus LSODA on the
+numeric Pinocchio backend. Errors are the largest deviation over the output grid, scaled by
+the channel's largest magnitude, against the compiled DOPRI5 at rtol 1e-12 (the closed
+form for free spin); the spread to a second tight solution is reported with each problem.
 
 Run:  make bench      (or  python benchmarks/work_precision.py [--quick])
 """
@@ -21,7 +22,7 @@ import os
 import platform
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -30,17 +31,16 @@ from scipy.optimize import brentq
 
 import winder
 from winder._files import atomic_write
-from winder._system import WinderSystem
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import rhs_speed  # noqa: E402  (the sibling benchmark)
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
 DOCS = ROOT / "docs"
-CHANNELS = ("radius", "roll_speed", "z", "normal_force")
+PAPER_CHANNELS = ("radius", "roll_speed", "z", "normal_force")
+TWO_DRUM_CHANNELS = ("set_radius", "set_speed", "set_x", "set_z", "rear_nip_normal_force",
+                     "rider_nip_normal_force")
 TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 RK4_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4, 6.25e-5)
+COMPILED = ("DOPRI5", "ROS2")
 SCIPY = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
 
@@ -50,15 +50,15 @@ class Problem:
     scene: winder.Scene
     t_end: float
     output_step: float
+    channels: tuple[str, ...] = PAPER_CHANNELS
     t_start: float = 0.0
     y0: np.ndarray | None = None
-    reference: dict[str, np.ndarray] | None = None
+    reference: dict[str, np.ndarray] | None = field(default=None, repr=False)
     note: str = ""
-    reference_method: str = "DOP853"
 
     def run(self, method: str, rtol: float, *, backend: str = "compiled",
             max_step: float | None = None, max_wall: float | None = None,
-            jacobian: str = "fd") -> winder.Result:
+            jacobian: str = "exact") -> winder.Result:
         return winder.simulate(self.scene, t_end=self.t_end, method=method, rtol=rtol,
                                atol=rtol * 1e-2, output_step=self.output_step,
                                backend=backend, max_step=max_step, max_wall=max_wall,
@@ -67,49 +67,50 @@ class Problem:
 
 
 def free_spin_closed_form(scene: winder.Scene, t: np.ndarray) -> dict[str, np.ndarray]:
-    """``J(r) ω = J₀ ω₀`` and ``ṙ = h ω/2π`` give ``t(r) = 2π/(h L₀) ∫ J dr``; inverted."""
-    law = WinderSystem(scene).law
+    """``J(r) ω = J₀ ω₀`` and ``ṙ = h ω/2π`` give ``t(r) = 2π/(h L₀) ∫ J dr``; inverted.
+    ``J(r) = J_c + k (r⁴ − r_c⁴)``, ``k = ρ π w / 2`` (winder-model §2)."""
     r0, w0, h = scene.roll.initial_radius, scene.roll.initial_speed, scene.paper.caliper
-    L0 = law.polar_inertia(r0) * w0
     k = 0.5 * scene.paper.density * math.pi * scene.roll.width
     rc, Jc = scene.roll.core_radius, scene.roll.core_inertia
+
+    def J(r: float) -> float:
+        return Jc + k * (r**4 - rc**4)
 
     def integral(r: float) -> float:
         return Jc * (r - r0) + k * ((r**5 - r0**5) / 5 - rc**4 * (r - r0))
 
+    L0 = J(r0) * w0
     r = np.array([brentq(lambda x, ti=ti: 2 * math.pi / (h * L0) * integral(x) - ti, r0,
                          r0 + 10.0, xtol=1e-15, rtol=1e-15) if ti > 0 else r0 for ti in t])
-    return {"radius": r, "roll_speed": L0 / np.array([law.polar_inertia(x) for x in r])}
+    return {"radius": r, "roll_speed": L0 / np.array([J(x) for x in r])}
 
 
 def build_problems(quick: bool) -> list[Problem]:
     smooth = winder.load_scene(MODELS / "paper_winding_smooth.toml")
     paper = winder.load_scene(MODELS / "paper_winding.toml")
     spin = winder.load_scene(MODELS / "free_spin.toml")
-    start = winder.simulate(paper, t_end=25.0, method="DOPRI5", rtol=1e-12, atol=1e-14,
-                            output_step=25.0)
-    names = WinderSystem(paper).state_names
-    y25 = np.array([start[n][-1] for n in ("z", "roll_angle", "z_dot", "roll_speed",
-                                           "radius")] + [start["friction_force"][-1]])
-    assert len(names) == len(y25)
+    two = winder.load_scene(MODELS / "two_drum_winder.toml")
+    start = winder.Stepper(paper, rtol=1e-12, atol=1e-14)
+    start.step(25.0)
     probs = [
         Problem("smooth paper scene, 0-120 s", smooth, 120.0, 1.0,
                 note="com_offset 0.5 mm: the roll stays on the drum"),
-        Problem("bouncing phase, 25-25.5 s", paper, 25.5, 0.005, t_start=25.0, y0=y25,
-                note="paper scene; the nip opens every turn", reference_method="DOPRI5"),
-        Problem("free spin, 0-300 s", spin, 300.0, 1.0, note="closed form reference"),
+        Problem("bouncing phase, 25-25.5 s", paper, 25.5, 0.005, t_start=25.0,
+                y0=np.array(start.y), note="paper scene; the nip opens every turn"),
+        Problem("free spin, 0-300 s", spin, 300.0, 1.0, channels=("radius", "roll_speed"),
+                note="closed form reference"),
+        Problem("two-drum winder, 0-30 s", two, 30.0 if not quick else 10.0, 0.01,
+                channels=TWO_DRUM_CHANNELS,
+                note="speed ramp; the set settles in the valley under the rider"),
     ]
-    if not quick:
-        probs.insert(1, Problem("smooth paper scene, 0-700 s", smooth, 700.0, 5.0,
-                                note="the full winding cycle", reference_method="DOPRI5"))
     return probs
 
 
 def errors(res: winder.Result, ref: dict[str, np.ndarray]) -> dict[str, float]:
     out = {}
-    for ch in CHANNELS:
-        if ch in ref and np.max(np.abs(ref[ch])) > 0:
-            out[ch] = float(np.max(np.abs(res[ch] - ref[ch])) / np.max(np.abs(ref[ch])))
+    for ch, r in ref.items():
+        if np.max(np.abs(r)) > 0:
+            out[ch] = float(np.max(np.abs(res[ch] - r)) / np.max(np.abs(r)))
     return out
 
 
@@ -124,44 +125,37 @@ def study(problems: list[Problem], *, max_wall: float, quick: bool,
             prob.reference = free_spin_closed_form(prob.scene, res.t)
             ref_note = "closed form"
         else:
-            # DOP853 at 1e-12 where scipy can reach it; through the bouncing phase scipy's
-            # steps straddle the touch-down jump of the damped force and stall at 1e-12, so
-            # the mode-locked DOPRI5 is the reference there (and on the long run, where
-            # DOP853 would take minutes); the spread to a second solution is reported.
-            main_m, other_m = (("DOP853", "DOPRI5") if prob.reference_method == "DOP853"
-                               else ("DOPRI5", "DOPRI5"))
-            ref = prob.run(main_m, 1e-12)
-            chk = prob.run(other_m, 1e-12 if other_m != main_m else 1e-11)
-            prob.reference = {ch: ref[ch] for ch in CHANNELS}
+            ref = prob.run("DOPRI5", 1e-12)
+            chk = prob.run("DOPRI5", 1e-11)
+            prob.reference = {ch: ref[ch] for ch in prob.channels}
             spread = max(errors(chk, prob.reference).values())
-            ref_note = (f"{main_m} 1e-12 ({other_m} "
-                        f"{1e-12 if other_m != main_m else 1e-11:.0e} differs by {spread:.1e})")
+            ref_note = f"DOPRI5 1e-12 (DOPRI5 1e-11 differs by {spread:.1e})"
         prob.note += f"; reference: {ref_note}"
         print(f"{prob.name}: reference in {time.perf_counter() - t0:.1f} s ({ref_note})",
               file=log, flush=True)
         runs: list[tuple[str, str, float | None, float | None]] = []
-        for m in ("DOPRI5", *SCIPY):
-            runs += [(m, "compiled", tol, None) for tol in tols]
-        runs += [("RK4", "compiled", None, h) for h in (RK4_STEPS[1::2] if quick else RK4_STEPS)]
-        if "700" not in prob.name:
+        for m in (*COMPILED, *SCIPY):
+            runs += [(m, "exact", tol, None) for tol in tols]
+        runs += [("RK4", "exact", None, h) for h in (RK4_STEPS[1::2] if quick else RK4_STEPS)]
+        runs += [(m, "fd", tol, None) for m in ("Radau", "BDF") for tol in tols]
+        if not prob.name.startswith(("smooth", "two-drum")):
             runs += [("LSODA", "pinocchio", tol, None) for tol in tols[:4]]
-            runs += [(m, "jacobian", tol, None) for m in ("BDF", "Radau") for tol in tols]
         given_up: set[tuple[str, str]] = set()
-        for method, backend, tol, h in runs:
-            label = {"compiled": method, "pinocchio": f"{method} (Pinocchio RHS)",
-                     "jacobian": f"{method} (Pinocchio Jacobian)"}[backend]
+        for method, variant, tol, h in runs:
+            label = {"exact": method, "pinocchio": f"{method} (Pinocchio RHS)",
+                     "fd": f"{method} (FD Jacobian)"}[variant]
             if (label, prob.name) in given_up:
                 continue
             row: dict[str, Any] = {"problem": prob.name, "method": label,
                                    "rtol": tol, "step": h}
             try:
                 res = prob.run(method, tol if tol is not None else 1e-6,
-                               backend="pinocchio" if backend == "pinocchio" else "compiled",
+                               backend="pinocchio" if variant == "pinocchio" else "compiled",
                                max_step=h, max_wall=max_wall,
-                               jacobian="pinocchio" if backend == "jacobian" else "fd")
+                               jacobian="fd" if variant == "fd" else "exact")
             except winder.SimulationError as exc:
                 msg = str(exc)
-                row["status"] = "wall limit" if "wall-clock" in msg else "failed"
+                row["status"] = "wall limit" if "max_wall" in msg else "failed"
                 row["message"] = msg.split(" at t =")[0][:80]
                 given_up.add((label, prob.name))
             else:
@@ -170,7 +164,7 @@ def study(problems: list[Problem], *, max_wall: float, quick: bool,
                            nfev=res.meta["rhs_evaluations"], events=res.meta["events"],
                            error=max(e.values()), **{f"err_{k}": v for k, v in e.items()})
             rows.append(row)
-            print(f"  {label:18s} {tol or h:8.1e} {row['status']:10s} "
+            print(f"  {label:24s} {tol or h:8.1e} {row['status']:10s} "
                   f"{row.get('wall', math.nan):8.3f} s  err {row.get('error', math.nan):.2e}",
                   file=log, flush=True)
     return rows
@@ -202,60 +196,59 @@ def default_check(rows: list[dict[str, Any]], problem: str) -> str:
             f"(ratio {a['wall'] / best['wall']:.2f})")
 
 
-def headline() -> dict[str, Any]:
-    """µs per RHS (both backends) and the 700 s paper cycle at rtol 1e-6."""
-    scene = winder.load_scene(MODELS / "paper_winding.toml")
-    speeds = rhs_speed.main()
-    out: dict[str, Any] = {"rhs_us_compiled": speeds["compiled"],
-                           "rhs_us_pinocchio": speeds["pinocchio"]}
-    winder.simulate(scene, t_end=1.0)  # compile and warm up
-    t0 = time.perf_counter()
-    res = winder.simulate(scene)  # auto, [solver] rtol 1e-6
-    out["cycle_total"] = time.perf_counter() - t0  # with output channels (70 001 samples)
-    out["cycle_wall"] = res.meta["wall_time"]
-    out["cycle_nfev"] = res.meta["rhs_evaluations"]
-    out["cycle_events"] = res.meta["events"]
-    out["rtf"] = 700.0 / out["cycle_total"]
-    return out
+def at_1e6(rows: list[dict[str, Any]], problem: str) -> tuple[list[str], str]:
+    """Rows of the rtol 1e-6 table (error, error/rtol, wall per method) and the method whose
+    error is closest to the requested 1e-6 (in decades)."""
+    ok = [r for r in rows if r["problem"] == problem and r["status"] == "ok"
+          and r["rtol"] == 1e-6]
+    if not ok:
+        return [], "no run at rtol 1e-6"
+    ok.sort(key=lambda r: r["wall"])
+    lines = [f"| {r['method']} | {r['error']:.1e} | {r['error'] / 1e-6:.2g} | {r['wall']:.3g} | "
+             f"{r['nfev']:,} |" for r in ok]
+    close = min(ok, key=lambda r: abs(math.log10(max(r["error"], 1e-300) / 1e-6)))
+    return lines, (f"closest to the requested accuracy at rtol 1e-6: **{close['method']}** "
+                   f"(error {close['error']:.1e}, {close['wall']:.3g} s); fastest at rtol 1e-6: "
+                   f"{ok[0]['method']} ({ok[0]['wall']:.3g} s, error {ok[0]['error']:.1e})")
 
 
-def write_markdown(rows: list[dict[str, Any]], problems: list[Problem], head: dict[str, Any],
-                   path: Path) -> None:
+def write_markdown(rows: list[dict[str, Any]], problems: list[dict[str, Any]],
+                   head: dict[str, Any], path: Path) -> None:
     lines = ["# Work–precision study", "",
              "Regenerate with `make bench` (`benchmarks/work_precision.py`). Errors: largest "
-             "deviation over the output grid of radius, roll speed, roll height and normal force, "
-             "each scaled by the channel's largest magnitude; the table gives the largest of them. "
-             "`atol = rtol/100`. Wall times on the machine that ran it "
-             f"({head.get('machine', 'see git log')}).", "",
-             "## Speed", "",
-             f"- Right-hand side: **{head['rhs_us_compiled']:.2f} µs** per evaluation (compiled "
-             f"planar backend, called from Python), {head['rhs_us_pinocchio']:.1f} µs with the "
-             "Pinocchio backend (ABA with the variable-mass terms). Inside the compiled "
-             "integrator an evaluation costs about "
-             f"{1e6 * head['cycle_wall'] / head['cycle_nfev']:.2f} µs.",
-             f"- The 700 s paper cycle (`models/paper_winding.toml`, `method=\"auto\"`, rtol "
-             f"1e-6): **{head['cycle_wall']:.2f} s** integration, {head['cycle_nfev']:,} "
-             f"evaluations, {head['cycle_events']} contact events; {head['cycle_total']:.2f} s "
-             f"with the 70 001 output samples: real-time factor **{head['rtf']:.0f}×**.", ""]
+             "deviation over the output grid of each problem's channels, each scaled by the "
+             "channel's largest magnitude; the table gives the largest of them. "
+             "`atol = rtol/100`. Scipy's implicit methods use the exact generated Jacobian "
+             "unless marked *FD Jacobian*. Runs are given up for tighter tolerances after "
+             f"one reaches the wall limit ({head['max_wall']:g} s). Wall times (`meta"
+             "[\"wall_time\"]`, the integration alone) on a shared, loaded machine "
+             f"({head.get('machine', 'see git log')}; load average {head['load'][0]:.1f} at "
+             f"the start, {head['load_after'][0]:.1f} at the end): the ratios between methods "
+             "are more telling than the absolute times.", "",
+             "Evaluation costs and whole cycles: [rhs_speed.md](rhs_speed.md), "
+             "[cycle_speed.md](cycle_speed.md), [codegen_speed.md](codegen_speed.md).", ""]
     for prob in problems:
-        lines += [f"## {prob.name}", "", prob.note + ".", "",
+        name, chans = prob["name"], prob["channels"]
+        lines += [f"## {name}", "", prob["note"] + ".", "",
                   "Best method per accuracy level (fastest run with error at most the level):", ""]
-        for level, label, wall in best_per_level(rows, prob.name):
+        for level, label, wall in best_per_level(rows, name):
             lines.append(f"- error ≤ {level:.0e}: {label}, {wall:.3g} s")
-        lines += ["", default_check(rows, prob.name) + ".", "",
+        t1e6, verdict = at_1e6(rows, name)
+        lines += ["", default_check(rows, name) + ".", "", f"At rtol 1e-6: {verdict}.", "",
+                  "| method (rtol 1e-6) | error | error / rtol | wall [s] | RHS evals |",
+                  "|---|---|---|---|---|", *t1e6, "",
                   "| method | rtol / step | status | wall [s] | RHS evals | events | error | "
-                  "radius | roll speed | z | normal force |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|"]
+                  + " | ".join(chans) + " |",
+                  "|---|---|---|---|---|---|---|" + "---|" * len(chans)]
         for r in rows:
-            if r["problem"] != prob.name:
+            if r["problem"] != name:
                 continue
             setting = f"{r['rtol']:.0e}" if r["rtol"] else f"h = {r['step']:.3g} s"
             if r["status"] != "ok":
                 lines.append(f"| {r['method']} | {setting} | {r['status']}: {r['message']} "
-                             "| | | | | | | | |")
+                             "| | | | " + "| " * len(chans) + "|")
                 continue
-            cells = [f"{r.get('err_' + c, math.nan):.1e}" if 'err_' + c in r else "–"
-                     for c in CHANNELS]
+            cells = [f"{r['err_' + c]:.1e}" if 'err_' + c in r else "–" for c in chans]
             lines.append(f"| {r['method']} | {setting} | ok | {r['wall']:.3g} | {r['nfev']:,} | "
                          f"{r['events']} | {r['error']:.1e} | " + " | ".join(cells) + " |")
         lines.append("")
@@ -263,7 +256,7 @@ def write_markdown(rows: list[dict[str, Any]], problems: list[Problem], head: di
     atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
-def plot(rows: list[dict[str, Any]], problems: list[Problem], path: Path) -> None:
+def plot(rows: list[dict[str, Any]], problems: list[dict[str, Any]], path: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -273,15 +266,16 @@ def plot(rows: list[dict[str, Any]], problems: list[Problem], path: Path) -> Non
     fig, axes = plt.subplots(nrows, cols, figsize=(6.0 * cols, 4.6 * nrows), squeeze=False)
     axes = axes.ravel()
     methods = sorted({r["method"] for r in rows})
-    colours = dict(zip(methods, plt.cm.tab10(np.linspace(0, 1, 10)), strict=False))
+    colours = dict(zip(methods, plt.cm.tab20(np.linspace(0, 1, 20)), strict=False))
     for ax, prob in zip(axes, problems, strict=False):
         for m in methods:
             pts = [(r["wall"], max(r["error"], 1e-16)) for r in rows
-                   if r["problem"] == prob.name and r["method"] == m and r["status"] == "ok"]
+                   if r["problem"] == prob["name"] and r["method"] == m
+                   and r["status"] == "ok"]
             if pts:
                 x, y = zip(*sorted(pts), strict=True)
                 ax.loglog(x, y, "o-", color=colours[m], label=m, ms=4)
-        ax.set_title(prob.name, fontsize=10)
+        ax.set_title(prob["name"], fontsize=10)
         ax.set_xlabel("wall time [s]")
         ax.grid(True, which="both", alpha=0.3)
     for ax in axes[::cols]:
@@ -299,8 +293,8 @@ def plot(rows: list[dict[str, Any]], problems: list[Problem], path: Path) -> Non
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="fewer problems and tolerances")
-    ap.add_argument("--max-wall", type=float, default=30.0,
+    ap.add_argument("--quick", action="store_true", help="fewer tolerances, shorter two-drum run")
+    ap.add_argument("--max-wall", type=float, default=20.0,
                     help="give up a method's tighter tolerances after a run this long [s]")
     ap.add_argument("--out", type=Path, default=DOCS, help="output folder (default docs/)")
     ap.add_argument("--replot", action="store_true",
@@ -310,18 +304,17 @@ def main(argv: list[str] | None = None) -> int:
     saved = args.out / "work_precision.json"
     if args.replot:
         data = json.loads(saved.read_text(encoding="utf-8"))
-        rows, head = data["rows"], data["head"]
-        problems = [Problem(p["name"], None, 0.0, 0.0, note=p["note"])  # type: ignore[arg-type]
-                    for p in data["problems"]]
+        rows, head, problems = data["rows"], data["head"], data["problems"]
     else:
-        problems = build_problems(args.quick)
-        rows = study(problems, max_wall=args.max_wall, quick=args.quick)
-        head = headline()
+        head: dict[str, Any] = {"load": os.getloadavg(), "max_wall": args.max_wall}
+        probs = build_problems(args.quick)
+        rows = study(probs, max_wall=args.max_wall, quick=args.quick)
         cpu = platform.processor() or platform.machine()
         head["machine"] = f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
-        text = json.dumps({"rows": rows, "head": head,
-                           "problems": [{"name": p.name, "note": p.note} for p in problems]},
-                          indent=1)
+        head["load_after"] = os.getloadavg()
+        problems = [{"name": p.name, "note": p.note, "channels": list(p.channels)}
+                    for p in probs]
+        text = json.dumps({"rows": rows, "head": head, "problems": problems}, indent=1)
         atomic_write(saved, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     write_markdown(rows, problems, head, args.out / "work_precision.md")
     plot(rows, problems, args.out / "work_precision.png")

@@ -19,6 +19,7 @@ from ._result import Result
 from ._scene import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
 from .core.machine import CORE_AUTO
 from .solve import integrators as integ
+from .solve.rosenbrock import ros2
 from .solve.system import MachineSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
@@ -26,8 +27,9 @@ __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "
 
 #: What ``method="auto"`` picks (chosen from the work–precision study, docs/), per backend.
 DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
-#: Methods that run entirely compiled (generated code only).
-COMPILED_METHODS = ("DOPRI5",)
+#: Methods that run entirely compiled (generated code only); ROS2 is the Rosenbrock method
+#: of :mod:`winder.solve.rosenbrock` (stiff machines, exact Jacobian).
+COMPILED_METHODS = ("DOPRI5", "ROS2")
 #: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
 _WALL_EVERY = 256  # evaluations between wall-clock checks on the Python paths
 _STEP_OVER = 1e-6  # [s] integrated without contact events after a grazing contact
@@ -105,7 +107,8 @@ def resolve_backend(backend: str | None, scene: Scene) -> str:
 
 def resolve_method(method: str | None, scene: Scene, backend: str | None = None) -> str:
     """The method to run (``auto`` resolved per backend, :data:`DEFAULT_METHOD`)."""
-    m = _check_choice("method", scene.solver.method if method is None else method, METHODS)
+    m = _check_choice("method", scene.solver.method if method is None else method,
+                      (*METHODS, "ROS2"))
     b = resolve_backend(backend, scene)
     if m == "auto":
         return DEFAULT_METHOD[b]
@@ -262,9 +265,10 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
             budget = min(integ.CHUNK, guards.limit - int(stats[0]))
             if budget <= 0:
                 raise _Stop("max_rhs")
-            if meth == "DOPRI5":
-                status, t, h, k = integ.dopri5(fns, table, t, tb, y, p, modes, rtol, atol, h,
-                                               hmax, t_out, Ys, k, budget, stats)
+            if meth in COMPILED_METHODS:
+                run = integ.dopri5 if meth == "DOPRI5" else ros2
+                status, t, h, k = run(fns, table, t, tb, y, p, modes, rtol, atol, h, hmax,
+                                      t_out, Ys, k, budget, stats)
             else:  # RK4: chunks of budget/4 steps
                 step = max_step or 1e-3
                 t_next = min(tb, t + step * budget / 4)
