@@ -52,7 +52,8 @@ __all__ = ["Scene", "SceneInfo", "Effects", "Drum", "Drive", "Roll", "Paper", "C
 EFFECT_NAMES = ("variable_mass", "web_momentum", "web_tension", "gravity", "imbalance",
                 "contact", "slip_relaxation", "rider_load")
 DRIVE_KINDS = ("speed_profile", "torque")
-METHODS = ("auto", "DOPRI5", "RK4", "RK45", "DOP853", "Radau", "BDF", "LSODA", "RK23")
+METHODS = ("auto", "DOPRI5", "RK4", "ROS2", "RK45", "DOP853", "Radau", "BDF", "LSODA",
+           "RK23")
 #: Right-hand side backends: the compiled planar equations, or Pinocchio's ABA.
 BACKENDS = ("compiled", "pinocchio")
 

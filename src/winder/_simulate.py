@@ -107,8 +107,7 @@ def resolve_backend(backend: str | None, scene: Scene) -> str:
 
 def resolve_method(method: str | None, scene: Scene, backend: str | None = None) -> str:
     """The method to run (``auto`` resolved per backend, :data:`DEFAULT_METHOD`)."""
-    m = _check_choice("method", scene.solver.method if method is None else method,
-                      (*METHODS, "ROS2"))
+    m = _check_choice("method", scene.solver.method if method is None else method, METHODS)
     b = resolve_backend(backend, scene)
     if m == "auto":
         return DEFAULT_METHOD[b]
@@ -316,8 +315,9 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     scene: from :func:`winder.load_scene`, or the path of a scene file.
     t_end: end time [s], finite and > 0 (default: ``[scene] duration``).
     method: one of ``auto`` (:data:`DEFAULT_METHOD`), DOPRI5 (compiled Dormand–Prince
-        with contact events), RK4 (fixed step ``max_step``, default 1 ms), or scipy's
-        RK45, DOP853, Radau, BDF, LSODA, RK23; default ``[solver] method``.
+        with contact events), RK4 (fixed step ``max_step``, default 1 ms), ROS2 (compiled
+        Rosenbrock on the exact Jacobian, for stiff scenes), or scipy's RK45, DOP853,
+        Radau, BDF, LSODA, RK23; default ``[solver] method``.
     rtol, atol: tolerances, rtol finite in (0, 0.1], atol finite > 0 (default ``[solver]``).
     progress: print a progress bar on stderr.
     output_step: sampling of the result [s], finite > 0 (default ``[scene] output_step``);
