@@ -119,6 +119,7 @@ class MachineSystem:
                                    for b in m.bodies if b.prescribed
                                    and b.part.drive.web_acceleration > 0})
         self.nfev = 0
+        self._tb = np.empty(1)
         self._eq: Equilibrium | None = None
         #: ``(t, state, message)`` where an unwinding roll ran out of web, else None
         self.end: tuple[float, np.ndarray, str] | None = None
@@ -191,11 +192,19 @@ class MachineSystem:
         return self.machine.evaluate(be, t, y, self.params,
                                      self.modes if modes is None else modes, outputs=outputs)
 
+    def _call(self, which: int, t: float, y: np.ndarray, size: int) -> np.ndarray:
+        """One generated function at ``(t, y)`` through the compiled caller (about 1 µs
+        from Python)."""
+        out = np.empty(size)
+        integ.evaluate(self.fns, which, self._tb, float(t),
+                       np.ascontiguousarray(y, dtype=np.float64), self.params, self.modes, out)
+        return out
+
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """``dy/dt`` (clamped nip laws; core modes as locked)."""
         self.nfev += 1
         if self.generated is not None:
-            dy = self.generated.call("rhs", t, y, self.params, self.modes)
+            dy = self._call(integ.F_RHS, t, y, self.n_states)
         else:
             ev = self.evaluate_numeric(t, y, outputs=False)
             dy = np.array([float(ev.rates[n]) for n in self.state_names])
@@ -207,7 +216,8 @@ class MachineSystem:
         """The exact Jacobian ``∂(dy/dt)/∂y`` (generated), or central differences on the
         numeric path."""
         if self.generated is not None:
-            return self.generated.call("jac", t, y, self.params, self.modes)
+            n = self.n_states
+            return self._call(integ.F_JAC, t, y, n * n).reshape(n, n, order="F")
         n = len(y)
         J = np.empty((n, n))
         for k in range(n):
@@ -221,7 +231,7 @@ class MachineSystem:
     def switches(self, t: float, y: np.ndarray) -> np.ndarray:
         """The switching functions (``machine.switch_names``)."""
         if self.generated is not None:
-            return self.generated.call("sw", t, y, self.params, self.modes)
+            return self._call(integ.F_SW, t, y, len(self.machine.switch_names))
         ev = self.evaluate_numeric(t, y, outputs=False)
         return np.array([float(ev.switches[n]) for n in self.machine.switch_names])
 
