@@ -14,8 +14,10 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 # The pin_casadi generator (Pinocchio's C++ headers on casadi::SX, winder/core/_pin_casadi.cpp):
-# built under $(VENV)/winder-pin-casadi/<pin, casadi, eigen versions>/ when missing (about 160 s
-# of g++ and 4 GB, once per version); a no-op otherwise; a warning only where g++ is missing.
+# built under ~/.cache/winder/pin-casadi/<pin, casadi, eigen versions>/ (shared by every clone
+# and venv; $(VENV)/winder-pin-casadi where the home cache is not writable) when missing
+# (about 160 s of g++ and 4 GB, once per version); a no-op otherwise; a warning only where
+# g++ is missing.
 pin-casadi: $(STAMP)
 	$(PY) -m winder.core.pin_casadi
 

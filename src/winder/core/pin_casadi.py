@@ -121,9 +121,11 @@ def _root() -> Path:
     """The folder for this generator version and its model cache."""
     key = _key()
     env = os.environ.get(_ENV_DIR)
+    # the user's cache first: every clone and venv with the same pin, casadi and eigen
+    # (the key) shares one build of the generator
     candidates = [Path(env)] if env else [
-        Path(sys.prefix) / "winder-pin-casadi",
-        Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "winder" / "pin-casadi"]
+        Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "winder" / "pin-casadi",
+        Path(sys.prefix) / "winder-pin-casadi"]
     for base in candidates:
         if _writable(base / key):
             return base / key
