@@ -127,6 +127,8 @@ class WinderSlave(Fmi2Slave):
         st = self._stepper
         assert st is not None
         try:
+            if st.ended is not None:  # before the time check: the step before stopped early
+                raise WinderError(f"the run has ended: {st.ended}")
             if abs(current_time - st.t) > 1e-9 * max(1.0, abs(current_time)):
                 raise WinderError(f"do_step at t = {current_time} but the FMU is at "
                                   f"t = {st.t} (steps must be contiguous)")
