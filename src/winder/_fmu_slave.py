@@ -133,8 +133,9 @@ class WinderSlave(Fmi2Slave):
                 raise WinderError(f"do_step at t = {current_time} but the FMU is at "
                                   f"t = {st.t} (steps must be contiguous)")
             for name, stepper_name in self._inputs.items():
-                if stepper_name not in st.inputs:  # single-drum scene on its profile
-                    continue
+                if self._legacy and not st.free_drum:
+                    continue  # a single-drum scene on its speed profile (a line's
+                    # tension set-point is an input with no torque-driven body)
                 tau = float(getattr(self, name))
                 if not math.isfinite(tau):
                     raise WinderError(f"input {name} is not finite: {tau!r}")
