@@ -39,6 +39,7 @@ demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
 	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
 	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
+	$(PY) examples/tension_control_fmu.py --out $(OUT)
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/two_drum_winder.npz --html $(OUT)/two_drum_winder.html --snapshots $(OUT)/snapshots_two_drum --every 100
 	$(PY) -m winder modes models/two_drum_winder.toml --plot $(OUT)/plots/two_drum_modes.png --csv $(OUT)/two_drum_modes.csv
@@ -73,10 +74,14 @@ peers: $(STAMP)
 docs-figures: $(STAMP)
 	$(PY) -m winder modes models/paper_winding.toml --plot docs/resonance_map.png --csv docs/modes.csv
 
-# The FMU and the closed-loop PI example (FMPy host).
+# The FMUs and the closed-loop examples (FMPy host): the drum-speed PI loop, and the winder
+# line's tension control through its FMU over a whole parent roll.
 fmu: $(STAMP)
 	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/winder.fmu
 	$(PY) examples/speed_control_fmu.py --out $(OUT)
+	$(PY) -m winder fmu models/winder_line.toml -o $(OUT)/winder_line.fmu
+	$(PY) -m winder fmu models/winder_line_small.toml -o $(OUT)/winder_line_small.fmu
+	$(PY) examples/tension_control_fmu.py --out $(OUT)
 
 lint: $(STAMP)
 	$(PY) -m ruff check src viewer tests examples benchmarks

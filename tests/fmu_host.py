@@ -88,6 +88,88 @@ def case_stepper(path: str, n: int = 100, dt: float = 0.01) -> dict:
             "t": sim.t, "state": sim.state}
 
 
+def _line_signal(name: str, i: int) -> float:
+    """An input signal of the winder line: a tension set-point about 1000 N [N], or a
+    torque about the unwind's braking torque ``−r T`` [N·m]."""
+    if name.endswith("_setpoint"):
+        return 1000.0 + 200.0 * np.sin(0.05 * i)
+    return -450.0 + 100.0 * np.sin(0.07 * i)
+
+
+def case_line(path: str, n: int = 200, dt: float = 0.01) -> dict:
+    """The winder line: its input driven by a signal, every output (and ``t``) compared
+    with the in-process Stepper of the FMU's scene after each step."""
+    import winder
+
+    md = fmpy.read_model_description(path)
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    with loaded_fmu(path, instance_name="host") as (fmu, refs, unzip):
+        start_fmu(fmu, refs)
+        sim = winder.Stepper(winder.load_scene(unzip / "resources" / "scene.toml"))
+        worst, echo = 0.0, 0.0
+        for i in range(n):
+            values = [_line_signal(k, i) for k in inputs]
+            fmu.setReal([refs[k] for k in inputs], values)
+            for name, value in zip(inputs, values, strict=True):
+                sim.set_input(name, value)
+            fmu.doStep(currentCommunicationPoint=i * dt, communicationStepSize=dt)
+            sim.step(dt)
+            got = np.array(fmu.getReal([refs[k] for k in outputs]))
+            want = np.array([sim.t if k == "t" else sim.output(k) for k in outputs])
+            worst = max(worst, float(np.max(np.abs(got - want) / (1.0 + np.abs(want)))))
+            echo = max([echo, *(abs(sim.output(k) - v) for k, v in zip(
+                inputs, values, strict=True) if k in sim.output_names)])
+        fmu.terminate()
+        fmu.freeInstance()
+    return {"worst": worst, "echo": echo, "inputs": inputs, "outputs": outputs,
+            "t": sim.t, "state": sim.state,
+            "final": {k: sim.output(k) for k in ("span_tension", "parent_radius",
+                                                  "set_radius", "parent_speed")}}
+
+
+def case_runout(path: str, dt: float = 0.01) -> dict:
+    """Steps until the parent roll runs out (the in-process Stepper alongside): where the
+    FMU's step fails, the status, the log, the outputs at that time, and the next step."""
+    import contextlib
+    import io
+
+    import winder
+
+    md = fmpy.read_model_description(path)
+    inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+    logged = io.StringIO()
+    with loaded_fmu(path, instance_name="host") as (fmu, refs, unzip):
+        start_fmu(fmu, refs)
+        sim = winder.Stepper(winder.load_scene(unzip / "resources" / "scene.toml"))
+        failed, i = None, 0
+        while failed is None and i < 100_000:
+            values = [_line_signal(k, 0) for k in inputs]
+            fmu.setReal([refs[k] for k in inputs], values)
+            for name, value in zip(inputs, values, strict=True):
+                sim.set_input(name, value)
+            with contextlib.redirect_stdout(logged):  # FMPy prints the FMU's log
+                try:
+                    fmu.doStep(currentCommunicationPoint=i * dt, communicationStepSize=dt)
+                except Exception as exc:  # FMPy raises on a status above warning
+                    failed = str(exc)
+            sim.step(dt)
+            i += 1
+        names = ["t", "parent_radius", "span_tension", "set_radius"]
+        after = dict(zip(names, fmu.getReal([refs[k] for k in names]), strict=True))
+        with contextlib.redirect_stdout(logged):
+            try:
+                fmu.doStep(currentCommunicationPoint=i * dt, communicationStepSize=dt)
+                again = None
+            except Exception as exc:
+                again = str(exc)
+        fmu.terminate()
+        fmu.freeInstance()
+    return {"steps": i, "failed": failed, "again": again, "log": logged.getvalue(),
+            "after": after, "stepper_t": sim.t, "stepper_ended": sim.ended,
+            "stepper": {k: sim.t if k == "t" else sim.output(k) for k in names}}
+
+
 def case_free_drums(path: str, n: int = 20, dt: float = 0.01) -> dict:
     """Contact off: each drum turns under its own constant input torque alone."""
     md = fmpy.read_model_description(path)

@@ -324,3 +324,149 @@ def test_parts_fmu_220_instantiate_free_cycles(torque_fmu, tmp_path) -> None:
     assert res["alive"] == 0
     assert np.allclose(res["radius"], res["radius"][0], rtol=0, atol=0)
     assert res["mem"][1] - res["mem"][0] < 10.0, res["mem"]
+
+
+# ---- the winder line (issue #15): unwind input, span tension, run-out --------------------
+
+LINES = {"line": "winder_line.toml", "small": "winder_line_small.toml",
+         "torque_line": "winder_line_fmu.toml"}
+
+
+@pytest.fixture(scope="module")
+def line_fmus(tmp_path_factory, models_dir) -> dict[str, Path]:
+    """The FMUs of the three line scenes, built by the CLI (and run-checked there)."""
+    d = tmp_path_factory.mktemp("fmu_line")
+    return {k: _cli_fmu(models_dir / v, d / f"{k}.fmu") for k, v in LINES.items()}
+
+
+@pytest.mark.parametrize("which", list(LINES))
+def test_line_fmu_validates(which, line_fmus) -> None:
+    path = line_fmus[which]
+    assert validate_fmu(str(path)) == []
+    proc = subprocess.run([str(Path(sys.executable).with_name("fmpy")), "validate",
+                           str(path)], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and "No problems found" in proc.stdout, proc.stdout
+
+
+@pytest.mark.parametrize("which", ["small", "torque_line"])
+def test_line_interface(which, line_fmus, models_dir) -> None:
+    """Inputs: the unwind's set-point (tension control) or its torque (kind torque), and
+    no drum torque (the drums follow their profile); outputs: every channel but the
+    inputs, and ``t``; parameters: the span's instead of ``web_tension``."""
+    from winder._fmu import fmu_parameters, parameter_value
+
+    scene = winder.load_scene(models_dir / LINES[which])
+    sim = winder.Stepper(scene)
+    md = fmpy.read_model_description(str(line_fmus[which]))
+    by = {v.name: v for v in md.modelVariables}
+    kinds: dict[str, set[str]] = {}
+    for v in md.modelVariables:
+        kinds.setdefault(v.causality, set()).add(v.name)
+    want = {"parent_tension_setpoint"} if which == "small" else {"parent_torque"}
+    assert set(sim.inputs) == want and kinds.pop("input") == want
+    assert kinds.pop("output") == (set(sim.output_names) - want) | {"t"}
+    assert {"span_tension", "parent_radius", "parent_speed", "set_radius", "set_speed",
+            "rear_speed"} <= set(sim.output_names)
+    params = fmu_parameters(scene)
+    assert kinds.pop("parameter") == {*params, "rtol"} and kinds == {}
+    assert "web_tension" not in params
+    for name, (place, _) in params.items():
+        assert float(by[name].start) == parameter_value(scene, place), name
+    assert float(by["span_EA"].start) == 1.4e6 and float(by["span_length"].start) == 3.0
+    (name,) = want
+    if which == "small":
+        assert float(by["parent_bandwidth"].start) == 10.0
+        assert float(by[name].start) == 1000.0
+    else:
+        assert "parent_bandwidth" not in params and "tension_error" not in by
+        assert float(by[name].start) == 0.0
+
+
+def test_line_scene_with_span_parameters(models_dir) -> None:
+    """FMU parameter values of the span and the controller land in the scene."""
+    from winder._fmu import scene_with_parameters
+
+    scene = winder.load_scene(models_dir / "winder_line_small.toml")
+    sc = scene_with_parameters(scene, {"span_EA": 2e6, "span_length": 2.5,
+                                       "parent_bandwidth": 5.0, "parent_width": 4.0})
+    assert (sc.web.span.EA, sc.web.span.length, sc.web.span.T_in) == (2e6, 2.5, 0.0)
+    parent = next(r for r in sc.rolls if r.name == "parent")
+    assert parent.drive.bandwidth == 5.0 and parent.drive.tension == 1000.0
+    assert parent.width == 4.0
+
+
+@pytest.mark.parametrize("which", ["small", "torque_line"])
+def test_line_fmu_equals_stepper(which, line_fmus, tmp_path) -> None:
+    """200 steps of 10 ms with the input (set-point or unwind torque) driven by a signal:
+    every output, and ``t``, equals the in-process Stepper's (same code, same steps:
+    measured 0). A torque input's channel equals the input exactly."""
+    res = _host("line", line_fmus[which], tmp_path)
+    assert res["worst"] < 1e-9
+    assert res["echo"] == 0.0
+    assert res["t"] == pytest.approx(2.0, rel=1e-12)
+    assert len(res["inputs"]) == 1 and len(res["outputs"]) > 50
+    # the line runs: the parent pays off (radius down from 0.45 m), the set winds
+    fin = res["final"]
+    assert fin["parent_radius"] < 0.45 and fin["set_radius"] > 0.05
+    assert fin["parent_speed"] > 1.0
+
+
+def test_line_fmu_stops_where_the_parent_runs_out(tmp_path, models_dir) -> None:
+    """A parent with 0.2 mm of paper (π (0.4002² − 0.4²) / h = 7.18 m) under the drums'
+    2 m/s² ramp from rest runs out near √(2 · 7.18 / 2) = 2.680 s (the span's strain,
+    T/EA ≈ 3e-3 under the ramp, and the start from rest delay it a little: measured
+    2.6863 s, 2.4e-3 later). The FMU's step stops there:
+    status discard, the reason in the log, the outputs at the run-out time (the Stepper's,
+    the parent at its core), and every later step fails too; the host process survives."""
+    from winder._fmu import build_fmu
+
+    scene = winder.load_scene(models_dir / "winder_line_fmu.toml")
+    scene = scene.replace(roll={"parent": {"initial_radius": 0.4002}})
+    fmu = build_fmu(_scene_file(scene, tmp_path / "runout.toml"), tmp_path / "runout.fmu")
+    res = _host("runout", fmu, tmp_path)
+    assert res["stepper_ended"] is not None and "ran out of web" in res["stepper_ended"]
+    assert "fmi2DoStep failed" in res["failed"] and "status 2" in res["failed"]
+    assert "[DISCARD]" in res["log"] and "'parent' ran out of web" in res["log"]
+    assert "stopped at t = " in res["log"]
+    after = res["after"]
+    assert after["t"] == res["stepper_t"]
+    assert (res["steps"] - 1) * 0.01 < after["t"] < res["steps"] * 0.01
+    L = np.pi * (0.4002 ** 2 - 0.4 ** 2) / 70e-6
+    assert after["t"] == pytest.approx(np.sqrt(2.0 * L / 2.0), rel=1e-2)
+    assert after["parent_radius"] == pytest.approx(0.4, abs=1e-9)
+    for k in ("parent_radius", "span_tension", "set_radius"):
+        assert after[k] == res["stepper"][k], k
+    assert res["again"] is not None and "fmi2DoStep failed" in res["again"]
+    assert "the run has ended" in res["log"]
+
+
+def test_tension_control_example_equals_the_model_controller(tmp_path, models_dir) -> None:
+    """examples/tension_control_fmu.py over 5 s: its controller, outside the FMU, is the
+    law of the in-model controller (winder_line_small.toml, same gains by the same rule),
+    so the span tension and the unwind torque equal those of winder.simulate of that
+    scene (measured 1.1e-5 of T* and of the peak torque: the 2 ms zero-order hold and
+    the sampled ∫e against the continuous law). The tension stays within 1.8 N of
+    T* = 1000 N from the start (measured 1.80 N at 0.2 s, 0.013 N after 1 s)."""
+    from winder._mass_law import paper_roll_mass
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "tension_control_fmu.py"
+    proc = subprocess.run([sys.executable, str(example), "--t-end", "5", "--out",
+                           str(tmp_path)], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "the parent did not run out" in proc.stdout
+    log = np.load(tmp_path / "tension_control_fmu.npz")
+    t = log["t"]
+    assert t[-1] == pytest.approx(5.0, rel=1e-12) and len(t) == 2501
+    ref = winder.simulate(winder.load_scene(models_dir / "winder_line_small.toml"),
+                          t_end=5.0, output_step=0.002, method="DOPRI5", rtol=1e-8,
+                          atol=1e-10)
+    T_ref = np.interp(t, ref.t, ref["span_tension"])
+    tau_ref = np.interp(t, ref.t, ref["parent_torque"])
+    assert np.max(np.abs(log["span_tension"] - T_ref)) / 1000.0 < 1.5e-4
+    assert np.max(np.abs(log["tau"] - tau_ref)) / np.max(np.abs(tau_ref)) < 1.5e-4
+    assert np.max(np.abs(log["e"])) < 2.5  # N (measured 1.80)
+    assert np.max(np.abs(log["e"][t >= 1.0])) < 0.1  # N (measured 0.013)
+    # the example's J(r) (the paper-roll law) is the model's parent inertia
+    J = paper_roll_mass(log["parent_radius"], 0.4, 3000.0, 300.0, np.pi * 650.0 * 5.0)[1]
+    np.testing.assert_allclose(J, log["parent_inertia"], rtol=1e-13)
+    assert (tmp_path / "tension_control_fmu.png").stat().st_size > 10_000

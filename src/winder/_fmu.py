@@ -26,10 +26,18 @@ Interface of a machine from parts
   ``ROLL_width``, ``ROLL_density``, ``ROLL_caliper``, per nip ``NIP_contact_stiffness``,
   ``NIP_contact_damping``, ``NIP_mu``, ``NIP_slip_reference_velocity``,
   ``NIP_relaxation_length``, and ``web_tension``; the drives are the scene's.
+  A winder line (``[web.span]``, machines.md §5) has ``span_length``, ``span_EA`` and
+  ``span_T_in`` instead of ``web_tension`` (the tension is the span's state), and
+  ``ROLL_bandwidth`` for a tension-controlled unwinding roll.
 - inputs: the :class:`~winder.Stepper`'s, ``DRUM_torque`` [N·m] per torque-driven drum
-  (none when every drum follows a speed profile).
+  or unwinding roll (``parent_torque``), ``ROLL_tension_setpoint`` [N] of a
+  tension-controlled unwind (none when every drum follows a speed profile).
 - outputs: the Stepper's outputs (machines.md §9 channels) but the ``DRUM_torque``
-  channel of a torque-driven drum, which is its input (same name, same value).
+  channel of a torque-driven drum, which is its input (same name, same value); with an
+  unwinding roll also ``t`` [s], the time of the outputs.
+- run-out: when an unwinding roll reaches its core (:attr:`winder.Stepper.ended`),
+  ``fmi2DoStep`` stops there, publishes the outputs at that time, logs why and fails
+  (``do_step`` returns false); every later step fails the same way.
 - ``rtol``: tolerance of the internal DOPRI5 (both kinds).
 """
 
@@ -127,7 +135,18 @@ def fmu_parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
             for suffix, (path, text) in _PART_PARAMETERS[kind].items():
                 out[f"{part.name}_{suffix}"] = ((kind, part.name, path),
                                                 f"{kind} {part.name}: {text}")
-    if scene.web is not None:
+    for roll in scene.rolls:
+        if getattr(roll.drive, "kind", None) == "tension_control":
+            out[f"{roll.name}_bandwidth"] = (
+                ("roll", roll.name, ("drive", "bandwidth")),
+                f"roll {roll.name}: tension controller's bandwidth ω_c [rad/s]")
+    span = scene.web.span if scene.web is not None else None
+    if span is not None:  # the tension is the span's state (no web_tension)
+        for key, text in (("length", "web span length L_s [m]"),
+                          ("EA", "web span axial stiffness EA [N]"),
+                          ("T_in", "wound-in tension of the unwinding roll T_in [N]")):
+            out[f"span_{key}"] = (("web", None, ("span", key)), text)
+    elif scene.web is not None:
         out["web_tension"] = (("web", None, ("tension",)), "web tension T [N]")
     return out
 

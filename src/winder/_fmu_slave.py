@@ -74,13 +74,24 @@ class WinderSlave(Fmi2Slave):
             setattr(self, name, start)
             self.register_variable(Real(name, causality=Fmi2Causality.input,
                                         variability=Fmi2Variability.continuous,
-                                        description="drive torque [N m]"))
+                                        description=("tension set-point [N]"
+                                                     if name.endswith("_setpoint")
+                                                     else "drive torque [N m]")))
         self._outputs = ((*OUTPUTS, "web_speed_reference") if self._legacy else
                          tuple(k for k in st.output_names if k not in self._inputs))
         for name in self._outputs:
             self.register_variable(Real(name, causality=Fmi2Causality.output,
                                         variability=Fmi2Variability.continuous,
                                         initial=Fmi2Initial.exact))
+        # a run that can end inside a step (an unwinding roll) tells the time it reached
+        self._clock = not self._legacy and st.system.machine.unwind is not None
+        if self._clock:
+            self.t = 0.0
+            self.register_variable(Real(
+                "t", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
+                initial=Fmi2Initial.exact,
+                description="time of the outputs [s]: the end of the last step, or where "
+                            "the run ended inside it"))
 
     def _build(self) -> None:
         """A Stepper of the scene with the parameters' values (again only when they
@@ -103,6 +114,8 @@ class WinderSlave(Fmi2Slave):
         for name, value in st.outputs().items():
             if name not in self._inputs:  # a parts scene's DRUM_torque is the input
                 setattr(self, name, value)
+        if getattr(self, "_clock", False):
+            self.t = st.t
         if self._legacy:  # the profile min(a_w t, v_w) [m/s] (a_w = 0: v_w from t = 0)
             a, v = float(self.web_acceleration), float(self.profile_web_speed)
             self.web_speed_reference = min(a * st.t, v) if a > 0 else v
@@ -114,12 +127,15 @@ class WinderSlave(Fmi2Slave):
         st = self._stepper
         assert st is not None
         try:
+            if st.ended is not None:  # before the time check: the step before stopped early
+                raise WinderError(f"the run has ended: {st.ended}")
             if abs(current_time - st.t) > 1e-9 * max(1.0, abs(current_time)):
                 raise WinderError(f"do_step at t = {current_time} but the FMU is at "
                                   f"t = {st.t} (steps must be contiguous)")
             for name, stepper_name in self._inputs.items():
-                if stepper_name not in st.inputs or not st.free_drum:
-                    continue  # a single-drum scene on its speed profile
+                if self._legacy and not st.free_drum:
+                    continue  # a single-drum scene on its speed profile (a line's
+                    # tension set-point is an input with no torque-driven body)
                 tau = float(getattr(self, name))
                 if not math.isfinite(tau):
                     raise WinderError(f"input {name} is not finite: {tau!r}")
@@ -129,4 +145,10 @@ class WinderSlave(Fmi2Slave):
             self.log(str(exc), status=Fmi2Status.error, category="logStatusError")
             return False
         self._publish()
+        if st.ended is not None:  # stopped inside the step: outputs at that time
+            self.log(f"{st.ended}; the step from t = {current_time:.9g} s by "
+                     f"{step_size:.6g} s stopped at t = {st.t:.9g} s (the outputs are "
+                     "those of that time); no further steps", status=Fmi2Status.discard,
+                     category="logStatusDiscard")
+            return False
         return True
