@@ -168,12 +168,16 @@ def write_docs(out: dict[str, Any]) -> None:
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in out["rows"]:
         lines.append(f"| {r['scene']} | {r['route']} | {r['states']} | {r['sx']:.2f} | "
-                     f"{r['cgen']:.2f} | {r['gcc']:.2f} | {r['total']:.2f} | "
+                     f"{r['cgen']:.4f} | {r['gcc']:.2f} | {r['total']:.2f} | "
                      f"{r['cold_process']:.2f} | {r['cached_load']:.4f} | "
                      f"{r['system_from_cache']:.3f} | {r['so_bytes'] / 1024:.0f} |")
     lines += ["", "*cold, whole process*: from the start of the measuring function to the "
               "end, including `import winder`-time work done lazily (casadi, the scene, the "
-              "Machine); Python's start-up itself is not included.", ""]
+              "Machine); Python's start-up itself is not included. *MachineSystem from cache*: "
+              "in a fresh process, mostly first imports — `scipy.optimize` for the static "
+              "balance took 1.4 s of the two-drum winder's 1.5 s in a profile (loaded "
+              "machine); model, library load and balance themselves take about 0.08 s, and a "
+              "second construction in the same process 0.01 s.", ""]
     text = "\n".join(lines)
     atomic_write(DOCS / "codegen_speed.md", lambda tmp: tmp.write_text(text, encoding="utf-8"))
     js = json.dumps(out, indent=1, default=float)

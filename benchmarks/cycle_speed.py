@@ -43,7 +43,7 @@ def run(scene: winder.Scene, method: str, *, repeats: int, max_wall: float,
     """Best of ``repeats`` runs (stops repeating once a run takes over 20 s)."""
     best: dict[str, Any] | None = None
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         try:
             res = winder.simulate(scene, method=method, rtol=1e-6, max_wall=max_wall, **kw)
         except winder.SimulationError as exc:
@@ -54,7 +54,8 @@ def run(scene: winder.Scene, method: str, *, repeats: int, max_wall: float,
                     "reached": getattr(exc, "time", None),
                     "projected": float(need.group(2)) if need else None}
         row = {"method": method, "status": "ok", "wall": res.meta["wall_time"],
-               "total": time.perf_counter() - t0, "nfev": res.meta["rhs_evaluations"],
+               "total": time.perf_counter() - t0, "cpu": time.process_time() - c0,
+               "nfev": res.meta["rhs_evaluations"],
                "events": res.meta["events"], "samples": len(res.t)}
         if best is None or row["wall"] < best["wall"]:
             best = row
@@ -122,12 +123,14 @@ def write_docs(data: dict[str, Any]) -> None:
              "`[solver]`), output grids of the scenes. *wall*: `result.meta[\"wall_time\"]`, the "
              "integration alone, after a warm-up that compiled the model and the numba "
              "kernels; *total*: the `simulate()` call with the static balance and the output "
-             "channels. Shared 2-core machine: the load average at the start of each section "
-             "is given; short runs are the best of several.", ""]
+             "channels; *CPU*: the process time of that call (what the process itself got "
+             "of a core: on a loaded machine closer to a quiet machine's wall time than the "
+             "wall time is). Shared 2-core machine: the load average at the start of each "
+             "section is given; short runs are the best of several.", ""]
     titles = {"paper": "The 700 s paper cycle",
               "two_drum": "The two-drum winder, full cycle (414.5 s; target < 2 s)",
               "stiff": "Stiff hard case: paper scene with nip stiffness 1e12 N/m (700 s)"}
-    notes = {"paper": f"Old engine (hand-written planar kernel, DOPRI5): {OLD_ENGINE_PAPER} s "
+    notes = {"paper": f"Old engine (hand-written planar kernel, DOPRI5): {OLD_ENGINE_PAPER:.2f} s "
                       "integration on a quiet machine.",
              "two_drum": "Radau, BDF, LSODA: scipy on the generated right-hand side and the "
                          "exact generated Jacobian (`jacobian=\"exact\"`), capped at "
@@ -139,19 +142,23 @@ def write_docs(data: dict[str, Any]) -> None:
         lines += [f"## {titles[key]}", "", notes[key],
                   f"Load average at the start: {sec['load'][0]:.1f} "
                   f"(1 min), {sec['load'][1]:.1f} (5 min).", "",
-                  "| scene | method | status | wall [s] | total [s] | evaluations | events |",
-                  "|---|---|---|---|---|---|---|"]
+                  "| scene | method | status | wall [s] | total [s] | CPU [s] | evaluations | "
+                  "events | µs per evaluation (wall) |",
+                  "|---|---|---|---|---|---|---|---|---|"]
         for r in sec["rows"]:
             if r["status"] != "ok":
-                where = (f" at t = {r['reached']:.4g} s" if r.get("reached") is not None
-                         else "")
+                at = re.search(r"at t = ([0-9.e+-]+) s", r["message"])
+                reached = r.get("reached") or (float(at.group(1)) if at else None)
+                where = f" at t = {reached:.4g} s" if reached is not None else ""
                 proj = (f"; ~{r['projected']:.3g} s to finish at that rate"
                         if r.get("projected") else "")
                 lines.append(f"| {r['scene']} | {r['method']} | {r['status']} after "
-                             f"{r['elapsed']:.0f} s{where}{proj} | | | | |")
+                             f"{r['elapsed']:.0f} s{where}{proj} | | | | | | |")
                 continue
+            cpu = f"{r['cpu']:.3f}" if "cpu" in r else "–"
             lines.append(f"| {r['scene']} | {r['method']} | ok | {r['wall']:.3f} | "
-                         f"{r['total']:.3f} | {r['nfev']:,} | {r['events']} |")
+                         f"{r['total']:.3f} | {cpu} | {r['nfev']:,} | {r['events']} | "
+                         f"{1e6 * r['wall'] / r['nfev']:.3f} |")
         lines.append("")
     text = "\n".join(lines)
     atomic_write(DOCS / "cycle_speed.md", lambda tmp: tmp.write_text(text, encoding="utf-8"))

@@ -73,6 +73,8 @@ def state_of(system: MachineSystem) -> np.ndarray:
 
 def measure(scene: winder.Scene, label: str, *, n_loop: int, n_py: int, repeats: int,
             pinocchio: bool = True) -> dict[str, Any]:
+    """(The numba loops run ``4 × repeats`` times: short loops, many repeats, so that the
+    best catches a moment with a whole core on a loaded machine.)"""
     """µs per evaluation for one scene (compiled: inside numba, from Python; Pinocchio)."""
     system = MachineSystem(scene)
     y, t = state_of(system), 5.0
@@ -86,9 +88,9 @@ def measure(scene: winder.Scene, label: str, *, n_loop: int, n_py: int, repeats:
         "scene": label, "states": n, "bodies": len(system.machine.bodies),
         "nips": len(scene.nips), "route": system.generated.route,
         "rhs_us": best_us(lambda: _loop(system.fns, integ.F_RHS, t, y, p, m, out_r, n_loop),
-                          n_loop, repeats),
+                          n_loop, 4 * repeats),
         "jac_us": best_us(lambda: _loop(system.fns, integ.F_JAC, t, y, p, m,
-                                        out_j, n_loop // 4), n_loop // 4, repeats),
+                                        out_j, n_loop // 4), n_loop // 4, 4 * repeats),
     }
     system.modes[:] = m
 
@@ -113,17 +115,23 @@ def measure(scene: winder.Scene, label: str, *, n_loop: int, n_py: int, repeats:
 
 
 def linear_fit(rows: list[dict[str, Any]], key: str) -> dict[str, float]:
-    """Least squares ``µs = c0 + c_body · bodies + c_nip · nips`` over the grown machines."""
+    """Least squares ``µs = c0 + c_body · bodies + c_nip · nips`` over the grown machines,
+    and the slopes per unit (drum + roll + nip, riders 0) and per rider (+ its nip, 1 unit)."""
     A = np.array([[1.0, r["bodies"], r["nips"]] for r in rows])
     b = np.array([r[key] for r in rows])
     c, *_ = np.linalg.lstsq(A, b, rcond=None)
     resid = float(np.max(np.abs(A @ c - b)))
+    units = [r for r in rows if r["riders"] == 0]
+    riders = [r for r in rows if r["units"] == 1]
+    per_unit = np.polyfit([r["units"] for r in units], [r[key] for r in units], 1)[0]
+    per_rider = np.polyfit([r["riders"] for r in riders], [r[key] for r in riders], 1)[0]
     return {"c0": float(c[0]), "per_body": float(c[1]), "per_nip": float(c[2]),
-            "max_residual": resid}
+            "max_residual": resid, "per_unit": float(per_unit),
+            "per_rider": float(per_rider)}
 
 
 def main(quick: bool = False, write: bool = True) -> dict[str, Any]:
-    n_loop, n_py, repeats = (20_000, 2_000, 3) if quick else (200_000, 20_000, 7)
+    n_loop, n_py, repeats = (20_000, 2_000, 3) if quick else (10_000, 5_000, 15)
     load = os.getloadavg()
     rows = [measure(winder.load_scene(MODELS / "paper_winding.toml"),
                     "paper_winding (single drum)", n_loop=n_loop, n_py=n_py, repeats=repeats),
@@ -149,14 +157,50 @@ def main(quick: bool = False, write: bool = True) -> dict[str, Any]:
               f"from Python {r['rhs_python_us']:.2f} µs, Pinocchio {r['pinocchio_us']:.1f} µs")
     if write:
         write_docs(out)
+        plot(out, DOCS / "rhs_speed.png")
     return out
+
+
+def plot(out: dict[str, Any], path: Path) -> None:
+    """µs per call against the number of states (grown machines, and the two models)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for key, label, mark in (("rhs_us", "rhs (numba)", "o"), ("jac_us", "jac (numba)", "s")):
+        for rows, face, what in ((out["grown"], None, "grown"), (out["rows"], "none", "models")):
+            x = [r["states"] for r in rows]
+            a1.plot(x, [r[key] for r in rows], mark, mfc=face,
+                    label=f"{label}, {what}", color="C0" if key == "rhs_us" else "C1")
+    a1.set_xlabel("states")
+    a1.set_ylabel("µs per call")
+    a1.set_title("generated code, called from numba")
+    a1.legend(fontsize=8)
+    a1.grid(alpha=0.3)
+    for rows, face, what in ((out["grown"], None, "grown"), (out["rows"], "none", "models")):
+        x = [r["states"] for r in rows]
+        a2.plot(x, [r["pinocchio_us"] for r in rows], "o", mfc=face, color="C2",
+                label=f"Pinocchio rhs, {what}")
+        a2.plot(x, [r["rhs_python_us"] for r in rows], "^", mfc=face, color="C3",
+                label=f"generated rhs from Python, {what}")
+    a2.set_yscale("log")
+    a2.set_xlabel("states")
+    a2.set_ylabel("µs per call")
+    a2.set_title("called from Python")
+    a2.legend(fontsize=8)
+    a2.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=100, format="png"))
+    plt.close(fig)
 
 
 def write_docs(out: dict[str, Any]) -> None:
     la, lb = out["load_before"], out["load_after"]
     lines = ["# Evaluation cost of the generated dynamics", "",
              "Regenerate with `python benchmarks/rhs_speed.py`. µs per call, best of "
-             f"{out['repeats']} repeats of {out['n_loop']:,} calls (in numba) on a shared "
+             f"{4 * out['repeats']} repeats of {out['n_loop']:,} calls (in numba; "
+             f"{out['repeats']} repeats from Python) on a shared "
              f"2-core machine; load average {la[0]:.1f} before and {lb[0]:.1f} after "
              "(best-of-N filters most of the load, the absolute numbers still carry it).", "",
              "- *rhs / jac in numba*: the generated C called through its address from a numba "
@@ -179,14 +223,15 @@ def write_docs(out: dict[str, Any]) -> None:
               "Least-squares fit `µs = c0 + c_body · bodies + c_nip · nips` over the grown "
               "machines (a unit adds two bodies — a speed-profile drum without states and a "
               "roll free in z — and one nip; a rider adds one body and one nip):", "",
-              "| quantity | c0 [µs] | per body [µs] | per nip [µs] | largest residual [µs] |",
-              "|---|---|---|---|---|"]
+              "| quantity | c0 [µs] | per body [µs] | per nip [µs] | largest residual [µs] | "
+              "slope per unit [µs] | slope per rider [µs] |",
+              "|---|---|---|---|---|---|---|"]
     for k, label in (("rhs_us", "rhs in numba"), ("jac_us", "jac in numba"),
                      ("pinocchio_us", "Pinocchio rhs")):
         f = out["fits"][k]
         lines.append(f"| {label} | {f['c0']:.3f} | {f['per_body']:.3f} | {f['per_nip']:.3f} | "
-                     f"{f['max_residual']:.3f} |")
-    lines.append("")
+                     f"{f['max_residual']:.3f} | {f['per_unit']:.3f} | {f['per_rider']:.3f} |")
+    lines += ["", "![µs per call against states](rhs_speed.png)", ""]
     text = "\n".join(lines)
     atomic_write(DOCS / "rhs_speed.md", lambda tmp: tmp.write_text(text, encoding="utf-8"))
     js = json.dumps(out, indent=1)
