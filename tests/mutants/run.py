@@ -4,7 +4,7 @@ Each mutant is applied to a *copy* of ``src/`` in a temporary directory (the rea
 are never written, so an interrupted run leaves them intact), imported through
 ``PYTHONPATH`` and checked by ``pytest -x`` on the mutant's suite of tests. A mutant is
 
-- ``killed`` when a test fails (the first failing test is reported),
+- ``killed`` when a test fails or errors in its set-up (the first one is reported),
 - ``SURVIVED`` when the suite passes,
 - ``DID NOT APPLY`` when its text is not found exactly once in the sources (the sources
   changed; update the catalogue), or ``ERROR`` when pytest could not run the suite
@@ -35,6 +35,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import resource
 import shutil
 import signal
 import subprocess
@@ -189,7 +190,9 @@ class Worker:
         finally:
             self.restore(files)
             shutil.rmtree(cache, ignore_errors=True)
-        failed = re.findall(r"^FAILED (\S+)", out, re.M)
+        # a failing test, or one whose set-up fails on the mutant (e.g. a scene the mutated
+        # nip law cannot carry is refused by the loader the fixture calls)
+        failed = re.findall(r"^(?:FAILED|ERROR) (\S+)", out, re.M)
         if rc == 1 and failed:
             m.status, m.killer = "killed", failed[0]
         elif rc == 0:
@@ -268,8 +271,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"\n{m.name}: {m.status}")
         for line in m.detail:
             print(f"    {line}")
+    cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
     print(f"\n{len(mutants) - len(bad)} of {len(mutants)} mutants killed in {total:.0f} s "
-          f"({jobs} jobs)")
+          f"({jobs} jobs; the tests used {cpu.ru_utime + cpu.ru_stime:.0f} s of CPU)")
     return 1 if bad else 0
 
 
