@@ -18,9 +18,9 @@ of the source of ``winder/core``, ``winder/forces`` and ``winder/_mass_law.py``;
 caches its kernels under ``$NUMBA_CACHE_DIR``, keyed by each module's path and time stamp.
 Every mutant gets its own fresh directory for both (deleted afterwards), so no mutant runs
 code generated or compiled from another source: a mutant of those sources starts with an
-empty generated cache; the others start from a copy of the worker's unmutated caches
-(their generated code cannot depend on the edit, and numba recompiles a mutated module:
-its stamp changed). The Pinocchio/CasADi generator of ``core/pin_casadi.py`` (built once
+empty generated cache, a mutant of a module with numba kernels an empty numba cache; the
+others start from a copy of the worker's unmutated caches (which cannot depend on the
+edit). The Pinocchio/CasADi generator of ``core/pin_casadi.py`` (built once
 under the virtual environment, ``winder-pin-casadi``) is shared: it is Pinocchio's
 algorithms, not winder's physics (``core/_pin_casadi.cpp`` is not mutated: a changed
 source rebuilds it, ~160 s of g++ per mutant).
@@ -77,6 +77,12 @@ class Mutant:
     def generated(self) -> bool:
         """An edit of the sources the generated code is keyed by."""
         return any(f.startswith(GENERATED) for f, _, _ in self.edits)
+
+    @property
+    def jitted(self) -> bool:
+        """An edit of a module with numba kernels (numba checks the stamp of a kernel's own
+        module only: kernels of other modules that inlined a mutated one would be stale)."""
+        return any("@njit" in (ROOT / f).read_text(encoding="utf-8") for f, _, _ in self.edits)
 
 
 def _term_edits(spec: list[dict], kind: str) -> list[tuple[str, str, str]]:
@@ -180,10 +186,11 @@ class Worker:
                 path = self.dir / file
                 text = path.read_text(encoding="utf-8")
                 path.write_text(text.replace(find, replace, 1), encoding="utf-8")
-            # its own caches: numba's unmutated kernels (a mutated module is recompiled: its
-            # stamp changed); the unmutated generated code only where it cannot depend on
-            # the edit
-            for sub in ("numba",) if m.generated else ("numba", "winder"):
+            # its own caches: empty, or a copy of the unmutated ones where they cannot
+            # depend on the edit
+            subs = [sub for sub, fresh in (("numba", m.jitted), ("winder", m.generated))
+                    if not fresh]
+            for sub in subs:
                 if (self.clean_cache / sub).is_dir():
                     shutil.copytree(self.clean_cache / sub, cache / sub, symlinks=True)
             rc, out, m.seconds = self.run(m.tests, cache)
