@@ -4,16 +4,27 @@ Each mutant is applied to a *copy* of ``src/`` in a temporary directory (the rea
 are never written, so an interrupted run leaves them intact), imported through
 ``PYTHONPATH`` and checked by ``pytest -x`` on the mutant's suite of tests. A mutant is
 
-- ``killed`` when a test fails (the first failing test is reported),
+- ``killed`` when a test fails or errors in its set-up (the first one is reported),
 - ``SURVIVED`` when the suite passes,
 - ``DID NOT APPLY`` when its text is not found exactly once in the sources (the sources
   changed; update the catalogue), or ``ERROR`` when pytest could not run the suite
   (collection error, crash, time-out).
 
-Anything but ``killed`` fails the run. Before the mutants, every suite must pass on the
-unmutated copy. Numba's on-disk cache: mutants that edit a compiled module get a fresh,
-private cache directory; the others share one cache of the unmutated copy (never the
-project's own cache).
+Anything but ``killed`` fails the run. Before the mutants, every test the mutants name
+must pass on the unmutated copy (this also fills each worker's caches).
+
+Caches: the generated C of a machine is cached under ``$WINDER_CACHE_DIR``, keyed by a hash
+of the source of ``winder/core``, ``winder/forces`` and ``winder/_mass_law.py``; numba
+caches its kernels under ``$NUMBA_CACHE_DIR``, keyed by each module's path and time stamp.
+Every mutant gets its own fresh directory for both (deleted afterwards), so no mutant runs
+code generated or compiled from another source: a mutant of those sources starts with an
+empty generated cache, a mutant of a module with numba kernels an empty numba cache; the
+others start from a copy of the worker's unmutated caches (which cannot depend on the
+edit). The Pinocchio/CasADi generator of ``core/pin_casadi.py`` (built once
+under the virtual environment, ``winder-pin-casadi``) is shared: it is Pinocchio's
+algorithms, not winder's physics (``core/_pin_casadi.cpp`` is not mutated: a changed
+source rebuilds it, ~160 s of g++ per mutant).
+Never the project's own caches.
 
 Usage: ``python tests/mutants/run.py [--jobs N] [--only SUBSTRING ...] [--list]
 [--catalogue FILE]``
@@ -24,6 +35,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import resource
 import shutil
 import signal
 import subprocess
@@ -37,19 +49,20 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 CATALOGUE = Path(__file__).with_name("catalogue.toml")
-COMPILED = ("src/winder/_planar.py", "src/winder/_integrators.py")  # numba-cached modules
+#: Sources the generated code is keyed by (a mutant there must not see the clean cache).
+GENERATED = ("src/winder/core/", "src/winder/forces/", "src/winder/_mass_law.py")
 KINDS = {"drop": lambda x: "0.0", "double": lambda x: f"2.0 * ({x})",
          "flip": lambda x: f"-({x})"}
-TIMEOUT = 900.0  # [s] per mutant
+TIMEOUT = 300.0  # [s] per mutant
 RUNNING: set[subprocess.Popen] = set()  # pytest processes, killed if the run is interrupted
 
 
 @dataclass
 class Mutant:
-    """One mutant: text edits ``(file, find, replace)`` and the suite that must kill it."""
+    """One mutant: text edits ``(file, find, replace)`` and the tests that must kill it."""
 
     name: str
-    suite: str
+    tests: list[str]
     edits: list[tuple[str, str, str]]
     status: str = ""
     killer: str = ""
@@ -61,8 +74,15 @@ class Mutant:
         return ", ".join(dict.fromkeys(Path(f).name for f, _, _ in self.edits))
 
     @property
-    def compiled(self) -> bool:
-        return any(f in COMPILED for f, _, _ in self.edits)
+    def generated(self) -> bool:
+        """An edit of the sources the generated code is keyed by."""
+        return any(f.startswith(GENERATED) for f, _, _ in self.edits)
+
+    @property
+    def jitted(self) -> bool:
+        """An edit of a module with numba kernels (numba checks the stamp of a kernel's own
+        module only: kernels of other modules that inlined a mutated one would be stale)."""
+        return any("@njit" in (ROOT / f).read_text(encoding="utf-8") for f, _, _ in self.edits)
 
 
 def _term_edits(spec: list[dict], kind: str) -> list[tuple[str, str, str]]:
@@ -76,24 +96,40 @@ def _term_edits(spec: list[dict], kind: str) -> list[tuple[str, str, str]]:
     return edits
 
 
-def load(path: Path = CATALOGUE) -> tuple[dict[str, list[str]], list[Mutant]]:
-    """The suites and the expanded list of mutants of the catalogue."""
+def _tests(entry: dict, suites: dict[str, list[str]]) -> list[str]:
+    """The tests of a catalogue entry: its ``suite`` (a name of ``[suites]``) and/or its
+    own ``tests`` (pytest node ids), in that order."""
+    name = entry["name"]
+    if "suite" in entry and entry["suite"] not in suites:
+        raise SystemExit(f"catalogue: {name} names unknown suite {entry['suite']!r}")
+    tests = list(suites.get(entry.get("suite", ""), [])) + list(entry.get("tests", []))
+    if not tests:
+        raise SystemExit(f"catalogue: {name} names no tests (suite or tests)")
+    return list(dict.fromkeys(tests))
+
+
+def load(path: Path = CATALOGUE) -> list[Mutant]:
+    """The expanded list of mutants of the catalogue."""
     cat = tomllib.loads(path.read_text(encoding="utf-8"))
-    suites = cat["suites"]
+    suites = cat.get("suites", {})
     mutants = []
     for term in cat.get("term", []):
-        for kind in KINDS:
-            comp, pino = _term_edits(term["compiled"], kind), _term_edits(term["pinocchio"], kind)
-            mutants += [Mutant(f"{term['name']}.{kind}.compiled", "paths", comp),
-                        Mutant(f"{term['name']}.{kind}.pinocchio", "paths", pino),
-                        Mutant(f"{term['name']}.{kind}.both", "oracles", comp + pino)]
+        spec = term.get("edits") or [{k: term[k] for k in ("file", "line", "expr", *KINDS)
+                                      if k in term}]
+        for kind in term.get("kinds", list(KINDS)):
+            if kind not in KINDS:
+                raise SystemExit(f"catalogue: term {term['name']}: kind {kind!r} is not one "
+                                 f"of {', '.join(KINDS)}")
+            mutants.append(Mutant(f"{term['name']}.{kind}", _tests(term, suites),
+                                  _term_edits(spec, kind)))
     for m in cat.get("mutant", []):
-        mutants.append(Mutant(m["name"], m["suite"],
+        mutants.append(Mutant(m["name"], _tests(m, suites),
                               [(e["file"], e["find"], e["replace"]) for e in m["edits"]]))
-    for m in mutants:
-        if m.suite not in suites:
-            raise SystemExit(f"catalogue: mutant {m.name} names unknown suite {m.suite!r}")
-    return suites, mutants
+    names = [m.name for m in mutants]
+    if len(set(names)) != len(names):
+        raise SystemExit("catalogue: mutant names repeat: "
+                         + ", ".join(sorted({n for n in names if names.count(n) > 1})))
+    return mutants
 
 
 def check_applies(m: Mutant) -> bool:
@@ -107,12 +143,12 @@ def check_applies(m: Mutant) -> bool:
 
 
 class Worker:
-    """A private copy of ``src/`` and a cache of its unmutated compiled code."""
+    """A private copy of ``src/`` and caches (numba, generated C) of its unmutated code."""
 
     def __init__(self, base: Path, index: int) -> None:
         self.dir = base / f"w{index}"
         self.src = self.dir / "src"
-        self.clean_cache = self.dir / "numba-clean"
+        self.clean_cache = self.dir / "cache-clean"
         shutil.copytree(ROOT / "src", self.src, copy_function=shutil.copy2,
                         ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
 
@@ -121,8 +157,10 @@ class Worker:
             shutil.copy2(ROOT / f, self.dir / f)
 
     def run(self, tests: list[str], cache: Path) -> tuple[int, str, float]:
+        """pytest on ``tests`` with the caches under ``cache`` (``numba``, ``winder``)."""
         env = dict(os.environ, PYTHONPATH=str(self.src), WINDER_MUTANT_SRC=str(self.src),
-                   NUMBA_CACHE_DIR=str(cache), PYTHONDONTWRITEBYTECODE="1")
+                   NUMBA_CACHE_DIR=str(cache / "numba"), WINDER_CACHE_DIR=str(cache / "winder"),
+                   PYTHONDONTWRITEBYTECODE="1")
         cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-rfE", "--no-header",
                "-p", "no:cacheprovider", *tests]
         t0 = time.perf_counter()
@@ -140,20 +178,28 @@ class Worker:
             RUNNING.discard(p)
         return rc, out, time.perf_counter() - t0
 
-    def mutate(self, m: Mutant, suites: dict[str, list[str]]) -> None:
+    def mutate(self, m: Mutant) -> None:
         files = list(dict.fromkeys(f for f, _, _ in m.edits))
+        cache = self.dir / f"cache-{m.name}"
         try:
             for file, find, replace in m.edits:
                 path = self.dir / file
                 text = path.read_text(encoding="utf-8")
                 path.write_text(text.replace(find, replace, 1), encoding="utf-8")
-            cache = self.dir / f"numba-{m.name}" if m.compiled else self.clean_cache
-            rc, out, m.seconds = self.run(suites[m.suite], cache)
-            if m.compiled:
-                shutil.rmtree(cache, ignore_errors=True)
+            # its own caches: empty, or a copy of the unmutated ones where they cannot
+            # depend on the edit
+            subs = [sub for sub, fresh in (("numba", m.jitted), ("winder", m.generated))
+                    if not fresh]
+            for sub in subs:
+                if (self.clean_cache / sub).is_dir():
+                    shutil.copytree(self.clean_cache / sub, cache / sub, symlinks=True)
+            rc, out, m.seconds = self.run(m.tests, cache)
         finally:
             self.restore(files)
-        failed = re.findall(r"^FAILED (\S+)", out, re.M)
+            shutil.rmtree(cache, ignore_errors=True)
+        # a failing test, or one whose set-up fails on the mutant (e.g. a scene the mutated
+        # nip law cannot carry is refused by the loader the fixture calls)
+        failed = re.findall(r"^(?:FAILED|ERROR) (\S+)", out, re.M)
         if rc == 1 and failed:
             m.status, m.killer = "killed", failed[0]
         elif rc == 0:
@@ -166,47 +212,48 @@ class Worker:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                    help="mutants run in parallel (default: the number of CPUs)")
+    ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
+                    help="mutants run in parallel (default: 2, or 1 on one CPU)")
     ap.add_argument("--only", nargs="*", default=[], help="run mutants whose name contains "
                     "one of these strings")
     ap.add_argument("--list", action="store_true", help="list the mutants and exit")
     ap.add_argument("--catalogue", type=Path, default=CATALOGUE, help="the mutants "
                     "(default: %(default)s)")
     args = ap.parse_args(argv)
-    suites, mutants = load(args.catalogue)
+    mutants = load(args.catalogue)
     if args.only:
         mutants = [m for m in mutants if any(s in m.name for s in args.only)]
     if args.list:
         for m in mutants:
-            print(f"{m.name:36s} {m.suite:8s} {m.files}")
+            print(f"{m.name:36s} {m.files:24s} {' '.join(m.tests)}")
         return 0
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # run the clean-up below
     t_start = time.perf_counter()
     todo = [m for m in mutants if check_applies(m)]
-    used = sorted({m.suite for m in todo})
+    # the slowest mutants first, so that the last ones do not run alone
+    todo.sort(key=lambda m: -len(m.tests))
     jobs = max(1, min(args.jobs, len(todo)))
     base = Path(tempfile.mkdtemp(prefix="winder-mutants-"))
     pool = ThreadPoolExecutor(jobs)
     try:
         workers = [Worker(base, i) for i in range(jobs)]
-        # the suites must pass without a mutant (this also fills each worker's clean cache)
-        tests = list(dict.fromkeys(t for s in used for t in suites[s]))
+        # the tests must pass without a mutant (this also fills each worker's clean caches)
+        tests = list(dict.fromkeys(t for m in todo for t in m.tests))
         base_runs = list(pool.map(lambda w: w.run(tests, w.clean_cache), workers))
         for rc, out, _ in base_runs:
             if rc != 0:
                 print(out)
-                print(f"mutants: the suites fail on the unmutated sources (status {rc}); "
+                print(f"mutants: the tests fail on the unmutated sources (status {rc}); "
                       "fix the tests first", file=sys.stderr)
                 return 1
-        print(f"baseline: suites {', '.join(used)} pass unmutated ({base_runs[0][2]:.0f} s)",
+        print(f"baseline: {len(tests)} tests pass unmutated ({base_runs[0][2]:.0f} s)",
               flush=True)
         free = list(workers)
 
         def one(m: Mutant) -> Mutant:
             w = free.pop()
             try:
-                w.mutate(m, suites)
+                w.mutate(m)
             finally:
                 free.append(w)
             print(f"  {m.name:36s} {m.status:8s} {m.seconds:6.1f} s", flush=True)
@@ -231,8 +278,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"\n{m.name}: {m.status}")
         for line in m.detail:
             print(f"    {line}")
+    cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
     print(f"\n{len(mutants) - len(bad)} of {len(mutants)} mutants killed in {total:.0f} s "
-          f"({jobs} jobs)")
+          f"({jobs} jobs; the tests used {cpu.ru_utime + cpu.ru_stime:.0f} s of CPU)")
     return 1 if bad else 0
 
 
