@@ -199,3 +199,19 @@ def test_small_line_model_runs_out_when_its_paper_is_paid_off() -> None:
     r = winder.simulate(MODELS / "winder_line_small.toml")
     assert r.t[-1] == pytest.approx(56.2, abs=0.05)
     assert r["parent_radius"][-1] == 0.4
+
+
+def test_stepper_stops_on_the_parent_core() -> None:
+    """The Stepper stops inside the step where the parent runs out, with its radius on the
+    core exactly (the state, not a clamped sample), and refuses to go on."""
+    scene = _line(parent={"initial_radius": 0.402}, duration=30.0)
+    sim = winder.Stepper(scene)
+    while sim.ended is None:
+        sim.step(1.0)
+    assert sim.y[sim.system.index("parent.radius")] == 0.4
+    assert "ran out of web" in sim.ended
+    ref = winder.simulate(scene, output_step=0.01)
+    # measured: the same event time to 1.7e-11 s (other communication steps)
+    assert sim.t == pytest.approx(ref.t[-1], abs=2e-10)
+    with pytest.raises(winder.SimulationError, match="the run has ended"):
+        sim.step(0.1)
