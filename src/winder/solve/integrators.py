@@ -34,7 +34,8 @@ from .._jit import njit
 from ..core.ccall import call
 from ..core.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
 
-__all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "DONE", "PAUSED",
+__all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "first_step",
+           "sample_and_switch", "DONE", "PAUSED",
            "STEP_UNDERFLOW", "NON_FINITE", "EXHAUSTED", "CHUNK", "TIME_RESOLUTION",
            "K_CONTACT", "K_CORE", "K_END"]
 
@@ -195,6 +196,49 @@ def _next_event(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh
 
 
 @njit
+def first_step(y: np.ndarray, f: np.ndarray, rtol: float, atol: float) -> float:
+    """Hairer's starting step, first part, from the state ``y`` and its rate ``f``."""
+    n = y.shape[0]
+    d0 = d1 = 0.0
+    for i in range(n):
+        sk = atol + rtol * abs(y[i])
+        d0 += (y[i] / sk) ** 2
+        d1 += (f[i] / sk) ** 2
+    d0, d1 = math.sqrt(d0 / n), math.sqrt(d1 / n)
+    return 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+
+
+@njit
+def sample_and_switch(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float,
+                      hh: float, t1: float, tb: np.ndarray, p: np.ndarray, m: np.ndarray,
+                      y: np.ndarray, y1: np.ndarray, yt: np.ndarray, g: np.ndarray,
+                      t_out: np.ndarray, Y_out: np.ndarray,
+                      k: int) -> tuple[int, float, float, int]:
+    """After an accepted step from ``(t, y)`` to ``y1`` with the dense output ``rc``: the
+    first mode switch inside it (:func:`_next_event`), the output samples up to it (or to
+    the step's end), and, at a switch, ``y`` moved to the crossing, landed exactly on the
+    core where a roll reaches it. Returns ``(slot or -1, new mode, end time, k)``."""
+    n = y.shape[0]
+    theta_end, slot, new_mode = _next_event(fns, table, rc, t, hh, tb, p, m, y1, yt, g,
+                                            True)
+    if theta_end > 1.0:
+        theta_end = 1.0
+    t_end = t + theta_end * hh
+    while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
+        if t_out[k] > t1 + 1e-13 * max(1.0, abs(t1)):
+            break
+        _dense(rc, min(theta_end, max(0.0, (t_out[k] - t) / hh)), yt)
+        for i in range(n):
+            Y_out[i, k] = yt[i]
+        k += 1
+    if slot >= 0:
+        _dense(rc, theta_end, y)
+        if new_mode == END or (table[slot, 0] == K_CORE and new_mode == AT_CORE):
+            y[table[slot, 3]] = p[table[slot, 4]]  # land exactly on the core
+    return slot, new_mode, t_end, k
+
+
+@njit
 def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
            p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
            max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
@@ -214,14 +258,8 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
     modes_of(fns, table, tb, t, y, p, m, g, False)
     evaluate(fns, F_RHS, tb, t, y, p, m, k1)
     nfev = 1
-    if h <= 0.0:  # Hairer's starting step, first part
-        d0 = d1 = 0.0
-        for i in range(n):
-            sk = atol + rtol * abs(y[i])
-            d0 += (y[i] / sk) ** 2
-            d1 += (k1[i] / sk) ** 2
-        d0, d1 = math.sqrt(d0 / n), math.sqrt(d1 / n)
-        h = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+    if h <= 0.0:
+        h = first_step(y, k1, rtol, atol)
     rejected_last = False
     status = DONE
     while t < t1:
@@ -296,24 +334,11 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
             rc[3, i] = dyi - hh * k7[i] - bspl
             rc[4, i] = hh * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i]
                              + D7 * k7[i])
-        theta_end, slot, new_mode = _next_event(fns, table, rc, t, hh, tb, p, m, y1, yt, g,
-                                                True)
-        if theta_end > 1.0:
-            theta_end = 1.0
-        t_end = t + theta_end * hh
-        while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
-            if t_out[k] > t1 + 1e-13 * max(1.0, abs(t1)):
-                break
-            _dense(rc, min(theta_end, max(0.0, (t_out[k] - t) / hh)), yt)
-            for i in range(n):
-                Y_out[i, k] = yt[i]
-            k += 1
+        slot, new_mode, t_end, k = sample_and_switch(fns, table, rc, t, hh, t1, tb, p, m, y,
+                                                     y1, yt, g, t_out, Y_out, k)
         stats[1] += 1
         if slot >= 0:  # event: restart at the crossing in the new mode
-            _dense(rc, theta_end, y)
             t = t_end
-            if new_mode == END or (table[slot, 0] == K_CORE and new_mode == AT_CORE):
-                y[table[slot, 3]] = p[table[slot, 4]]  # land exactly on the core
             if new_mode == END:
                 status = EXHAUSTED
                 break

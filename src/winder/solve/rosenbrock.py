@@ -16,22 +16,20 @@ import math
 import numpy as np
 
 from .._jit import njit
-from ..core.machine import AT_CORE
 from .integrators import (
     DONE,
     END,
     EXHAUSTED,
     F_JAC,
     F_RHS,
-    K_CORE,
     NON_FINITE,
     PAUSED,
     STEP_UNDERFLOW,
     TIME_RESOLUTION,
-    _dense,
-    _next_event,
     evaluate,
+    first_step,
     modes_of,
+    sample_and_switch,
 )
 
 __all__ = ["ros2"]
@@ -108,13 +106,7 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
     evaluate(fns, F_RHS, tb, t, y, p, m, f0)
     nfev = 1
     if h <= 0.0:
-        d0 = d1 = 0.0
-        for i in range(n):
-            sk = atol + rtol * abs(y[i])
-            d0 += (y[i] / sk) ** 2
-            d1 += (f0[i] / sk) ** 2
-        d0, d1 = math.sqrt(d0 / n), math.sqrt(d1 / n)
-        h = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+        h = first_step(y, f0, rtol, atol)
     status = DONE
     fresh = False  # Jacobian at (t, y) is current
     while t < t1:
@@ -187,25 +179,12 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
             rc[0, i] = y[i]
             rc[1, i] = hh * k2[i]
             rc[2, i] = hh * (k1[i] - k2[i]) / (1.0 - 2.0 * D)
-        theta_end, slot, new_mode = _next_event(fns, table, rc, t, hh, tb, p, m, y1, yt, g,
-                                                True)
-        if theta_end > 1.0:
-            theta_end = 1.0
-        t_end = t + theta_end * hh
-        while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
-            if t_out[k] > t1 + 1e-13 * max(1.0, abs(t1)):
-                break
-            _dense(rc, min(theta_end, max(0.0, (t_out[k] - t) / hh)), yt)
-            for i in range(n):
-                Y_out[i, k] = yt[i]
-            k += 1
+        slot, new_mode, t_end, k = sample_and_switch(fns, table, rc, t, hh, t1, tb, p, m, y,
+                                                     y1, yt, g, t_out, Y_out, k)
         stats[1] += 1
         fresh = False
         if slot >= 0:
-            _dense(rc, theta_end, y)
             t = t_end
-            if new_mode == END or (table[slot, 0] == K_CORE and new_mode == AT_CORE):
-                y[table[slot, 3]] = p[table[slot, 4]]
             if new_mode == END:
                 status = EXHAUSTED
                 break
