@@ -38,6 +38,7 @@ DOCS = ROOT / "docs"
 PAPER_CHANNELS = ("radius", "roll_speed", "z", "normal_force")
 TWO_DRUM_CHANNELS = ("set_radius", "set_speed", "set_x", "set_z", "rear_nip_normal_force",
                      "rider_nip_normal_force")
+LINE_CHANNELS = (*TWO_DRUM_CHANNELS, "span_tension", "parent_speed", "parent_torque")
 TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 RK4_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4, 6.25e-5)
 COMPILED = ("DOPRI5", "ROS2")
@@ -90,6 +91,7 @@ def build_problems(quick: bool) -> list[Problem]:
     paper = winder.load_scene(MODELS / "paper_winding.toml")
     spin = winder.load_scene(MODELS / "free_spin.toml")
     two = winder.load_scene(MODELS / "two_drum_winder.toml")
+    line = winder.load_scene(MODELS / "winder_line.toml")
     start = winder.Stepper(paper, rtol=1e-12, atol=1e-14)
     start.step(25.0)
     probs = [
@@ -102,6 +104,10 @@ def build_problems(quick: bool) -> list[Problem]:
         Problem("two-drum winder, 0-30 s", two, 30.0 if not quick else 10.0, 0.01,
                 channels=TWO_DRUM_CHANNELS,
                 note="speed ramp; the set settles in the valley under the rider"),
+        Problem("winder line, 0-30 s", line, 30.0 if not quick else 10.0, 0.01,
+                channels=LINE_CHANNELS,
+                note="the two-drum winder fed through the web span (EA/L_s = 4.7e5 N/m), "
+                     "its tension held by the unwind's controller"),
     ]
     return probs
 
@@ -138,7 +144,7 @@ def study(problems: list[Problem], *, max_wall: float, quick: bool,
             runs += [(m, "exact", tol, None) for tol in tols]
         runs += [("RK4", "exact", None, h) for h in (RK4_STEPS[1::2] if quick else RK4_STEPS)]
         runs += [(m, "fd", tol, None) for m in ("Radau", "BDF") for tol in tols]
-        if not prob.name.startswith(("smooth", "two-drum")):
+        if not prob.name.startswith(("smooth", "two-drum", "winder line")):
             runs += [("LSODA", "pinocchio", tol, None) for tol in tols[:4]]
         given_up: set[tuple[str, str]] = set()
         for method, variant, tol, h in runs:
@@ -302,6 +308,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, default=DOCS, help="output folder (default docs/)")
     ap.add_argument("--replot", action="store_true",
                     help="rewrite the table and plot from the saved work_precision.json")
+    ap.add_argument("--only", default=None,
+                    help="run only the problems whose name starts with this text and merge "
+                         "their rows into the saved work_precision.json")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     saved = args.out / "work_precision.json"
@@ -311,12 +320,19 @@ def main(argv: list[str] | None = None) -> int:
     else:
         head: dict[str, Any] = {"load": os.getloadavg(), "max_wall": args.max_wall}
         probs = build_problems(args.quick)
-        rows = study(probs, max_wall=args.max_wall, quick=args.quick)
+        keep: list[dict[str, Any]] = []
+        kept: list[dict[str, Any]] = []
+        if args.only is not None:
+            probs = [p for p in probs if p.name.startswith(args.only)]
+            old = json.loads(saved.read_text(encoding="utf-8"))
+            keep = [r for r in old["rows"] if not r["problem"].startswith(args.only)]
+            kept = [p for p in old["problems"] if not p["name"].startswith(args.only)]
+        rows = keep + study(probs, max_wall=args.max_wall, quick=args.quick)
         cpu = platform.processor() or platform.machine()
         head["machine"] = f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
         head["load_after"] = os.getloadavg()
-        problems = [{"name": p.name, "note": p.note, "channels": list(p.channels)}
-                    for p in probs]
+        problems = kept + [{"name": p.name, "note": p.note, "channels": list(p.channels)}
+                           for p in probs]
         text = json.dumps({"rows": rows, "head": head, "problems": problems}, indent=1)
         atomic_write(saved, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     write_markdown(rows, problems, head, args.out / "work_precision.md")
