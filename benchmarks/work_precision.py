@@ -104,7 +104,8 @@ def build_problems(quick: bool) -> list[Problem]:
         Problem("two-drum winder, 0-30 s", two, 30.0 if not quick else 10.0, 0.01,
                 channels=TWO_DRUM_CHANNELS,
                 note="speed ramp; the set settles in the valley under the rider"),
-        Problem("winder line, 0-30 s", line, 30.0 if not quick else 10.0, 0.01,
+        Problem(f"winder line, 0-{30 if not quick else 10} s", line,
+                30.0 if not quick else 10.0, 0.01,
                 channels=LINE_CHANNELS,
                 note="the two-drum winder fed through the web span (EA/L_s = 4.7e5 N/m), "
                      "its tension held by the unwind's controller"),
