@@ -252,8 +252,11 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
             try:
                 for fut in as_completed(list(futures)):
                     i = futures.pop(fut)
-                    if fut.status == "finished":
+                    try:  # a result lost with its worker is computed again: wait for it
                         fields, result = fut.result()
+                    except Exception:  # noqa: BLE001 - the run's worker died: missing
+                        fields = None
+                    if fields is not None:
                         row = row_of(i, fields)
                         store.write_run(row, schema, result if trajectories else None)
                         rows[i] = row
