@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -199,4 +200,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    status = main()
+    # pythonfmu's binary now and then corrupts the heap in the interpreter's exit-time
+    # clean-up (after everything above is written): leave without it
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(status)
