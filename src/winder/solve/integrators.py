@@ -34,7 +34,7 @@ from .._jit import njit
 from ..core.ccall import call
 from ..core.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
 
-__all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "first_step",
+__all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "switch_buffer", "first_step",
            "sample_and_switch", "DONE", "PAUSED",
            "STEP_UNDERFLOW", "NON_FINITE", "EXHAUSTED", "CHUNK", "TIME_RESOLUTION",
            "K_CONTACT", "K_CORE", "K_END"]
@@ -196,6 +196,12 @@ def _next_event(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh
 
 
 @njit
+def switch_buffer(table: np.ndarray) -> np.ndarray:
+    """A buffer for every switching function the mode ``table`` refers to."""
+    return np.empty(max(1, int(table[:, 1:3].max()) + 1 if table.shape[0] else 1))
+
+
+@njit
 def first_step(y: np.ndarray, f: np.ndarray, rtol: float, atol: float) -> float:
     """Hairer's starting step, first part, from the state ``y`` and its rate ``f``."""
     n = y.shape[0]
@@ -253,7 +259,7 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
     yt, y1 = np.empty(n), np.empty(n)
     rc = np.empty((5, n))
     tb = np.empty(1)
-    g = np.empty(max(1, int(table[:, 1:3].max()) + 1 if table.shape[0] else 1))
+    g = switch_buffer(table)
     t = t0
     modes_of(fns, table, tb, t, y, p, m, g, False)
     evaluate(fns, F_RHS, tb, t, y, p, m, k1)
@@ -384,7 +390,7 @@ def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
     k1, k2, k3, k4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     yt, y1 = np.empty(n), np.empty(n)
     tb = np.empty(1)
-    g = np.empty(max(1, int(table[:, 1:3].max()) + 1 if table.shape[0] else 1))
+    g = switch_buffer(table)
     modes_of(fns, table, tb, t0, y, p, m, g, True)
     evaluate(fns, F_RHS, tb, t0, y, p, m, k1)
     nfev = 1

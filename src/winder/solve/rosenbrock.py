@@ -30,6 +30,7 @@ from .integrators import (
     first_step,
     modes_of,
     sample_and_switch,
+    switch_buffer,
 )
 
 __all__ = ["ros2"]
@@ -100,7 +101,7 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
     piv = np.empty(n, dtype=np.int64)
     rc = np.zeros((5, n))
     tb = np.empty(1)
-    g = np.empty(max(1, int(table[:, 1:3].max()) + 1 if table.shape[0] else 1))
+    g = switch_buffer(table)
     t = t0
     modes_of(fns, table, tb, t, y, p, m, g, False)
     evaluate(fns, F_RHS, tb, t, y, p, m, f0)

@@ -59,7 +59,7 @@ def _channels_into(fns: np.ndarray, table: np.ndarray, t: np.ndarray, Y: np.ndar
     y = np.empty(n)
     m = np.empty(table.shape[0])
     tb = np.empty(1)
-    g = np.empty(max(1, int(table[:, 1:3].max()) + 1 if table.shape[0] else 1))
+    g = integ.switch_buffer(table)
     col = np.empty(out.shape[0])
     for i in range(t.shape[0]):
         for j in range(n):
