@@ -424,7 +424,7 @@ SWEEP_VARY = {
                        ("drum.rear.drive.web_speed", "twice")),
     "tied: bounds of one key": (TWO_DRUM, ["drum.front.drive.web_speed,roll.set.com_offset="
                                            "10:30:5"], ("com_offset", "10")),
-    "tied: beyond both bounds": (TWO_DRUM, [_SPEED + "=10:2000:3"], ("web_speed", "2000")),
+    "tied: beyond both bounds": (TWO_DRUM, [_SPEED + "=10:2000:2"], ("web_speed", "2000")),
     "tied: no spec": (TWO_DRUM, [_SPEED], ("KEY=SPEC",)),
     "tied: no key": (TWO_DRUM, ["=10:30:5"], ("KEY=SPEC",)),
     "tied: half a range": (TWO_DRUM, [_SPEED + "=10:30"], ("START:STOP:COUNT",)),
