@@ -309,7 +309,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     if csv is not None:
         cols = mm.as_columns()
         header = ",".join(cols)
-        table = np.column_stack(list(cols.values()))
+        table = np.column_stack(list(cols.values())) + 0.0  # -0.0 printed as 0, not -0
         atomic_write(csv, lambda p: np.savetxt(p, table, delimiter=",", header=header,
                                                comments="", fmt="%.10g"))
         print(f"  table written to {csv}")
