@@ -100,6 +100,16 @@ def _result_files(out: Path) -> list[Path]:
     return [out, out.with_suffix(".npz")] if out.suffix.lower() == ".csv" else [out]
 
 
+def _balance_text(residual: float, scale: float) -> str:
+    """The line on the initial static balance (machines.md §7): its largest force
+    residual ``residual`` [N] against the largest force ``scale`` [N] in it; with no force
+    at all there is nothing to balance (no free coordinate rests on a nip)."""
+    if scale == 0.0 and residual == 0.0:
+        return ("initial static balance: nothing to solve (no free coordinate rests on a "
+                "nip or carries a load)")
+    return f"initial static balance: residual {residual:.1e} N of {scale:.1e} N"
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from ._files import check_output_dir, check_output_file
 
@@ -139,8 +149,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     print(f"{scene.name}: {len(result.t)} samples to {out} ({m['method']}, rtol {m['rtol']:g}, "
           f"{m['rhs_evaluations']} RHS evaluations, {m['wall_time']:.2f} s integration)")
     if m.get("static_residual") is not None:
-        print(f"  initial static balance: residual {m['static_residual']:.1e} N of "
-              f"{m['static_scale']:.1e} N")
+        print("  " + _balance_text(m["static_residual"], m["static_scale"]))
     if m.get("ended"):
         print(f"  {m['ended']}")
     if plots is not None:
