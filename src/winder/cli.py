@@ -436,9 +436,10 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", required=True, help="result file (.csv or .npz; a .csv gets "
                      "an .npz twin)")
     run.add_argument("--t-end", type=_POSITIVE, help="end time [s] (default: scene duration)")
-    run.add_argument("--method", help="integrator (auto, DOPRI5, RK4, RK45, DOP853, Radau, "
-                     "BDF, LSODA, RK23)")
-    run.add_argument("--backend", help="right-hand side: compiled (default) or pinocchio")
+    run.add_argument("--method", help=f"integrator ({', '.join(METHODS)}; default: the "
+                     "scene's [solver] method, else auto)")
+    run.add_argument("--backend", help=f"right-hand side: {' or '.join(BACKENDS)} (default: "
+                     "the scene's [solver] backend, else compiled)")
     run.add_argument("--rtol", type=_RTOL, help=f"relative tolerance (0 < rtol <= {RTOL_MAX:g})")
     run.add_argument("--atol", type=_POSITIVE, help="absolute tolerance (> 0)")
     run.add_argument("--max-evals", type=_EVALS, metavar="N",
