@@ -407,6 +407,53 @@ def _name_cases() -> list[Case]:
     return cases
 
 
+# ---- sweep keys (tied keys share one axis) ----------------------------------------------------
+TWO_DRUM = ROOT / "models" / "two_drum_winder.toml"
+_SPEED = "drum.front.drive.web_speed,drum.rear.drive.web_speed"
+
+#: label → (scene, --vary options, what the message names); every one is refused before a
+#: cluster starts or anything is written
+SWEEP_VARY = {
+    "tied: unknown element": (TWO_DRUM, ["drum.front.drive.web_speed,drum.middle.drive."
+                                         "web_speed=10:30:5"], ("drum.middle", "front, rear")),
+    "tied: empty key": (TWO_DRUM, ["drum.front.drive.web_speed,=10:30:5"], ("empty key",)),
+    "tied: trailing comma": (TWO_DRUM, [_SPEED + ",=10:30:5"], ("empty key",)),
+    "tied: a key twice": (TWO_DRUM, ["drum.front.drive.web_speed,drum.front.drive.web_speed"
+                                     "=10:30:5"], ("drum.front.drive.web_speed", "twice")),
+    "tied and alone": (TWO_DRUM, [_SPEED + "=10:30:5", "drum.rear.drive.web_speed=10,20"],
+                       ("drum.rear.drive.web_speed", "twice")),
+    "tied: bounds of one key": (TWO_DRUM, ["drum.front.drive.web_speed,roll.set.com_offset="
+                                           "10:30:5"], ("com_offset", "10")),
+    "tied: beyond both bounds": (TWO_DRUM, [_SPEED + "=10:2000:2"], ("web_speed", "2000")),
+    "tied: no spec": (TWO_DRUM, [_SPEED], ("KEY=SPEC",)),
+    "tied: no key": (TWO_DRUM, ["=10:30:5"], ("KEY=SPEC",)),
+    "tied: half a range": (TWO_DRUM, [_SPEED + "=10:30"], ("START:STOP:COUNT",)),
+    "tied: empty range": (TWO_DRUM, [_SPEED + "=10:30:0"], ("empty range",)),
+    "tied: a table": (TWO_DRUM, ["drum.front.drive,drum.rear.drive=1,2"],
+                      ("drum.front.drive", "table")),
+    "tied: parts keys on a single-drum scene": (PAPER, [_SPEED + "=10:30:5"],
+                                                ("drum.front.drive.web_speed", "drive")),
+    "tied: a word for a number": (PAPER, ["drum.drive.web_speed,drum.drive.web_acceleration"
+                                          "=fast,slow"], ("web_speed", "fast")),
+    "tied: words on the map's axis": (TWO_DRUM, ["nip.front.contact.law,nip.rear.contact.law="
+                                                 "linear,hunt_crossley", "--plot"],
+                                      ("--plot", "hunt_crossley")),
+}
+
+
+def _sweep_cases() -> list[Case]:
+    cases = []
+    for label, (scene, vary, names) in SWEEP_VARY.items():
+        def build(d: Path, scene: Path = scene, vary: list[str] = vary) -> list[str]:
+            argv = ["sweep", str(scene), "--out", str(d / "sweep"), "--no-progress"]
+            for item in vary:
+                argv += ["--plot"] if item == "--plot" else ["--vary", item]
+            return argv
+        cases.append(Case("sweep key", label, build, names=names))
+    return cases
+
+
 def corpus() -> list[Case]:
-    """Every case (categories: option, output path, scene name, result file)."""
-    return [*_option_cases(), *_output_cases(), *_name_cases(), *_result_cases()]
+    """Every case (categories: option, output path, scene name, result file, sweep key)."""
+    return [*_option_cases(), *_output_cases(), *_name_cases(), *_result_cases(),
+            *_sweep_cases()]

@@ -16,6 +16,12 @@ from winder.cli import main
 def test_free_spin_matches_closed_form_through_cli(tmp_path, models_dir, capsys) -> None:
     out = tmp_path / "free.csv"
     assert main(["run", str(models_dir / "free_spin.toml"), "--out", str(out)]) == 0
+    # contact off: no free coordinate rests on a nip, no balance to report a residual of
+    printed = capsys.readouterr().out
+    assert "initial static balance: nothing to solve (no free coordinate rests on a nip" \
+        in printed and "residual" not in printed
+    meta = winder.load_result(out.with_suffix(".npz")).meta
+    assert meta["static_residual"] == 0.0 and meta["static_scale"] == 0.0
     with open(out) as fh:
         header = fh.readline().strip().split(",")
     assert tuple(header[:len(winder.CHANNELS)]) == winder.CHANNELS
@@ -96,3 +102,24 @@ def test_free_spin_figure_draws_the_conserved_momentum(tmp_path, models_dir, cap
     ys, xs = np.nonzero(blue[:330])  # upper axes
     left, right = ys[xs < xs.min() + 20].mean(), ys[xs > xs.max() - 20].mean()
     assert right - left > 50  # ω(100 s) well below ω(0): the curve ends lower
+
+
+def test_balance_line_reports_a_solved_balance(tmp_path, models_dir, capsys) -> None:
+    """The paper scene's roll rests on the nip: its residual against its weight."""
+    assert main(["run", str(models_dir / "paper_winding.toml"), "--out",
+                 str(tmp_path / "p.npz"), "--t-end", "0.05"]) == 0
+    meta = winder.load_result(tmp_path / "p.npz").meta
+    assert meta["static_scale"] > 30 * 9.81  # the core's weight at least
+    assert (f"initial static balance: residual {meta['static_residual']:.1e} N of "
+            f"{meta['static_scale']:.1e} N") in capsys.readouterr().out
+
+
+def test_run_help_lists_every_method_and_backend(capsys) -> None:
+    """`winder run --help` names the scene's [solver] choices, ROS2 included."""
+    from winder._scene import BACKENDS, METHODS
+
+    assert main(["run", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "ROS2" in METHODS
+    assert f"integrator ({', '.join(METHODS)};" in text
+    assert " or ".join(BACKENDS) in text

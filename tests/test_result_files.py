@@ -146,3 +146,30 @@ def test_metadata_and_channels_checked(tmp_path: Path) -> None:
         write_npz(tmp_path / name, arrays, meta)
         with pytest.raises(ResultFileError, match=message):
             winder.load_result(tmp_path / name)
+
+
+def test_csv_writes_zero_not_minus_zero(tmp_path: Path) -> None:
+    """-0.0 is written as 0 (no "-0" in the file); every other value reads back as the
+    value its 15 significant digits give, NaN, ±inf and the smallest subnormals included."""
+    rng = np.random.default_rng(7)
+    special = np.array([-0.0, 0.0, -0.0, -5e-324, 5e-324, -1e-300, 1.0, -1.0, np.nan,
+                        np.inf, -np.inf, -2.5e-17, 1e308, -1e308, 0.1, -0.1])
+    n = len(special)
+    values = np.concatenate([special, -np.abs(rng.standard_normal(64)) * 10.0 **
+                             rng.integers(-300, 300, 64)])
+    t = np.arange(len(values), dtype=float)
+    res = winder.Result({"t": t, "x": values, "zero": -np.zeros(len(values))}, {})
+    path = res.to_csv(tmp_path / "r.csv")
+    text = path.read_text()
+    cells = [c for line in text.splitlines()[1:] for c in line.split(",")]
+    assert "-0" not in cells and "-0.0" not in cells
+    assert [line.split(",")[2] for line in text.splitlines()[1:]] == ["0"] * len(values)
+    back = winder.load_result(path)
+    expect = np.array([float(f"{v:.15g}") for v in values])
+    np.testing.assert_array_equal(back["x"], expect)  # NaN where NaN
+    zeros = expect == 0.0
+    assert zeros.sum() == 3 and not np.any(np.signbit(back["x"][zeros]))
+    assert not np.any(np.signbit(back["zero"]))
+    assert np.array_equal(np.signbit(back["x"][~zeros & ~np.isnan(expect)]),
+                          np.signbit(values[~zeros & ~np.isnan(expect)]))
+    assert n == 16

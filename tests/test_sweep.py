@@ -14,8 +14,18 @@ import pytest
 
 import winder
 from winder import _progress
+from winder._scene import key_unit
 from winder._sweep import run_id, run_one, run_settings
-from winder._sweep_grid import build_grid, get_path, parse_spec, resolve, set_path
+from winder._sweep_grid import (
+    build_grid,
+    get_path,
+    parse_spec,
+    parse_vary,
+    resolve,
+    set_path,
+    split_keys,
+)
+from winder._sweep_plot import axis_label
 from winder._sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS, default_band_edges
 from winder._sweep_table import SweepTable
 from winder.cli import main
@@ -25,6 +35,7 @@ from winder.cli import main
 # with 0.5 mm.
 VARY = {"drum.drive.web_speed": "12:24:4", "roll.com_offset": [0.5e-3, 1e-3]}
 RUN = {"t_end": 30.0, "output_step": 2e-3, "bands": 6}
+MODELS = Path(__file__).resolve().parents[1] / "models"
 # Per-run columns that depend on the machine, not on the physics.
 MACHINE = ("wall_time", "task_time", "worker")
 
@@ -32,6 +43,11 @@ MACHINE = ("wall_time", "task_time", "worker")
 @pytest.fixture(scope="module")
 def base(paper_scene) -> winder.Scene:
     return paper_scene.replace(drum={"drive": {"web_acceleration": 2.0}})
+
+
+@pytest.fixture(scope="module")
+def two_drum() -> winder.Scene:
+    return winder.load_scene(MODELS / "two_drum_winder.toml")
 
 
 @pytest.fixture(scope="module")
@@ -351,15 +367,164 @@ def test_cli_sweep_with_failures_and_map(cluster, reference, tmp_path, capsys,
                  "--scheduler", lc.scheduler_address, "--t-end", "30", "--output-step",
                  "2e-3", "--bands", "6", "--plot", str(png), "--no-progress"])
     assert code == 0
-    assert "8 runs" in capsys.readouterr().out
+    out, err = capsys.readouterr()
+    assert "8 runs" in out and "4 failed" in out
     table = SweepTable.read(tmp_path / "c")
     bad = table.frame[table.frame["solver.max_rhs"] == 3000]
     assert list(bad["status"]) == ["budget"] * 4
+    # each failed run listed on stderr with its values, status and message; no traceback
+    lines = err.strip().splitlines()
+    assert lines[0] == "winder: 4 of 8 runs failed:" and "Traceback" not in err
+    for line, row in zip(lines[1:], bad.to_dict("records"), strict=True):
+        assert line.startswith(f"  run {row['run']} (drum.drive.web_speed = "
+                               f"{row['drum.drive.web_speed']!r}, solver.max_rhs = 3000): "
+                               "budget: ")
+        assert row["message"].split()[0] in line and "max_rhs" in line
     ok = table.frame[table.frame["status"] == "ok"]
     assert len(ok) == 4
     for row in ok.to_dict("records"):  # the same runs as the grid's 1 mm column
         _assert_rows_equal(row, reference[row["run_id"]])
     assert png.stat().st_size > 20_000
+
+
+def test_cli_sweep_where_every_run_fails_exits_2(cluster, tmp_path, capsys,
+                                                models_dir) -> None:
+    """Every run stopped by its budget: each is listed, exit 2, no map; the table stays."""
+    _, lc = cluster
+    png = tmp_path / "map.png"
+    code = main(["sweep", str(models_dir / "paper_winding.toml"), "--vary",
+                 "solver.max_rhs=2000,3000", "--out", str(tmp_path / "f"), "--scheduler",
+                 lc.scheduler_address, "--t-end", "30", "--plot", str(png), "--no-progress"])
+    assert code == 2
+    out, err = capsys.readouterr()
+    assert "2 runs" in out and "2 failed" in out
+    lines = err.strip().splitlines()
+    assert lines[0] == "winder: every run failed (2):"
+    assert lines[1].startswith("  run 0 (solver.max_rhs = 2000): budget: ")
+    assert lines[2].startswith("  run 1 (solver.max_rhs = 3000): budget: ")
+    assert all("max_rhs" in ln for ln in lines[1:3]) and "no runnability map" in lines[3]
+    assert not png.exists()
+    assert list(SweepTable.read(tmp_path / "f").frame["status"]) == ["budget"] * 2
+
+
+# ---- tied keys and units -----------------------------------------------------------------
+
+TIED = "drum.front.drive.web_speed,drum.rear.drive.web_speed"
+
+
+def test_tied_keys_parse_and_refuse() -> None:
+    """Tied keys share one axis; a key named twice (in a tie or across axes), an empty key
+    or a key with no spec is refused naming it."""
+    vary = parse_vary([TIED + "=10:30:5", "roll.set.com_offset=1e-3,2e-3"])
+    assert list(vary) == [TIED, "roll.set.com_offset"]
+    assert vary[TIED] == [10.0, 15.0, 20.0, 25.0, 30.0]
+    assert parse_vary([" a.b , c.d =1,2"]) == {"a.b,c.d": [1, 2]}  # spaces around keys
+    assert split_keys(("a.b", "c.d")) == split_keys("a.b,c.d") == ("a.b", "c.d")
+    for items, match in (([TIED + "=1:2:2", "drum.rear.drive.web_speed=3"], "given twice"),
+                         (["a.b,a.b=1"], "listed twice"), (["a.b,,c.d=1"], "empty key"),
+                         (["a.b,=1"], "empty key"), ([TIED], "KEY=SPEC"),
+                         ([TIED + "=1:2"], "START:STOP:COUNT")):
+        with pytest.raises(winder.ArgumentError, match=match):
+            parse_vary(items)
+
+
+def test_tied_keys_in_the_grid(two_drum) -> None:
+    """Every run sets all tied keys to the axis's value, and its scene is the scene edited
+    by hand to those values; bounds are checked with the keys set together."""
+    grid = build_grid(two_drum, {TIED: [10.0, 20.0], "roll.set.com_offset": [1e-3, 2e-3]})
+    assert [a.keys for a in grid.axes] == [tuple(TIED.split(",")), ("roll.set.com_offset",)]
+    assert grid.keys == (*TIED.split(","), "roll.set.com_offset")
+    for point, scene in zip(grid.points, grid.scenes, strict=True):
+        v, e = point["drum.front.drive.web_speed"], point["roll.set.com_offset"]
+        assert point["drum.rear.drive.web_speed"] == v
+        hand = two_drum.replace(drum={"front": {"drive": {"web_speed": v}},
+                                      "rear": {"drive": {"web_speed": v}}},
+                                roll={"set": {"com_offset": e}})
+        assert scene.to_dict() == hand.to_dict()
+    with pytest.raises(winder.ArgumentError, match=r"drum.middle.*front, rear"):
+        build_grid(two_drum, {"drum.front.drive.web_speed,drum.middle.drive.web_speed": [1]})
+    with pytest.raises(winder.ArgumentError, match=r"value 2000.0 fails.*web_speed"):
+        build_grid(two_drum, {(TIED.split(",")[0], TIED.split(",")[1]): [10.0, 2000.0]})
+    with pytest.raises(winder.ArgumentError, match=r"com_offset"):  # metres, not m/s
+        build_grid(two_drum, {"drum.front.drive.web_speed,roll.set.com_offset": [10.0]})
+    with pytest.raises(winder.ArgumentError, match="given twice"):
+        build_grid(two_drum, {TIED: [1.0], "drum.front.drive.web_speed": [2.0]})
+
+
+def test_units_come_from_the_key_declarations() -> None:
+    """Every numeric key of both scene formats has a unit; paths of both formats map to
+    the same unit; words and unknown paths have none."""
+    from winder import _scene
+
+    for specs in (_scene._SPEC, _scene._PART_SPEC):
+        for table, keys in specs.items():
+            for key, (kind, _, _) in keys.items():
+                if kind == "num":
+                    assert (table, key) in _scene._UNITS, (table, key)
+    for path, unit in (("drum.drive.web_speed", "m/s"), ("drum.front.drive.web_speed", "m/s"),
+                       ("roll.com_offset", "m"), ("roll.set.com_offset", "m"),
+                       ("roll.set.density", "kg/m³"), ("contact.stiffness", "N/m"),
+                       ("nip.rear.contact.stiffness", "N/m"), ("friction.mu", "-"),
+                       ("rider.rider.mass", "kg"), ("web.tension", "N"),
+                       ("roll.parent.drive.bandwidth", "rad/s"), ("scene.duration", "s"),
+                       ("contact.law", ""), ("drum.front.name", ""), ("no.such.key", ""),
+                       ("drum", "")):
+        assert key_unit(path) == unit, path
+    # a part named like a sub-table: the scene's tables decide
+    assert key_unit("drum.drive.radius", {"drum": [{"name": "drive"}]}) == "m"
+    assert key_unit("drum.drive.web_speed", {"drum": {"drive": {}}}) == "m/s"
+    assert axis_label(TIED, {"drum": []}) == \
+        "drum.front.drive.web_speed,\ndrum.rear.drive.web_speed [m/s]"
+    assert axis_label("drum.front.radius,roll.set.core_mass", {"drum": [], "roll": []}) == \
+        "drum.front.radius [m],\nroll.set.core_mass [kg]"
+
+
+def test_tied_sweep_runs_are_the_hand_edited_scenes(cluster, two_drum, tmp_path, capsys,
+                                                    monkeypatch) -> None:
+    """Oracle: `winder sweep --vary KEY1,KEY2=SPEC` gives, run for run, the rows of the
+    scene edited by hand to the same values (run in this process); the Python API with a
+    tuple of keys names the same runs; the map labels the tied axis with both keys and its
+    unit."""
+    from winder import _sweep_plot
+
+    _, lc = cluster
+    fast = (MODELS / "two_drum_winder.toml").read_text().replace(
+        "web_acceleration = 0.7", "web_acceleration = 20.0")
+    assert fast.count("web_acceleration = 20.0") == 2
+    scene_file = tmp_path / "fast.toml"
+    scene_file.write_text(fast)
+    figures = []
+    monkeypatch.setattr(_sweep_plot.plt, "close", figures.append)
+    png = tmp_path / "map.png"
+    code = main(["sweep", str(scene_file), "--vary", TIED + "=5:15:3", "--out",
+                 str(tmp_path / "t"), "--scheduler", lc.scheduler_address, "--t-end", "1.0",
+                 "--output-step", "2e-3", "--bands", "3", "--plot", str(png),
+                 "--no-progress"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "3 runs" in out and "0 failed" in out
+    table = SweepTable.read(tmp_path / "t")
+    assert table.axes == (tuple(TIED.split(",")),)
+    assert table.keys == tuple(TIED.split(","))
+    base = winder.load_scene(scene_file)
+    settings = run_settings(t_end=1.0, output_step=2e-3)
+    for row, v in zip(table.frame.to_dict("records"), (5.0, 10.0, 15.0), strict=True):
+        assert row["drum.front.drive.web_speed"] == row["drum.rear.drive.web_speed"] == v
+        hand = base.replace(drum={"front": {"drive": {"web_speed": v}},
+                                  "rear": {"drive": {"web_speed": v}}})
+        assert row["run_id"] == run_id(hand, settings, table.band_edges)
+        ref, _ = run_one(hand, settings, table.band_edges)
+        assert ref["status"] == "ok"
+        _assert_rows_equal(row, ref)
+    # the runs differ: the tie reaches the physics (both drums at the new speed)
+    assert len({row["final_radius"] for row in table.frame.to_dict("records")}) == 3
+    again = winder.sweep(base, {tuple(TIED.split(",")): [5.0, 10.0, 15.0]}, tmp_path / "t",
+                         scheduler="tcp://127.0.0.1:9", t_end=1.0, output_step=2e-3, bands=3)
+    assert again.computed == () and len(again.skipped) == 3  # the same runs: all done
+    (fig,) = figures
+    labels = [ax.get_ylabel() for ax in fig.axes if ax.get_ylabel()]
+    assert "drum.front.drive.web_speed,\ndrum.rear.drive.web_speed [m/s]" in labels
+    assert any(ax.get_xlabel() == "roll diameter [m]" for ax in fig.axes)
 
 
 # ---- progress --------------------------------------------------------------------------

@@ -60,13 +60,19 @@ def _tracks(html: str) -> dict[tuple[str, str], list[dict]]:
     return tracks
 
 
-def test_html_is_standalone_and_plays_the_result(tmp_path: Path, paper_scene) -> None:
+def test_html_is_standalone_and_plays_the_result(tmp_path: Path, paper_scene,
+                                                 capfd) -> None:
     """The animation data in the HTML are the result's channels at the frame times:
     frame k of ``playback·fps + 1`` shows t_k = k·t_end/(playback·fps); the paper's scale is
-    the radius (unit cylinder), the roll's height is z, the drum does not move."""
+    the radius (unit cylinder), the roll's height is z, the drum does not move. Writing it
+    opens no viewer and prints no viewer address."""
     res = _short_result(paper_scene)
+    capfd.readouterr()
     html = export_html(WinderGraph(paper_scene), res, tmp_path / "a.html", playback=4.0,
                        fps=10)
+    printed = capfd.readouterr()
+    assert "visualizer" not in printed.out + printed.err
+    assert "http" not in printed.out + printed.err
     text = html.read_text()
     assert "<script" in text and "three" in text.lower()
     assert "src=\"http" not in text and "href=\"http" not in text  # nothing fetched
@@ -566,3 +572,17 @@ def test_line_run_motion_from_its_channels(line) -> None:
         np.testing.assert_allclose(path[-1], p_b, atol=1e-12)
         assert readout_text(m, i).splitlines()[-1].split() == [
             "span", "T", f"{res['span_tension'][j]:.1f}", "N"]
+
+
+def test_view_html_prints_only_what_it_wrote(tmp_path: Path, paper_scene, capfd) -> None:
+    """`winder view --html` says where the animation went and nothing about a viewer."""
+    from winder.cli import main
+
+    src = _short_result(paper_scene).to_npz(tmp_path / "r.npz")
+    capfd.readouterr()
+    assert main(["view", str(src), "--html", str(tmp_path / "a.html"), "--playback",
+                 "2"]) == 0
+    printed = capfd.readouterr()
+    assert printed.out.splitlines() == [f"animation (2 s playback) written to "
+                                        f"{tmp_path / 'a.html'}"]
+    assert "visualizer" not in printed.err and "http" not in printed.err

@@ -5,13 +5,14 @@ error, and when a command is stopped by a signal (:mod:`winder._interrupt`)."""
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import shutil
 import signal
 import subprocess
 from collections.abc import Iterator
-from contextlib import ExitStack, contextmanager
+from contextlib import ExitStack, contextmanager, redirect_stdout
 from pathlib import Path
 
 import meshcat
@@ -54,13 +55,22 @@ def _stop(proc: subprocess.Popen | None) -> None:
 @contextmanager
 def served(graph: WinderGraph) -> Iterator[meshcat.Visualizer]:
     """A meshcat server with ``graph`` built in it; the server subprocess is stopped on
-    exit, on an error and on a signal (0.3.2's ViewerWindow has no close())."""
+    exit, on an error and on a signal (0.3.2's ViewerWindow has no close()).
+
+    meshcat prints "You can open the visualizer by visiting the following URL" on stdout
+    as its server starts: that text is kept from stdout (an HTML export or a snapshot opens
+    no viewer; the live view prints its own address, ``vis.url()``) and goes into the
+    message if the server cannot start."""
     with ExitStack() as stack:
         with deferred():  # a signal while the server starts is acted on once it is known
+            said = io.StringIO()
             try:
-                vis = meshcat.Visualizer()
+                with redirect_stdout(said):
+                    vis = meshcat.Visualizer()
             except Exception as exc:  # the zmq server subprocess could not start
-                raise WinderError(f"could not start the meshcat server: {exc}") from exc
+                told = " ".join(said.getvalue().split())[-400:]
+                raise WinderError(f"could not start the meshcat server: {exc}"
+                                  + (f" (it said: {told})" if told else "")) from exc
             proc = getattr(vis.window, "server_proc", None)
             stack.callback(_stop, proc)
             stack.enter_context(on_abort(lambda: _stop(proc)))

@@ -77,7 +77,9 @@ class Result(Mapping[str, np.ndarray]):
         suffix = Path(path).suffix.lower()
         if suffix == ".csv":
             names = list(self._channels)
-            table = np.column_stack([self._channels[n] for n in names])
+            # + 0.0 turns -0.0 into 0.0 (printed "0", not "-0") and leaves every other
+            # value, NaN and ±inf included, as it is
+            table = np.column_stack([self._channels[n] for n in names]) + 0.0
 
             def write_csv(tmp: Path) -> None:
                 np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="",

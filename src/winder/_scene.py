@@ -495,6 +495,57 @@ _PART_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]{0,39}")
 #: Bounds of a rider's load schedule: radius (0, 10] [m], line load [0, 1e7] [N/m].
 MAX_LOAD_RADIUS, MAX_LINE_LOAD = 10.0, 1e7
 
+#: Units of the numeric keys, by table as in :data:`_MAX` ("-": dimensionless, "": none in
+#: common); they label sweep axes and plots. Keys absent here (words, flags, pairs) have no
+#: unit. A new numeric key needs its unit here (tests/test_sweep.py checks).
+_UNITS: dict[tuple[str, str], str] = {
+    ("scene", "duration"): "s", ("scene", "output_step"): "s", ("scene", "gravity"): "m/s²",
+    ("drum", "radius"): "m", ("drum", "inertia"): "kg·m²", ("drum", "mass"): "kg",
+    ("drum.drive", "web_acceleration"): "m/s²", ("drum.drive", "web_speed"): "m/s",
+    ("drum.drive", "torque"): "N·m",
+    ("roll", "core_radius"): "m", ("roll", "core_mass"): "kg",
+    ("roll", "core_inertia"): "kg·m²", ("roll", "width"): "m", ("roll", "initial_radius"): "m",
+    ("roll", "initial_speed"): "rad/s", ("roll", "com_offset"): "m",
+    ("roll", "initial_height"): "m", ("paper", "density"): "kg/m³", ("paper", "caliper"): "m",
+    ("contact", "stiffness"): "N/m", ("contact", "damping"): "N·s/m",
+    ("contact", "exponent"): "-", ("contact", "hc_damping"): "s/m",
+    ("friction", "mu"): "-", ("friction", "slip_velocity"): "m/s",
+    ("friction", "relaxation_length"): "m", ("friction", "min_speed"): "m/s",
+    ("solver", "rtol"): "-", ("solver", "max_rhs"): "-", ("solver", "max_wall"): "s",
+    ("solver", "atol"): "",  # in each state's own unit: none in common
+}
+_UNITS.update({("drum[]", k): _UNITS[("drum", k)] for k in _SPEC["drum"]})
+_UNITS.update({("drum[].drive", k): u for (t, k), u in _UNITS.items() if t == "drum.drive"})
+_UNITS.update({("roll[]", k): u for (t, k), u in _UNITS.items() if t in ("roll", "paper")})
+_UNITS.update({("nip[]." + t, k): u for (t, k), u in _UNITS.items()
+               if t in ("contact", "friction")})
+_UNITS.update({("drum[].drive", "ratio"): "-", ("rider[]", "radius"): "m",
+               ("rider[]", "mass"): "kg", ("rider[]", "inertia"): "kg·m²",
+               ("rider[]", "x"): "m", ("web", "tension"): "N", ("roll[].drive", "torque"): "N·m",
+               ("roll[].drive", "tension"): "N", ("roll[].drive", "bandwidth"): "rad/s",
+               ("web.span", "length"): "m", ("web.span", "EA"): "N", ("web.span", "T_in"): "N",
+               ("web.span", "initial_tension"): "N"})
+
+
+def key_unit(path: str, data: Mapping[str, Any] | None = None) -> str:
+    """The unit of the scene key at dotted ``path`` (``drum.drive.web_speed``: ``"m/s"``;
+    ``nip.front.contact.stiffness``: ``"N/m"``), ``"-"`` for a dimensionless number and
+    ``""`` for a key without a unit (a word, a flag) or an unknown path. ``data`` (the
+    scene's nested tables, :meth:`Scene.to_dict`) tells an array of tables (whose next
+    segment is an element's name) from a table; without it, the first segment is an array
+    when the path does not fit the single-drum tables."""
+    parts = path.split(".")
+    if len(parts) < 2:
+        return ""
+    head, rest = parts[0], parts[1:]
+    if data is not None:
+        array = isinstance(data.get(head), list)
+    else:
+        array = head in _ARRAYS and ".".join([head, *rest[:-1]]) not in _SPEC
+    if array:
+        head, rest = head + "[]", rest[1:]  # skip the element's name
+    return _UNITS.get((".".join([head, *rest[:-1]]), rest[-1]), "") if rest else ""
+
 
 def _check_name(source: str, value: str) -> str:
     if not value or len(value) > MAX_NAME or not value.isprintable():

@@ -31,7 +31,7 @@ from ._progress import SweepProgress
 from ._result import Result
 from ._scene import Scene, load_scene
 from ._simulate import simulate
-from ._sweep_grid import Grid, Value, build_grid, parse_spec, scene_hash
+from ._sweep_grid import Grid, Value, build_grid, parse_spec, scene_hash, split_keys
 from ._sweep_summary import default_band_edges, empty_summary, summarise
 from ._sweep_table import RunStore, SweepTable, row_schema, table_meta
 
@@ -168,7 +168,8 @@ def _client(scheduler: Any, workers: int | None) -> Iterator[Any]:
         cluster.close()
 
 
-def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
+def sweep(scene: Scene | str | Path,
+          vary: Mapping[str | tuple[str, ...], str | Sequence[Value]],
           out: str | Path, *, scheduler: Any = None, workers: int | None = None,
           t_end: float | None = None, rtol: float | None = None,
           output_step: float | None = None, max_wall: float | None = None,
@@ -181,7 +182,10 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
     ----------
     scene: the base scene (a :class:`~winder.Scene` or a scene file).
     vary: ``{key path: values}``; values are a list or a spec string (``"15:45:16"``:
-        16 values from 15 to 45; ``"1e7,2e7"``); see :mod:`winder._sweep_grid`.
+        16 values from 15 to 45; ``"1e7,2e7"``); see :mod:`winder._sweep_grid`. Tied keys
+        share one axis (each run sets them all to the same value): the key
+        ``"drum.front.drive.web_speed,drum.rear.drive.web_speed"`` or a tuple of key
+        paths.
     out: output directory (``runs/``, ``summary.parquet``, ``trajectories/``). Runs
         already done there are skipped: an interrupted sweep resumes.
     scheduler: ``None`` (an embedded ``LocalCluster`` with ``workers`` processes, default
@@ -205,9 +209,13 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
     base = scene if isinstance(scene, Scene) else load_scene(scene)
     if not isinstance(vary, Mapping) or not vary:
         raise ArgumentError(f"vary: give at least one {{key: values}}, got {vary!r}")
-    values = {k: parse_spec(k, v) if isinstance(v, str)
-              else [x.item() if isinstance(x, np.generic) else x for x in v]
-              for k, v in vary.items()}
+    values = {}
+    for k, v in vary.items():
+        name = ",".join(split_keys(k))
+        if name in values:
+            raise ArgumentError(f"vary: the key {name} is given twice")
+        values[name] = parse_spec(name, v) if isinstance(v, str) \
+            else [x.item() if isinstance(x, np.generic) else x for x in v]
     grid = build_grid(base, values)
     settings = run_settings(t_end=t_end, rtol=rtol, output_step=output_step,
                             max_wall=max_wall, window=window, threshold=threshold)
@@ -223,7 +231,8 @@ def sweep(scene: Scene | str | Path, vary: Mapping[str, str | Sequence[Value]],
     edges = _edges(bands, grid, settings["t_end"])
     ids = [run_id(s, settings, edges) for s in grid.scenes]
     hashes = [scene_hash(s.to_dict()) for s in grid.scenes]
-    schema = row_schema(grid.axes, table_meta(grid.keys, edges, base.to_dict(), settings))
+    schema = row_schema(grid.axes, table_meta(grid.keys, edges, base.to_dict(), settings,
+                                              axes=[a.keys for a in grid.axes]))
     store = RunStore(out)
 
     def row_of(i: int, fields: Mapping[str, Any]) -> dict[str, Any]:

@@ -7,6 +7,11 @@ stiffness`` is ``stiffness`` in table ``contact`` of the ``[[nip]]`` element who
 ``name = "rear"``. Resolution works on any nested ``dict``/``list`` structure
 (:meth:`Scene.to_dict`), so new scene formats need no change here.
 
+Several keys can share one axis (tied keys): ``drum.front.drive.web_speed,drum.rear.
+drive.web_speed`` (comma-separated, no spaces needed) gives every key the same value in
+each run, e.g. both drums' web speed. The axis is named by its keys joined with commas;
+the table has one column per key.
+
 A value spec is a range ``START:STOP:COUNT`` (``COUNT`` values from ``START`` to ``STOP``
 inclusive, evenly spaced) or a comma-separated list (numbers, ``true``/``false``, or
 words such as ``linear,hunt_crossley``).
@@ -32,8 +37,8 @@ import numpy as np
 from ._errors import ArgumentError, SceneError
 from ._scene import Scene, scene_from_dict
 
-__all__ = ["Axis", "Grid", "parse_spec", "parse_vary", "resolve", "get_path", "set_path",
-           "scene_hash", "build_grid"]
+__all__ = ["Axis", "Grid", "parse_spec", "parse_vary", "split_keys", "resolve", "get_path",
+           "set_path", "scene_hash", "build_grid"]
 
 Value = float | int | bool | str
 
@@ -155,18 +160,47 @@ def parse_spec(key: str, spec: str) -> list[Value]:
     return values
 
 
+def split_keys(name: str | Sequence[str]) -> tuple[str, ...]:
+    """The keys of one axis: ``"a.b,c.d"`` (tied keys, comma-separated) or a sequence of
+    key paths → ``("a.b", "c.d")``. Raises :class:`ArgumentError` for an empty key or a
+    key listed twice."""
+    if isinstance(name, str):
+        keys = tuple(k.strip() for k in name.split(","))
+    elif isinstance(name, Sequence) and all(isinstance(k, str) for k in name):
+        keys = tuple(k.strip() for k in name)
+    else:
+        raise ArgumentError(f"vary: a key is a key path or a tuple of key paths, got "
+                            f"{name!r}")
+    shown = name if isinstance(name, str) else ",".join(name)
+    if not keys or any(not k for k in keys):
+        raise ArgumentError(f"--vary {shown!r}: empty key; tied keys are key paths "
+                            "separated by commas, e.g. drum.front.drive.web_speed,"
+                            "drum.rear.drive.web_speed=10:30:5")
+    for k in keys:
+        if keys.count(k) > 1:
+            raise ArgumentError(f"--vary {shown}: key {k} is listed twice")
+    return keys
+
+
 def parse_vary(items: Sequence[str]) -> dict[str, list[Value]]:
-    """``["KEY=SPEC", ...]`` (the ``--vary`` options) → ``{key: values}`` in order."""
+    """``["KEY=SPEC", ...]`` (the ``--vary`` options) → ``{key: values}`` in order. KEY may
+    be tied keys ``KEY1,KEY2`` sharing the values (the result's key is then
+    ``"KEY1,KEY2"``)."""
     out: dict[str, list[Value]] = {}
+    seen: set[str] = set()
     for item in items:
         key, sep, spec = item.partition("=")
         key = key.strip()
         if not sep or not key:
-            raise ArgumentError(f"--vary {item!r}: expected KEY=SPEC, e.g. "
+            raise ArgumentError(f"--vary {item!r}: expected KEY=SPEC or KEY1,KEY2=SPEC, e.g. "
                                 "drum.drive.web_speed=15:45:16")
-        if key in out:
-            raise ArgumentError(f"--vary {key}: the key is given twice")
-        out[key] = parse_spec(key, spec)
+        keys = split_keys(key)
+        for k in keys:
+            if k in seen:
+                raise ArgumentError(f"--vary {k}: the key is given twice")
+            seen.add(k)
+        name = ",".join(keys)
+        out[name] = parse_spec(name, spec)
     if not out:
         raise ArgumentError("--vary: give at least one KEY=SPEC")
     return out
@@ -182,16 +216,27 @@ def scene_hash(data: Mapping[str, Any]) -> str:
 
 @dataclass(frozen=True)
 class Axis:
-    """One swept key and its values."""
+    """One axis of the grid: its key paths (several: tied keys, all set to the same value
+    in a run) and its values."""
 
-    key: str
+    keys: tuple[str, ...]
     values: tuple[Value, ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "keys", split_keys(self.keys))
+        object.__setattr__(self, "values", tuple(self.values))
+
+    @property
+    def key(self) -> str:
+        """The axis's name: its keys joined with commas."""
+        return ",".join(self.keys)
 
 
 @dataclass(frozen=True)
 class Grid:
-    """The full factorial grid of a sweep: ``points[i]`` maps each key to its value in
-    run ``i`` (first axis outermost), ``scenes[i]`` is that run's validated scene."""
+    """The full factorial grid of a sweep: ``points[i]`` maps each key (each tied key on
+    its own) to its value in run ``i`` (first axis outermost), ``scenes[i]`` is that run's
+    validated scene."""
 
     base: Scene
     axes: tuple[Axis, ...]
@@ -200,7 +245,8 @@ class Grid:
 
     @property
     def keys(self) -> tuple[str, ...]:
-        return tuple(a.key for a in self.axes)
+        """Every swept key path (tied keys each on their own), in axis order."""
+        return tuple(k for a in self.axes for k in a.keys)
 
     def __len__(self) -> int:
         return len(self.points)
@@ -220,32 +266,42 @@ def _build(base: Scene, data: dict[str, Any], keys: Sequence[str]) -> Scene:
         raise ArgumentError(f"--vary {', '.join(keys)}: {exc}") from None
 
 
-def build_grid(base: Scene, vary: Mapping[str, Sequence[Value]]) -> Grid:
-    """Resolve every key, check every value alone against the base scene (the error names
-    that key and value), then build and validate every grid point."""
+def build_grid(base: Scene, vary: Mapping[str | tuple[str, ...], Sequence[Value]]) -> Grid:
+    """Resolve every key, check every value of an axis alone against the base scene (tied
+    keys together; the error names the keys and the value), then build and validate every
+    grid point. A key of ``vary`` is one key path, tied key paths ``"k1,k2"`` or a tuple
+    of key paths."""
     data = base.to_dict()
-    axes = []
-    for key, values in vary.items():
+    axes: list[Axis] = []
+    seen: set[str] = set()
+    for name, values in vary.items():
+        keys = split_keys(name)
+        key = ",".join(keys)
         values = tuple(values)
         if not values:
             raise ArgumentError(f"--vary {key}: no values")
-        container, slot = resolve(data, key)
-        if slot not in container:  # a key the scene leaves at its default, or a typo
-            try:
-                scene_from_dict(_apply(data, {key: values[0]}), source=base.source)
-            except SceneError as exc:
-                raise ArgumentError(f"--vary {key}: unknown key or bad value ({exc})") \
-                    from None
+        for k in keys:
+            if k in seen:
+                raise ArgumentError(f"--vary {k}: the key is given twice")
+            seen.add(k)
+            container, slot = resolve(data, k)
+            if slot not in container:  # a key the scene leaves at its default, or a typo
+                try:
+                    scene_from_dict(_apply(data, dict.fromkeys(keys, values[0])),
+                                    source=base.source)
+                except SceneError as exc:
+                    raise ArgumentError(f"--vary {k}: unknown key or bad value ({exc})") \
+                        from None
         for v in values:
             try:
-                scene_from_dict(_apply(data, {key: v}), source=base.source)
+                scene_from_dict(_apply(data, dict.fromkeys(keys, v)), source=base.source)
             except SceneError as exc:
                 raise ArgumentError(f"--vary {key}: value {v!r} fails scene validation: "
                                     f"{exc}") from None
-        axes.append(Axis(key, values))
+        axes.append(Axis(keys, values))
     points, scenes = [], []
     for combo in itertools.product(*(a.values for a in axes)):
-        point = {a.key: v for a, v in zip(axes, combo, strict=True)}
+        point = {k: v for a, v in zip(axes, combo, strict=True) for k in a.keys}
         points.append(point)
         scenes.append(_build(base, _apply(data, point), list(point)))
     return Grid(base, tuple(axes), tuple(points), tuple(scenes))

@@ -7,7 +7,8 @@ mean nip force, :mod:`winder._sweep_summary`): 1 and above means the roll lifts 
 Where the roll turns ``k`` times per bounce period the imbalance drives the nip at
 resonance: at diameter ``d`` that happens at web speed ``v_k(d) = π d f_bounce(d/2) / k``,
 drawn for ``k = 1, 2, 3`` from the linearised modes of the panel's scene. When swept keys
-other than the web speed exist, each of their combinations gets its own panel.
+other than the web speed exist, each of their combinations gets its own panel. Axes and
+panels are labelled with the swept keys (all of them for tied keys) and their units.
 """
 
 from __future__ import annotations
@@ -27,13 +28,15 @@ from matplotlib.colors import LogNorm  # noqa: E402
 from ._errors import ArgumentError, WinderError  # noqa: E402
 from ._files import atomic_write  # noqa: E402
 from ._modes import mode_map  # noqa: E402
-from ._scene import scene_from_dict  # noqa: E402
-from ._sweep_grid import set_path  # noqa: E402
+from ._scene import key_unit, scene_from_dict  # noqa: E402
+from ._sweep_grid import set_path, split_keys  # noqa: E402
 from ._sweep_table import SweepTable  # noqa: E402
 
-__all__ = ["runnability_map", "map_layout", "SPEED_KEY"]
+__all__ = ["runnability_map", "map_layout", "axis_label", "SPEED_KEY"]
 
-#: The key path of the web speed: the map's vertical axis when it is swept.
+#: The key path of the web speed of a single-drum scene. An axis whose keys are all drums'
+#: web speeds (``drum.drive.web_speed``, ``drum.NAME.drive.web_speed``, tied or not) is the
+#: map's vertical axis when it is swept.
 SPEED_KEY = "drum.drive.web_speed"
 _ORDERS = ((1, "-"), (2, "--"), (3, ":"))
 _MAX_PANELS = 12
@@ -64,12 +67,43 @@ def _critical_lines(table: SweepTable, fixed: dict, speeds: np.ndarray,
     return mm.radius, mm.bounce_frequency
 
 
+def _is_speed(axis: str) -> bool:
+    """Whether every key of ``axis`` (``"k1,k2"``) is a drum's web speed."""
+    return all(k.startswith("drum.") and k.endswith(".drive.web_speed")
+               for k in split_keys(axis))
+
+
+def _with_unit(text: str, unit: str) -> str:
+    return f"{text} [{unit}]" if unit else text
+
+
+def axis_label(axis: str, scene: dict, *, sep: str = ",\n") -> str:
+    """The label of a swept axis (``"k1,k2"`` for tied keys): every key path and its unit
+    (``drum.drive.web_speed [m/s]``); tied keys of one unit share it at the end. ``scene``:
+    the base scene's nested tables (they tell arrays of parts from tables)."""
+    keys = split_keys(axis)
+    units = [key_unit(k, scene) for k in keys]
+    if len(set(units)) == 1:
+        return _with_unit(sep.join(keys), units[0])
+    return sep.join(_with_unit(k, u) for k, u in zip(keys, units, strict=True))
+
+
+def _value_text(axis: str, value: object, scene: dict) -> str:
+    """``"k1, k2 = 20 m/s"``: a panel's fixed value of an axis, with its unit."""
+    units = {key_unit(k, scene) for k in split_keys(axis)}
+    unit = f" {units.pop()}" if len(units) == 1 and "" not in units and "-" not in units \
+        else ""
+    shown = f"{value:g}" if isinstance(value, float) else f"{value}"
+    return f"{', '.join(split_keys(axis))} = {shown}{unit}"
+
+
 def map_layout(vary: dict[str, list]) -> tuple[str, list[str]]:
-    """``(vertical key, panel keys)`` of the map of a sweep over ``vary`` (``{key:
-    values}``); raises :class:`ArgumentError` when it cannot be drawn (checked before a
-    sweep runs): a non-numeric vertical key, or more than 12 panels."""
+    """``(vertical axis, panel axes)`` of the map of a sweep over ``vary`` (``{axis:
+    values}``, an axis of tied keys named ``"k1,k2"``); raises :class:`ArgumentError` when
+    it cannot be drawn (checked before a sweep runs): a non-numeric vertical axis, or more
+    than 12 panels. The vertical axis is the first of drums' web speeds, else the first."""
     keys = list(vary)
-    ykey = SPEED_KEY if SPEED_KEY in keys else keys[0]
+    ykey = next((k for k in keys if _is_speed(k)), keys[0])
     if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in vary[ykey]):
         raise ArgumentError(f"--plot: the runnability map needs numbers on its vertical "
                             f"axis; {ykey} has values {list(vary[ykey])}")
@@ -86,14 +120,16 @@ def runnability_map(table: SweepTable, path: str | Path, *, column: str = "vibra
                     title: str = "") -> Path:
     """Draw the runnability map of ``table`` into ``path`` (PNG); returns the path.
 
-    The vertical axis is the web speed when ``drum.drive.web_speed`` is swept (with the
-    critical-speed lines), else the first swept key. ``column``: the per-band column that
+    The vertical axis is the web speed when drums' web speeds are swept (with the
+    critical-speed lines), else the first swept axis. ``column``: the per-band column that
     colours the cells (``vibration_level`` by default)."""
     frame = table.frame
     if len(frame) == 0:
         raise ArgumentError(f"{table.path}: the sweep has no finished run to draw")
-    ykey, others = map_layout({k: frame[k].tolist() for k in table.keys})
-    combos = list(itertools.product(*(sorted(set(frame[k])) for k in others))) or [()]
+    # one column per axis: tied keys hold equal values, the first stands for them all
+    first = {",".join(a): a[0] for a in table.axes}
+    ykey, others = map_layout({name: frame[k].tolist() for name, k in first.items()})
+    combos = list(itertools.product(*(sorted(set(frame[first[k]])) for k in others))) or [()]
     level = table.bands(column)
     d_edges = 2 * table.band_edges
     ncol = min(3, len(combos))
@@ -109,14 +145,15 @@ def runnability_map(table: SweepTable, path: str | Path, *, column: str = "vibra
         fixed = dict(zip(others, combo, strict=True))
         mask = np.ones(len(frame), dtype=bool)
         for k, v in fixed.items():
-            mask &= (frame[k] == v).to_numpy()
-        ys = frame[ykey].to_numpy(dtype=float)[mask]
+            mask &= (frame[first[k]] == v).to_numpy()
+        ys = frame[first[ykey]].to_numpy(dtype=float)[mask]
         order = np.argsort(ys)
         ys, cells = ys[order], level[mask][order]
         mesh = ax.pcolormesh(d_edges, _cell_edges(ys), np.ma.masked_invalid(cells),
                              cmap="magma_r", norm=norm, shading="flat")
-        if len(ys) and ykey == SPEED_KEY:
-            lines = _critical_lines(table, fixed, ys)
+        if len(ys) and _is_speed(ykey):
+            lines = _critical_lines(table, {k: v for name, v in fixed.items()
+                                            for k in split_keys(name)}, ys)
             if isinstance(lines, str):
                 ax.text(0.02, 0.02, lines[:80], transform=ax.transAxes, fontsize=7)
             else:
@@ -127,15 +164,16 @@ def runnability_map(table: SweepTable, path: str | Path, *, column: str = "vibra
                 ax.set_ylim(_cell_edges(ys)[0], _cell_edges(ys)[-1])
                 ax.legend(fontsize=7, loc="lower right")
         ax.set_xlim(d_edges[0], d_edges[-1])
-        ax.set_title(", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                               for k, v in fixed.items()) or "", fontsize=9)
+        ax.set_title("; ".join(_value_text(k, v, table.base_scene)
+                               for k, v in fixed.items()), fontsize=9)
         ax.grid(alpha=0.25)
     for ax in axes.flat[len(combos):]:
         ax.set_visible(False)
     for ax in axes[-1, :]:
         ax.set_xlabel("roll diameter [m]")
     for ax in axes[:, 0]:
-        ax.set_ylabel("web speed [m/s]" if ykey == SPEED_KEY else ykey)
+        ax.set_ylabel(axis_label(ykey, table.base_scene),
+                      fontsize=10 if len(split_keys(ykey)) == 1 else 8)
     cbar = fig.colorbar(mesh, ax=axes.ravel().tolist(), shrink=0.9)
     cbar.set_label(f"{column.replace('_', ' ')} [-]" + (" (≥ 1: lift-off)"
                                                          if column == "vibration_level"

@@ -53,9 +53,13 @@ def _value_type(values: Sequence[Any]) -> pa.DataType:
 
 
 def table_meta(keys: Sequence[str], band_edges: np.ndarray, base_scene: Mapping[str, Any],
-               settings: Mapping[str, Any]) -> dict[str, Any]:
-    """What a sweep table's Parquet metadata stores (:meth:`SweepTable.read` restores it)."""
-    return {"keys": list(keys), "band_edges": np.asarray(band_edges, dtype=float).tolist(),
+               settings: Mapping[str, Any], *,
+               axes: Sequence[Sequence[str]] | None = None) -> dict[str, Any]:
+    """What a sweep table's Parquet metadata stores (:meth:`SweepTable.read` restores it):
+    ``axes`` groups ``keys`` into the grid's axes (tied keys share one; default: one axis
+    per key)."""
+    return {"keys": list(keys), "axes": [list(a) for a in (axes or [[k] for k in keys])],
+            "band_edges": np.asarray(band_edges, dtype=float).tolist(),
             "base_scene": dict(base_scene), "settings": dict(settings)}
 
 
@@ -63,7 +67,7 @@ def row_schema(axes: Sequence[Axis], meta: Mapping[str, Any] | None = None) -> p
     """The Parquet schema of a sweep's rows: ``run`` (grid index), one column per swept
     key, the run columns (:data:`RUN_COLUMNS`), the scalar summary and the per-band lists."""
     fields = [pa.field("run", pa.int64())]
-    fields += [pa.field(a.key, _value_type(a.values)) for a in axes]
+    fields += [pa.field(k, _value_type(a.values)) for a in axes for k in a.keys]
     fields += [pa.field(c, pa.float64() if c.endswith("_time") else pa.string())
                for c in RUN_COLUMNS]
     scalars, bands = nip_columns(scene_nip_names((meta or {}).get("base_scene", {})))
@@ -140,7 +144,9 @@ class SweepTable:
         (integration), ``task_time`` [s] (the whole task on its worker), ``worker``, the
         scalar summary columns and per-band list columns (``winder._sweep_summary``; a
         scene of parts also has them per nip, ``NIP.column``).
-    keys: the swept key paths.
+    keys: the swept key paths (each tied key on its own, as the columns).
+    axes: the grid's axes, each a tuple of its key paths (several: tied keys, equal in
+        every row).
     band_edges: radius band edges [m] of the per-band columns.
     base_scene: the base scene as nested tables (:meth:`winder.Scene.to_dict`).
     settings: the run settings (``t_end``, ``rtol``, ``output_step`` …).
@@ -161,6 +167,11 @@ class SweepTable:
     computed: tuple[str, ...] = ()
     skipped: tuple[str, ...] = ()
     dashboard: str | None = None
+    axes: tuple[tuple[str, ...], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.axes:
+            self.axes = tuple((k,) for k in self.keys)
 
     def __len__(self) -> int:
         return len(self.frame)
@@ -197,5 +208,6 @@ class SweepTable:
             raise WinderError(f"{p}: not a winder sweep table (no 'winder' metadata)")
         meta = json.loads(raw)
         return cls(frame=table.to_pandas(), keys=tuple(meta["keys"]),
+                   axes=tuple(tuple(a) for a in meta.get("axes", [[k] for k in meta["keys"]])),
                    band_edges=np.asarray(meta["band_edges"], dtype=float),
                    base_scene=meta["base_scene"], settings=meta.get("settings", {}), path=p)

@@ -100,6 +100,16 @@ def _result_files(out: Path) -> list[Path]:
     return [out, out.with_suffix(".npz")] if out.suffix.lower() == ".csv" else [out]
 
 
+def _balance_text(residual: float, scale: float) -> str:
+    """The line on the initial static balance (machines.md §7): its largest force
+    residual ``residual`` [N] against the largest force ``scale`` [N] in it; with no force
+    at all there is nothing to balance (no free coordinate rests on a nip)."""
+    if scale == 0.0 and residual == 0.0:
+        return ("initial static balance: nothing to solve (no free coordinate rests on a "
+                "nip or carries a load)")
+    return f"initial static balance: residual {residual:.1e} N of {scale:.1e} N"
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from ._files import check_output_dir, check_output_file
 
@@ -139,8 +149,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     print(f"{scene.name}: {len(result.t)} samples to {out} ({m['method']}, rtol {m['rtol']:g}, "
           f"{m['rhs_evaluations']} RHS evaluations, {m['wall_time']:.2f} s integration)")
     if m.get("static_residual") is not None:
-        print(f"  initial static balance: residual {m['static_residual']:.1e} N of "
-              f"{m['static_scale']:.1e} N")
+        print("  " + _balance_text(m["static_residual"], m["static_scale"]))
     if m.get("ended"):
         print(f"  {m['ended']}")
     if plots is not None:
@@ -309,7 +318,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     if csv is not None:
         cols = mm.as_columns()
         header = ",".join(cols)
-        table = np.column_stack(list(cols.values()))
+        table = np.column_stack(list(cols.values())) + 0.0  # -0.0 printed as 0, not -0
         atomic_write(csv, lambda p: np.savetxt(p, table, delimiter=",", header=header,
                                                comments="", fmt="%.10g"))
         print(f"  table written to {csv}")
@@ -330,11 +339,38 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Failed runs listed by ``winder sweep`` (the rest are counted; the table holds them all).
+_MAX_FAILED_LISTED = 20
+
+
+def _axis_values(table: Any, row: Any) -> str:
+    """``k1, k2 = 20.0, k3 = 1e-3``: a run's swept values, tied keys once."""
+    return ", ".join(f"{', '.join(a)} = {row[a[0]]!r}" for a in table.axes)
+
+
+def _failed_runs(table: Any) -> list[str]:
+    """Lines listing the runs of ``table`` that did not end normally: run index, swept
+    values, status and message (its first line, cut to 200 characters)."""
+    bad = table.failed
+    lines = []
+    for row in bad.head(_MAX_FAILED_LISTED).to_dict("records"):
+        message = " ".join(str(row["message"]).split()) or "(no message)"
+        if len(message) > 200:
+            message = message[:197] + "..."
+        lines.append(f"  run {row['run']} ({_axis_values(table, row)}): {row['status']}: "
+                     f"{message}")
+    if len(bad) > _MAX_FAILED_LISTED:
+        lines.append(f"  ... and {len(bad) - _MAX_FAILED_LISTED} more (column 'status' of "
+                     f"{table.path})")
+    return lines
+
+
 def _cmd_sweep(args: argparse.Namespace) -> int:
     """``winder sweep``: the grid on Dask, the summary table, optionally the map. Exit 0
-    when every run is done (failed runs are recorded in the table), 1 when runs are
-    missing (workers died), 128 + N on signal N (130 Ctrl-C; finished runs are kept: re-run
-    to resume)."""
+    when every run is done and at least one ended normally (failed runs are listed on
+    stderr and recorded in the table), 2 when every run failed (listed; the table is kept,
+    no map is drawn), 1 when runs are missing (workers died), 128 + N on signal N (130
+    Ctrl-C; finished runs are kept: re-run to resume)."""
     from ._files import check_output_dir, check_output_file
     from ._scene import load_scene
     from ._sweep import sweep
@@ -359,10 +395,19 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         print(f"winder: interrupted; finished runs are kept in {args.out}/runs; run the same "
               "command again to resume", file=sys.stderr)
         return exc.exit_status if isinstance(exc, Interrupted) else 130
-    n_bad = int((table.frame["status"] != "ok").sum())
+    n_bad = len(table.failed)
     print(f"{scene.name}: {len(table)} runs in {table.path} ({len(table.computed)} run now, "
           f"{len(table.skipped)} already done, {n_bad} failed)")
-    if args.plot:
+    all_failed = n_bad == len(table) > 0
+    if n_bad:
+        head = (f"every run failed ({n_bad})" if all_failed
+                else f"{n_bad} of {len(table)} runs failed")
+        print(f"winder: {head}:", file=sys.stderr)
+        for line in _failed_runs(table):
+            print(line, file=sys.stderr)
+    if args.plot and all_failed:
+        print("  no runnability map: no run ended normally", file=sys.stderr)
+    elif args.plot:
         from ._sweep_plot import runnability_map
 
         png = Path(args.out) / "runnability_map.png" if args.plot is True else args.plot
@@ -372,13 +417,15 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         print(f"winder: {len(table.missing)} runs missing (their workers died); run the same "
               "command again to retry them:", file=sys.stderr)
         for m in table.missing:
-            values = ", ".join(f"{k} = {m[k]!r}" for k in table.keys)
-            print(f"  run {m['run']} ({values}): {m['reason']}", file=sys.stderr)
+            print(f"  run {m['run']} ({_axis_values(table, m)}): {m['reason']}",
+                  file=sys.stderr)
         return 1
-    return 0
+    return EXIT_ERROR if all_failed else 0
 
 
 def _build_parser() -> argparse.ArgumentParser:
+    from ._scene import BACKENDS, METHODS  # the scene's [solver] choices: one list
+
     parser = _Parser(prog="winder", description="Paper winder simulation.",
                      epilog="Exit status: 0 done; 2 bad input or failed run (a message names "
                      "the file, option or key); 128+N stopped by signal N (130 Ctrl-C, 143 "
@@ -389,9 +436,10 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", required=True, help="result file (.csv or .npz; a .csv gets "
                      "an .npz twin)")
     run.add_argument("--t-end", type=_POSITIVE, help="end time [s] (default: scene duration)")
-    run.add_argument("--method", help="integrator (auto, DOPRI5, RK4, RK45, DOP853, Radau, "
-                     "BDF, LSODA, RK23)")
-    run.add_argument("--backend", help="right-hand side: compiled (default) or pinocchio")
+    run.add_argument("--method", help=f"integrator ({', '.join(METHODS)}; default: the "
+                     "scene's [solver] method, else auto)")
+    run.add_argument("--backend", help=f"right-hand side: {' or '.join(BACKENDS)} (default: "
+                     "the scene's [solver] backend, else compiled)")
     run.add_argument("--rtol", type=_RTOL, help=f"relative tolerance (0 < rtol <= {RTOL_MAX:g})")
     run.add_argument("--atol", type=_POSITIVE, help="absolute tolerance (> 0)")
     run.add_argument("--max-evals", type=_EVALS, metavar="N",
@@ -435,11 +483,18 @@ def _build_parser() -> argparse.ArgumentParser:
                        help="add the simulated normal-force envelope to the plot")
     modes.set_defaults(func=_cmd_modes)
     sweep = sub.add_parser("sweep", help="run a scene over a parameter grid on Dask "
-                           "(runnability map)")
+                           "(runnability map)",
+                           epilog="Exit status: 0 every run done (runs that failed are "
+                           "listed on stderr with their values and message, and kept in the "
+                           "table); 2 bad input, or every run failed (the table is kept); 1 "
+                           "runs missing (their workers died: run again to retry them); "
+                           "130 Ctrl-C (run again to resume).")
     sweep.add_argument("scene", help="scene file (TOML)")
     sweep.add_argument("--vary", action="append", required=True, metavar="KEY=SPEC",
                        help="scene key path and values: a range START:STOP:COUNT or a list "
-                       "a,b,c (repeat for a grid), e.g. drum.drive.web_speed=15:45:16")
+                       "a,b,c (repeat for a grid), e.g. drum.drive.web_speed=15:45:16; tied "
+                       "keys KEY1,KEY2=SPEC take the same value in each run, e.g. "
+                       "drum.front.drive.web_speed,drum.rear.drive.web_speed=10:30:5")
     sweep.add_argument("--out", required=True, help="output directory (resumes a sweep "
                        "already there)")
     sweep.add_argument("--scheduler", help="address of a running Dask scheduler (default: "
