@@ -22,14 +22,15 @@ import os
 import re
 import shutil
 import tempfile
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
+from typing import Any
 
 from ._errors import WinderError
 from ._interrupt import deferred, on_abort
 
-__all__ = ["OutputError", "atomic_write", "atomic_write_all", "check_output_dir",
+__all__ = ["OutputError", "atomic_write", "atomic_write_all", "check_output_dir", "csv_writer",
            "check_output_file", "safe_stem", "scratch_dir"]
 
 Writer = Callable[[Path], object]
@@ -181,6 +182,19 @@ def _unlink(path: Path) -> None:
 
 _UMASK = os.umask(0)
 os.umask(_UMASK)
+
+
+def csv_writer(columns: Mapping[str, Any], *, fmt: str) -> Writer:
+    """A writer (for :func:`atomic_write`) of a CSV of equal-length numeric ``columns``:
+    a header of their names, then one row per sample in ``fmt``. -0.0 is written 0 (``+
+    0.0`` turns it into 0.0 and leaves every other value, NaN and ±inf included, as it
+    is)."""
+    import numpy as np
+
+    header = ",".join(columns)
+    table = np.column_stack(list(columns.values())) + 0.0
+    return lambda tmp: np.savetxt(tmp, table, delimiter=",", header=header, comments="",
+                                  fmt=fmt)
 
 
 def atomic_write_all(items: Sequence[tuple[str | os.PathLike[str], Writer]]) -> list[Path]:

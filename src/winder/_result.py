@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ._errors import WinderError
-from ._files import atomic_write, atomic_write_all
+from ._files import atomic_write, atomic_write_all, csv_writer
 
 __all__ = ["Result", "ResultFileError", "load_result"]
 
@@ -76,15 +76,7 @@ class Result(Mapping[str, np.ndarray]):
         suffix: ``.csv`` (header: channel names) or ``.npz`` (channels + ``__meta__``)."""
         suffix = Path(path).suffix.lower()
         if suffix == ".csv":
-            names = list(self._channels)
-            # + 0.0 turns -0.0 into 0.0 (printed "0", not "-0") and leaves every other
-            # value, NaN and ±inf included, as it is
-            table = np.column_stack([self._channels[n] for n in names]) + 0.0
-
-            def write_csv(tmp: Path) -> None:
-                np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="",
-                           fmt="%.15g")
-            return write_csv
+            return csv_writer(self._channels, fmt="%.15g")
         if suffix == ".npz":
             meta = np.array(json.dumps(self.meta, default=str))
 

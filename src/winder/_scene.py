@@ -403,24 +403,31 @@ _SPEC: dict[str, dict[str, tuple]] = {
                "atol": ("num", False, _POS), "max_rhs": ("num", False, _POS),
                "backend": ("str", False, None), "max_wall": ("num", False, _POS)},
 }
-#: Upper bounds of the numeric keys (far beyond any real winder, well inside the float
-#: range so that masses, inertias and forces cannot overflow); units as in the tables'
-#: docstrings. Keys without a lower bound are bounded in magnitude.
-_MAX: dict[tuple[str, str], float] = {
-    ("scene", "duration"): 1e6, ("scene", "gravity"): 1e3,
-    ("drum", "radius"): 10.0, ("drum", "inertia"): 1e7, ("drum", "mass"): 1e6,
-    ("drum.drive", "web_acceleration"): 1e3, ("drum.drive", "web_speed"): 1e3,
-    ("drum.drive", "torque"): 1e8,
-    ("roll", "core_radius"): 10.0, ("roll", "core_mass"): 1e6, ("roll", "core_inertia"): 1e7,
-    ("roll", "width"): 100.0, ("roll", "initial_radius"): 10.0,
-    ("roll", "initial_speed"): 1e5, ("roll", "com_offset"): 10.0,
-    ("roll", "initial_height"): 1e3,
-    ("paper", "density"): 1e5, ("paper", "caliper"): 0.1,
-    ("contact", "stiffness"): 1e18, ("contact", "damping"): 1e12,
-    ("contact", "exponent"): 3.0, ("contact", "hc_damping"): 1e4,
-    ("friction", "mu"): 10.0, ("friction", "slip_velocity"): 1e3,
-    ("friction", "relaxation_length"): 1e3, ("friction", "min_speed"): 1e3,
-    ("solver", "rtol"): RTOL_MAX, ("solver", "atol"): 1.0, ("solver", "max_rhs"): 1e12,
+#: The numeric keys, by table: ``(upper bound, unit)``. The bound is far beyond any real
+#: winder, well inside the float range so that masses, inertias and forces cannot overflow
+#: (None: bounded otherwise, or not at all); keys without a lower bound are bounded in
+#: magnitude. The unit labels sweep axes and plots ("-": dimensionless, "": none in
+#: common). :data:`_MAX` and :data:`_UNITS` are read from it; a new numeric key needs an
+#: entry here (tests/test_sweep.py checks).
+_NUMBERS: dict[tuple[str, str], tuple[float | None, str]] = {
+    ("scene", "duration"): (1e6, "s"), ("scene", "output_step"): (None, "s"),
+    ("scene", "gravity"): (1e3, "m/s²"),
+    ("drum", "radius"): (10.0, "m"), ("drum", "inertia"): (1e7, "kg·m²"),
+    ("drum", "mass"): (1e6, "kg"),
+    ("drum.drive", "web_acceleration"): (1e3, "m/s²"),
+    ("drum.drive", "web_speed"): (1e3, "m/s"), ("drum.drive", "torque"): (1e8, "N·m"),
+    ("roll", "core_radius"): (10.0, "m"), ("roll", "core_mass"): (1e6, "kg"),
+    ("roll", "core_inertia"): (1e7, "kg·m²"), ("roll", "width"): (100.0, "m"),
+    ("roll", "initial_radius"): (10.0, "m"), ("roll", "initial_speed"): (1e5, "rad/s"),
+    ("roll", "com_offset"): (10.0, "m"), ("roll", "initial_height"): (1e3, "m"),
+    ("paper", "density"): (1e5, "kg/m³"), ("paper", "caliper"): (0.1, "m"),
+    ("contact", "stiffness"): (1e18, "N/m"), ("contact", "damping"): (1e12, "N·s/m"),
+    ("contact", "exponent"): (3.0, "-"), ("contact", "hc_damping"): (1e4, "s/m"),
+    ("friction", "mu"): (10.0, "-"), ("friction", "slip_velocity"): (1e3, "m/s"),
+    ("friction", "relaxation_length"): (1e3, "m"), ("friction", "min_speed"): (1e3, "m/s"),
+    ("solver", "rtol"): (RTOL_MAX, "-"),
+    ("solver", "atol"): (1.0, ""),  # in each state's own unit: none in common
+    ("solver", "max_rhs"): (1e12, "-"), ("solver", "max_wall"): (None, "s"),
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,
             ("solver", "method"): METHODS, ("solver", "backend"): BACKENDS}
@@ -469,19 +476,26 @@ _DRIVE_KEYS = {"speed_profile": ("kind", "web_acceleration", "web_speed", "ratio
 #: Keys of each drive kind of an unwinding roll.
 _UNWIND_DRIVE_KEYS = {"torque": ("kind", "torque"),
                       "tension_control": ("kind", "tension", "bandwidth")}
-_MAX.update({("drum[]", k): _MAX[("drum", k)] for k in _SPEC["drum"]})
-_MAX.update({("drum[].drive", k): _MAX[("drum.drive", k)]
-             for k in ("web_acceleration", "web_speed", "torque")})
-_MAX.update({("roll[]", k): v for (t, k), v in _MAX.items() if t in ("roll", "paper")})
-_MAX.update({("nip[]." + t, k): v for (t, k), v in _MAX.items()
-             if t in ("contact", "friction")})
-_MAX.update({("drum[].drive", "ratio"): 100.0, ("rider[]", "radius"): 10.0,
-             ("rider[]", "mass"): 1e6, ("rider[]", "inertia"): 1e7,
-             ("rider[]", "x"): MAX_COORD, ("web", "tension"): 1e7,
-             ("roll[].drive", "torque"): 1e8, ("roll[].drive", "tension"): 1e7,
-             ("roll[].drive", "bandwidth"): 1e4, ("web.span", "length"): 1e3,
-             ("web.span", "EA"): 1e12, ("web.span", "T_in"): 1e7,
-             ("web.span", "initial_tension"): 1e7})
+_NUMBERS.update({("drum[]", k): _NUMBERS[("drum", k)] for k in _SPEC["drum"]})
+_NUMBERS.update({("drum[].drive", k): v for (t, k), v in _NUMBERS.items()
+                 if t == "drum.drive"})
+_NUMBERS.update({("roll[]", k): v for (t, k), v in _NUMBERS.items()
+                 if t in ("roll", "paper")})
+_NUMBERS.update({("nip[]." + t, k): v for (t, k), v in _NUMBERS.items()
+                 if t in ("contact", "friction")})
+_NUMBERS.update({("drum[].drive", "ratio"): (100.0, "-"), ("rider[]", "radius"): (10.0, "m"),
+                 ("rider[]", "mass"): (1e6, "kg"), ("rider[]", "inertia"): (1e7, "kg·m²"),
+                 ("rider[]", "x"): (MAX_COORD, "m"), ("web", "tension"): (1e7, "N"),
+                 ("roll[].drive", "torque"): (1e8, "N·m"),
+                 ("roll[].drive", "tension"): (1e7, "N"),
+                 ("roll[].drive", "bandwidth"): (1e4, "rad/s"),
+                 ("web.span", "length"): (1e3, "m"), ("web.span", "EA"): (1e12, "N"),
+                 ("web.span", "T_in"): (1e7, "N"), ("web.span", "initial_tension"): (1e7, "N")})
+#: Upper bounds of the numeric keys that have one (:data:`_NUMBERS`).
+_MAX = {key: hi for key, (hi, _) in _NUMBERS.items() if hi is not None}
+#: Units of the numeric keys (:data:`_NUMBERS`); keys absent here (words, flags, pairs)
+#: have no unit.
+_UNITS = {key: unit for key, (_, unit) in _NUMBERS.items()}
 _CHOICES.update({("drum[].drive", "kind"): DRIVE_KINDS, ("roll[]", "kind"): ROLL_KINDS,
                  ("roll[].drive", "kind"): UNWIND_DRIVE_KINDS,
                  ("nip[].contact", "law"): CONTACT_LAWS})
@@ -494,38 +508,6 @@ _LEGACY_TABLES = tuple(t for t in _SPEC if t != "drum.drive")
 _PART_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_-]{0,39}")
 #: Bounds of a rider's load schedule: radius (0, 10] [m], line load [0, 1e7] [N/m].
 MAX_LOAD_RADIUS, MAX_LINE_LOAD = 10.0, 1e7
-
-#: Units of the numeric keys, by table as in :data:`_MAX` ("-": dimensionless, "": none in
-#: common); they label sweep axes and plots. Keys absent here (words, flags, pairs) have no
-#: unit. A new numeric key needs its unit here (tests/test_sweep.py checks).
-_UNITS: dict[tuple[str, str], str] = {
-    ("scene", "duration"): "s", ("scene", "output_step"): "s", ("scene", "gravity"): "m/s²",
-    ("drum", "radius"): "m", ("drum", "inertia"): "kg·m²", ("drum", "mass"): "kg",
-    ("drum.drive", "web_acceleration"): "m/s²", ("drum.drive", "web_speed"): "m/s",
-    ("drum.drive", "torque"): "N·m",
-    ("roll", "core_radius"): "m", ("roll", "core_mass"): "kg",
-    ("roll", "core_inertia"): "kg·m²", ("roll", "width"): "m", ("roll", "initial_radius"): "m",
-    ("roll", "initial_speed"): "rad/s", ("roll", "com_offset"): "m",
-    ("roll", "initial_height"): "m", ("paper", "density"): "kg/m³", ("paper", "caliper"): "m",
-    ("contact", "stiffness"): "N/m", ("contact", "damping"): "N·s/m",
-    ("contact", "exponent"): "-", ("contact", "hc_damping"): "s/m",
-    ("friction", "mu"): "-", ("friction", "slip_velocity"): "m/s",
-    ("friction", "relaxation_length"): "m", ("friction", "min_speed"): "m/s",
-    ("solver", "rtol"): "-", ("solver", "max_rhs"): "-", ("solver", "max_wall"): "s",
-    ("solver", "atol"): "",  # in each state's own unit: none in common
-}
-_UNITS.update({("drum[]", k): _UNITS[("drum", k)] for k in _SPEC["drum"]})
-_UNITS.update({("drum[].drive", k): u for (t, k), u in _UNITS.items() if t == "drum.drive"})
-_UNITS.update({("roll[]", k): u for (t, k), u in _UNITS.items() if t in ("roll", "paper")})
-_UNITS.update({("nip[]." + t, k): u for (t, k), u in _UNITS.items()
-               if t in ("contact", "friction")})
-_UNITS.update({("drum[].drive", "ratio"): "-", ("rider[]", "radius"): "m",
-               ("rider[]", "mass"): "kg", ("rider[]", "inertia"): "kg·m²",
-               ("rider[]", "x"): "m", ("web", "tension"): "N", ("roll[].drive", "torque"): "N·m",
-               ("roll[].drive", "tension"): "N", ("roll[].drive", "bandwidth"): "rad/s",
-               ("web.span", "length"): "m", ("web.span", "EA"): "N", ("web.span", "T_in"): "N",
-               ("web.span", "initial_tension"): "N"})
-
 
 def key_unit(path: str, data: Mapping[str, Any] | None = None) -> str:
     """The unit of the scene key at dotted ``path`` (``drum.drive.web_speed``: ``"m/s"``;

@@ -209,13 +209,10 @@ def sweep(scene: Scene | str | Path,
     base = scene if isinstance(scene, Scene) else load_scene(scene)
     if not isinstance(vary, Mapping) or not vary:
         raise ArgumentError(f"vary: give at least one {{key: values}}, got {vary!r}")
-    values = {}
-    for k, v in vary.items():
-        name = ",".join(split_keys(k))
-        if name in values:
-            raise ArgumentError(f"vary: the key {name} is given twice")
-        values[name] = parse_spec(name, v) if isinstance(v, str) \
-            else [x.item() if isinstance(x, np.generic) else x for x in v]
+    # keyed as given: build_grid refuses a key on two axes ("a,b" and ("a", "b") too)
+    values = {k: parse_spec(",".join(split_keys(k)), v) if isinstance(v, str)
+              else [x.item() if isinstance(x, np.generic) else x for x in v]
+              for k, v in vary.items()}
     grid = build_grid(base, values)
     settings = run_settings(t_end=t_end, rtol=rtol, output_step=output_step,
                             max_wall=max_wall, window=window, threshold=threshold)

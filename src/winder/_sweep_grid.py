@@ -28,7 +28,7 @@ import hashlib
 import itertools
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -37,8 +37,8 @@ import numpy as np
 from ._errors import ArgumentError, SceneError
 from ._scene import Scene, scene_from_dict
 
-__all__ = ["Axis", "Grid", "parse_spec", "parse_vary", "split_keys", "resolve", "get_path",
-           "set_path", "scene_hash", "build_grid"]
+__all__ = ["Axis", "Grid", "parse_spec", "parse_vary", "split_keys", "axis_keys", "resolve",
+           "get_path", "set_path", "scene_hash", "build_grid"]
 
 Value = float | int | bool | str
 
@@ -182,28 +182,37 @@ def split_keys(name: str | Sequence[str]) -> tuple[str, ...]:
     return keys
 
 
+def axis_keys(names: Iterable[str | Sequence[str]]) -> list[tuple[str, ...]]:
+    """The keys of each axis named in ``names`` (:func:`split_keys`); raises
+    :class:`ArgumentError` for a key on two axes."""
+    out: list[tuple[str, ...]] = []
+    seen: set[str] = set()
+    for name in names:
+        keys = split_keys(name)
+        for k in keys:
+            if k in seen:
+                raise ArgumentError(f"--vary {k}: the key is given twice")
+            seen.add(k)
+        out.append(keys)
+    return out
+
+
 def parse_vary(items: Sequence[str]) -> dict[str, list[Value]]:
     """``["KEY=SPEC", ...]`` (the ``--vary`` options) → ``{key: values}`` in order. KEY may
     be tied keys ``KEY1,KEY2`` sharing the values (the result's key is then
     ``"KEY1,KEY2"``)."""
-    out: dict[str, list[Value]] = {}
-    seen: set[str] = set()
+    pairs = []
     for item in items:
         key, sep, spec = item.partition("=")
         key = key.strip()
         if not sep or not key:
             raise ArgumentError(f"--vary {item!r}: expected KEY=SPEC or KEY1,KEY2=SPEC, e.g. "
                                 "drum.drive.web_speed=15:45:16")
-        keys = split_keys(key)
-        for k in keys:
-            if k in seen:
-                raise ArgumentError(f"--vary {k}: the key is given twice")
-            seen.add(k)
-        name = ",".join(keys)
-        out[name] = parse_spec(name, spec)
-    if not out:
+        pairs.append((key, spec))
+    if not pairs:
         raise ArgumentError("--vary: give at least one KEY=SPEC")
-    return out
+    names = [",".join(keys) for keys in axis_keys(key for key, _ in pairs)]
+    return {name: parse_spec(name, spec) for name, (_, spec) in zip(names, pairs, strict=True)}
 
 
 # ---- the grid --------------------------------------------------------------------------
@@ -273,17 +282,12 @@ def build_grid(base: Scene, vary: Mapping[str | tuple[str, ...], Sequence[Value]
     of key paths."""
     data = base.to_dict()
     axes: list[Axis] = []
-    seen: set[str] = set()
-    for name, values in vary.items():
-        keys = split_keys(name)
+    for keys, values in zip(axis_keys(vary), vary.values(), strict=True):
         key = ",".join(keys)
         values = tuple(values)
         if not values:
             raise ArgumentError(f"--vary {key}: no values")
         for k in keys:
-            if k in seen:
-                raise ArgumentError(f"--vary {k}: the key is given twice")
-            seen.add(k)
             container, slot = resolve(data, k)
             if slot not in container:  # a key the scene leaves at its default, or a typo
                 try:

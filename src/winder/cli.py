@@ -295,9 +295,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     plot = check_output_file(args.plot, "--plot", suffixes=(".png",)) \
         if args.plot is not None else None
 
-    import numpy as np
-
-    from ._files import atomic_write
+    from ._files import atomic_write, csv_writer
     from ._modes import mode_map
     from ._scene import load_scene
 
@@ -316,11 +314,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
             print(f"  {h} rotation meets the bounce mode{'' if one else ' ' + c} at r = "
                   + (", ".join(f"{x:.4f} m" for x in crit) if crit else "(no crossing)"))
     if csv is not None:
-        cols = mm.as_columns()
-        header = ",".join(cols)
-        table = np.column_stack(list(cols.values())) + 0.0  # -0.0 printed as 0, not -0
-        atomic_write(csv, lambda p: np.savetxt(p, table, delimiter=",", header=header,
-                                               comments="", fmt="%.10g"))
+        atomic_write(csv, csv_writer(mm.as_columns(), fmt="%.10g"))
         print(f"  table written to {csv}")
     if plot is not None:
         from ._plots import campbell_figure
