@@ -9,6 +9,9 @@ static balance of the initial state (that radius as ``initial_radius``):
 - ``ok``: solved;
 - ``refused``: refused because the nip is too soft to carry its load (the closed-form static
   penetration exceeds a radius: no valid scene in fact), naming the stiffness key;
+- ``saturated``: no operating point because a nip's friction saturates (``|v_s| > 2 v_ref``
+  at the last iterate: the nip cannot carry the roll's torque, e.g. web momentum without
+  the variable-mass term near the core);
 - ``failed``: any other refusal or error (a valid scene the solver could not handle).
 
 Run: ``python benchmarks/balance_robustness.py [--samples N] [--seed S]``.
@@ -69,7 +72,9 @@ def _with_radius(scene: winder.Scene, r: float) -> winder.Scene:
 
 def _classify(exc: BaseException) -> str:
     text = str(exc)
-    return "refused" if "too soft" in text and "stiffness" in text else "failed"
+    if "too soft" in text and "stiffness" in text:
+        return "refused"
+    return "saturated" if "friction saturated" in text else "failed"
 
 
 def main() -> None:
@@ -104,17 +109,19 @@ def main() -> None:
                 except Exception as exc:  # noqa: BLE001 - every way of failing is counted
                     c[_classify(exc)] += 1
                     if args.verbose:
-                        print(f"{kind} #{i} {what} r={r:.3f}: {type(exc).__name__}: "
-                              f"{str(exc)[:300]}")
+                        nips = {n.name: n.contact for n in scene.nips}
+                        print(f"{kind} #{i} {what} r={r!r}: {type(exc).__name__}: "
+                              f"{str(exc)[:300]}\n    {scene.effects}\n    {nips}")
     for (kind, what), c in sorted(counts.items()):
         n = sum(c.values())
         if what == "invalid":
             print(f"{kind:9s} invalid scenes skipped: {n}")
             continue
-        valid = c["ok"] + c["failed"]
+        valid = c["ok"] + c["failed"] + c["saturated"]
         rate = c["ok"] / valid if valid else math.nan
-        print(f"{kind:9s} {what:16s} ok {c['ok']:3d}  refused (too soft) {c['refused']:3d}  "
-              f"failed {c['failed']:3d}  success {100 * rate:5.1f} % of {valid}")
+        print(f"{kind:9s} {what:16s} ok {c['ok']:3d}  too soft {c['refused']:3d}  "
+              f"saturated {c['saturated']:3d}  failed {c['failed']:3d}  "
+              f"success {100 * rate:5.1f} % of {valid}")
     print(f"({time.perf_counter() - t0:.0f} s)")
 
 

@@ -57,6 +57,10 @@ WEB_SPEED_MAX = _MAX[("drum.drive", "web_speed")]  # [m/s], as in a scene
 _NEWTON_STEPS = 200
 #: Largest relative change of a mode's frequency between neighbouring radii at a crossing.
 _JUMP = 0.25
+#: A scaled residual (each equation over its largest Jacobian entry: a step in the unknowns'
+#: units) at which the operating point is solved where stiff nips leave no descent (the
+#: Jacobian's condition number reaches 1e15).
+_ROUND_OFF = 1e-12
 #: Units of the equations' residuals, by the ending of the state's name.
 _RATE_UNIT = {"x_dot": " m/s²", "z_dot": " m/s²", "theta_dot": " rad/s²", "friction": " N/s"}
 #: Harmonics of the roll's rotation drawn and searched for crossings.
@@ -267,7 +271,9 @@ class _Linearisation:
         """Globalised Newton from ``y`` (changed in place): the exact Jacobian, rows scaled
         by their largest entry at the start, each step limited so that no surface speed
         moves by more than half the slip velocity (the slip law saturates beyond a few
-        ``v_ref``), then halved until the scaled residual decreases (Armijo). Returns
+        ``v_ref``), then halved until the scaled residual decreases (Armijo); converged at a
+        step below 1e-10 of the unknowns' scale, or where no step descends any more with the
+        scaled residual at round-off (:data:`_ROUND_OFF`). Returns
         ``(converged, scaled residual, raw residual)``."""
         u = self.unknowns
         floor = np.ones(len(u))  # [m], [rad/s], [N]
@@ -295,9 +301,9 @@ class _Linearisation:
                 if np.isfinite(m_n) and m_n <= (1 - 1e-4 * lam) * merit or m_n == 0:
                     break
                 lam /= 2
-            else:
+            else:  # no descent left: solved if the residual is at round-off
                 y[u] = x0
-                return False, D * res, res
+                return bool(np.max(np.abs(D * res)) <= _ROUND_OFF), D * res, res
             res, J, merit = res_n, J_n, m_n
         return False, D * res, res
 
@@ -369,8 +375,8 @@ class _Linearisation:
             raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s "
                                 f"{nips} carry the roll's torque and weight: no operating "
                                 f"point (the equation of d({name})/dt did not converge: "
-                                f"residual {value:.3g}{unit}); valid: a lower web speed or a "
-                                "smaller radius")
+                                f"residual {value:.3g}{unit}{self._saturated(y)}); valid: a "
+                                "lower web speed or a smaller radius")
         sw = sys_.switches(self.t, y)
         for n in self.machine.nips:
             g = sw[self.machine.switch_names.index(f"{n.name}.contact")]
@@ -386,6 +392,23 @@ class _Linearisation:
                                     "axis would lie inside the other body); valid: a smaller "
                                     f"radius or a stiffer nip ({nip_key(self.machine, n)})")
         return y
+
+    def _saturated(self, y: np.ndarray) -> str:
+        """``; nip 'N' slips at v_s …`` for each nip whose friction is saturated at the
+        last iterate ``y`` (``|v_s| > 2 v_ref``: ``tanh > 0.96``), else ``""``."""
+        try:
+            with np.errstate(all="ignore"):
+                ev = self.system.evaluate_numeric(self.t, y, outputs=False)
+        except Exception:  # noqa: BLE001 - only a diagnosis: the error is raised anyway
+            return ""
+        out = []
+        for n in self.machine.nips:
+            ns = ev.nips[n.name]
+            vs, fn = float(ns.v_s), float(ns.normal_force)
+            if np.isfinite(vs) and abs(vs) > 2 * n.part.friction.slip_velocity and fn > 0:
+                out.append(f"; nip {n.name!r} slips at v_s = {vs:.3g} m/s, its friction "
+                           f"saturated at mu F_n = {n.part.friction.mu * fn:.4g} N")
+        return "".join(out)
 
     def _distance(self, y: np.ndarray, n) -> float:  # noqa: ANN001
         def c(b):  # noqa: ANN001, ANN202
