@@ -79,7 +79,7 @@ def _classify(exc: BaseException) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--samples", type=int, default=60, help="scenes per machine (default 60)")
+    ap.add_argument("--samples", type=int, default=100, help="scenes per machine (default 100)")
     ap.add_argument("--seed", type=int, default=21)
     ap.add_argument("-v", "--verbose", action="store_true", help="print every failure")
     args = ap.parse_args()

@@ -365,8 +365,14 @@ class _Linearisation:
         finally:
             sys_.modes[self.contact] = AUTO
         v = self.v
+        nips = "the nip cannot" if len(self.machine.nips) == 1 else "the nips cannot"
+        saturated = self._saturated(y)
+        if converged and saturated:  # gross slip: the friction cannot hold the speeds
+            raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s "
+                                f"{nips} carry the roll's torque and weight: no operating "
+                                f"point without gross slip ({saturated[2:]}); valid: a lower "
+                                "web speed or a smaller radius")
         if not converged:
-            nips = "the nip cannot" if len(self.machine.nips) == 1 else "the nips cannot"
             bad = np.where(np.isfinite(scaled), np.abs(scaled), np.inf)
             k = int(np.argmax(bad)) if len(bad) == len(self.equations) else 0
             name = self.machine.state_names[self.equations[k]]
@@ -375,7 +381,7 @@ class _Linearisation:
             raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s "
                                 f"{nips} carry the roll's torque and weight: no operating "
                                 f"point (the equation of d({name})/dt did not converge: "
-                                f"residual {value:.3g}{unit}{self._saturated(y)}); valid: a "
+                                f"residual {value:.3g}{unit}{saturated}); valid: a "
                                 "lower web speed or a smaller radius")
         sw = sys_.switches(self.t, y)
         for n in self.machine.nips:
@@ -398,7 +404,9 @@ class _Linearisation:
         last iterate ``y`` (``|v_s| > 2 v_ref``: ``tanh > 0.96``), else ``""``."""
         try:
             with np.errstate(all="ignore"):
-                ev = self.system.evaluate_numeric(self.t, y, outputs=False)
+                modes = self.system.modes.copy()
+                modes[self.contact] = IN_CONTACT  # as solved
+                ev = self.system.evaluate_numeric(self.t, y, modes, outputs=False)
         except Exception:  # noqa: BLE001 - only a diagnosis: the error is raised anyway
             return ""
         out = []
