@@ -233,3 +233,52 @@ def test_failed_operating_point_names_the_equation(paper_scene) -> None:
                              r"mu F_n = .* N"):
         lin.solve(0.0825, "operating_point")
     lin.solve(0.1, "operating_point")  # further out the nip carries it
+
+
+def test_two_drum_modes_break_off_where_overdamped(tmp_path) -> None:
+    """Issue #21 item 5: in ``two_drum_modes.png`` the set's modes break off near r = 0.17
+    and 0.32 m. Every operating point of the map solves; the breaks are the stretches where
+    the mode is overdamped (real eigenvalue): at 41.7 m/s the relaxed friction acts on the
+    set's tangential motion as a damper of slope ``μ F_n/v_ref`` beyond critical for the
+    light set. Checked independently at r = 0.2 m on the exact Jacobian: no oscillating
+    eigenpair carries a quarter of its kinetic energy in ``set.x``, while at web speed 0
+    (the friction state relaxes at ``v_min/σ``, too slowly to damp) ``set.x`` oscillates.
+    ``winder modes`` prints the ranges and the chart marks them."""
+    from winder._linearise import jacobian
+    from winder._modes import modes_at
+
+    path = MODELS / "two_drum_winder.toml"
+    scene = winder.load_scene(path)
+    mm = mode_map(scene, n=150)
+    for c in mm.coordinates:
+        assert np.all(np.isfinite(mm.frequencies[c])), c
+    (lo_z, hi_z), = mm.overdamped("set.z")
+    (lo_x, hi_x), = mm.overdamped("set.x")
+    assert 0.13 < lo_z < hi_z < 0.18 and 0.16 < lo_x < 0.2 and 0.3 < hi_x < 0.33
+    assert mm.overdamped("rider.z") == []
+    inside = (mm.radius >= lo_x) & (mm.radius <= hi_x)
+    np.testing.assert_array_equal(mm.dampings["set.x"][inside], 1.0)
+    # independently: eigenpairs and kinetic-energy shares at r = 0.2 m
+    lin = _Linearisation(scene, 41.7)
+    y = lin.solve(0.2, "test")
+    A = jacobian(lin.system, lin.t, y)[np.ix_(lin.fast, lin.fast)]
+    lam, vec = np.linalg.eig(A)
+    nt = len(lin.positions)
+    ev = lin.system.evaluate_numeric(lin.t, y, outputs=False)
+    masses = np.array([float(ev.bodies[c.split(".")[0]].mass) for c in lin.coords])
+    inertias = np.array([float(ev.bodies[b].inertia) for b in ("set", "rider")])
+    for i in np.nonzero(lam.imag > 0)[0]:
+        kin = np.concatenate([masses * np.abs(vec[nt:2 * nt, i]) ** 2,
+                              inertias * np.abs(vec[2 * nt:2 * nt + 2, i]) ** 2])
+        assert kin[lin.coords.index("set.x")] / kin.sum() < 0.25, lam[i]
+    still = {m.coordinate: m for m in modes_at(scene, 0.2, web_speed=0.0)[:3]}
+    assert still["set.x"].frequency > 10.0 and still["set.x"].damping_ratio < 0.5
+    csv = tmp_path / "m.csv"
+    png = tmp_path / "m.png"
+    proc = subprocess.run([sys.executable, "-m", "winder", "modes", str(path), "--points",
+                           "150", "--no-simulate", "--csv", str(csv), "--plot", str(png)],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert (f"bounce mode set.x is overdamped (real eigenvalue, no oscillation, no crossing) "
+            f"at r = {lo_x:.4f}-{hi_x:.4f} m") in proc.stdout
+    assert "bounce mode set.z is overdamped" in proc.stdout and png.exists()

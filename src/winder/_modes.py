@@ -525,6 +525,8 @@ class ModeMap:
     roll: str
     drum_rotation: dict[str, float] = field(default_factory=dict)
     legacy: bool = False
+    #: per bounce mode its natural frequency ``|λ|/2π`` [Hz] (also where it is overdamped)
+    natural: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def coordinates(self) -> list[str]:
@@ -543,6 +545,23 @@ class ModeMap:
     @property
     def bounce_damping(self) -> np.ndarray:
         return self.dampings[self.main]
+
+    def overdamped(self, mode: str | None = None) -> list[tuple[float, float]]:
+        """The radius ranges ``(first, last)`` [m] over which a bounce mode (default
+        :attr:`main`) is overdamped: its eigenvalue is real (damping ratio 1, damped
+        frequency 0), so it has no oscillation and no crossing there (the nips' damping and
+        the friction relaxation couple into it)."""
+        over = self.frequencies[mode or self.main] == 0.0
+        out, i = [], 0
+        while i < len(over):
+            if over[i]:
+                j = i
+                while j + 1 < len(over) and over[j + 1]:
+                    j += 1
+                out.append((float(self.radius[i]), float(self.radius[j])))
+                i = j
+            i += 1
+        return out
 
     @property
     def rotation_2x(self) -> np.ndarray:
@@ -694,6 +713,7 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     nt = len(lin.coords)
     freq = np.full((nt, len(radii)), np.nan)
     damp = np.full((nt, len(radii)), np.nan)
+    natural = np.full((nt, len(radii)), np.nan)
     slip = np.full((2, len(radii)), np.nan)
     prev = None
     for i, r in enumerate(radii):  # continued in radius from the previous point
@@ -707,6 +727,7 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
         for m in ms[:nt]:
             j = lin.coords.index(m.coordinate)
             freq[j, i], damp[j, i] = m.frequency, m.damping_ratio
+            natural[j, i] = m.natural_frequency
         if len(ms) > nt:
             slip[:, i] = ms[nt].natural_frequency, ms[nt].damping_ratio
     drums = {b.name: b.part.drive.ratio * v / (2 * math.pi * b.part.radius)
@@ -715,4 +736,4 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),
                    dict(zip(lin.coords, damp, strict=True)), slip[0], slip[1],
                    ratio * v / (2 * math.pi * radii), v, lin.roll.name, drums,
-                   bool(scene.legacy))
+                   bool(scene.legacy), dict(zip(lin.coords, natural, strict=True)))

@@ -302,6 +302,9 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         f, z = mm.frequencies[c], mm.dampings[c]
         print(f"  bounce mode{'' if one else ' ' + c} {f[0]:.1f} -> {f[-1]:.1f} Hz, "
               f"damping ratio {z[0]:.3f} -> {z[-1]:.3f}")
+        for lo, hi in mm.overdamped(c):
+            print(f"  bounce mode{'' if one else ' ' + c} is overdamped (real eigenvalue, no "
+                  f"oscillation, no crossing) at r = {lo:.4f}-{hi:.4f} m")
     for c in mm.coordinates:
         for h in mm.harmonics():
             crit = mm.critical_radii(h, c)
