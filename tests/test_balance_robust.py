@@ -282,3 +282,41 @@ def test_two_drum_modes_break_off_where_overdamped(tmp_path) -> None:
     assert (f"bounce mode set.x is overdamped (real eigenvalue, no oscillation, no crossing) "
             f"at r = {lo_x:.4f}-{hi_x:.4f} m") in proc.stdout
     assert "bounce mode set.z is overdamped" in proc.stdout and png.exists()
+
+
+def test_states_without_dynamics_drop_out(paper_scene) -> None:
+    """A state whose rate is identically zero (here the friction state of the paper
+    scene, frozen by wrapping the system, as an effect that is off would leave it) drops
+    out of the operating point's unknowns and of the modes. Drum at rest: the operating
+    point keeps the friction at its initial value 0 and the roll at rest on the nip, and
+    the bounce mode is the damped closed form ``−c/2m ± i√(k/m − (c/2m)²)`` (1e-9,
+    measured 4e-16), with no zero eigenvalue of the frozen state among the modes."""
+    lin = _Linearisation(paper_scene, 0.0)
+    sys_ = lin.system
+    i = sys_.index("nip.friction")
+    rhs, jac = sys_.rhs, sys_.jac
+
+    def frozen_rhs(t: float, y: np.ndarray) -> np.ndarray:
+        f = rhs(t, y)
+        f[i] = 0.0
+        return f
+
+    def frozen_jac(t: float, y: np.ndarray) -> np.ndarray:
+        J = jac(t, y)
+        J[i] = 0.0
+        return J
+
+    sys_.rhs, sys_.jac = frozen_rhs, frozen_jac
+    r = 0.3
+    y = lin.solve(r, "test")
+    assert lin.idle == ["nip.friction"] and i not in lin.unknowns and i not in lin.fast
+    assert y[i] == 0.0
+    res, _ = lin._residual(y)
+    assert np.max(np.abs(res)) < 1e-9
+    modes = lin.modes(y)
+    assert len(modes) == 2 and min(abs(m.eigenvalue) for m in modes) > 0
+    m = _roll_mass(paper_scene, np.array(r))
+    k, c = paper_scene.contact.stiffness, paper_scene.contact.damping
+    lam = modes[0].eigenvalue
+    assert lam.real == pytest.approx(-c / (2 * m), rel=1e-9)
+    assert abs(lam.imag) == pytest.approx(math.sqrt(k / m - (c / (2 * m)) ** 2), rel=1e-9)

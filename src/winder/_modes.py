@@ -186,6 +186,32 @@ class _Linearisation:
                                       len(self.positions) + len(self.speeds))
         self.v_ref = min(n.part.friction.slip_velocity for n in m.nips)
         self.contact = np.array([n.endswith(".contact") for n in m.mode_names])
+        self.idle: list[str] = []  # states without dynamics, found at the first solve
+        self._idle_checked = False
+
+    def _drop_idle(self, y: np.ndarray) -> None:
+        """Drop from the unknowns, the equations and the modes every state besides the
+        positions and speeds whose rate is identically zero (its row of the exact Jacobian
+        vanishes at ``y`` and at a perturbed state, and its rate is 0): with an effect off
+        such a state (a friction state without relaxation, say) has no dynamics, stays at
+        its initial value and would only make the Newton matrix singular."""
+        self._idle_checked = True
+        rng = np.random.default_rng(0)
+        y2 = y.copy()
+        y2[self.unknowns] *= 1.0 + 1e-3 * rng.standard_normal(len(self.unknowns))
+        idle = []
+        sys_ = self.system
+        for yy in (y, y2):
+            f, J = sys_.rhs(self.t, yy), sys_.jac(self.t, yy)
+            idle.append({i for i in self.others if f[i] == 0.0 and not np.any(J[i])})
+        drop = idle[0] & idle[1]
+        if not drop:
+            return
+        self.idle = [self.machine.state_names[i] for i in sorted(drop)]
+        self.others = [i for i in self.others if i not in drop]
+        self.unknowns = self.positions + self.speeds + self.others
+        self.equations = self.velocities + self.speeds + self.others
+        self.fast = self.positions + self.velocities + self.speeds + self.others
 
     # ---- the operating point ------------------------------------------------------------
     def _radius_of(self, y: np.ndarray, name: str) -> float:
@@ -345,6 +371,8 @@ class _Linearisation:
         sys_.modes[self.contact] = IN_CONTACT  # smooth while solving
         try:
             with np.errstate(all="ignore"):
+                if not self._idle_checked:
+                    self._drop_idle(y)
                 for attempt in ("newton", "trust_region", "guess"):
                     if attempt == "guess":
                         if start is None:
