@@ -312,6 +312,20 @@ def new_option_cases() -> list[Case]:
             def build(d: Path, opt: str = opt, v: str = v) -> list[str]:
                 return ["run", str(quick_scene(d)), "--out", str(d / "out" / "r.npz"), opt, v]
             cases.append(Case("new option", f"run {opt} {v!r}", build, names=(opt,)))
+    # the map's radius range (issue #21): below the core, beyond 10 m, an empty range
+    for opt in ("--radius-min", "--radius-max"):
+        for v in (*JUNK_NUMBERS, "-5", "0.05", "1e12", "0.3"):
+            def modes(d: Path, opt: str = opt, v: str = v) -> list[str]:
+                return ["modes", str(PAPER), "--points", "3", "--csv", str(d / "m.csv"), opt, v]
+            sane = v == "0.3"
+            cases.append(Case("new option", f"modes {opt} {v!r}", modes, ok=(0,) if sane else (2,),
+                              names=() if sane else (opt,), keep=("m.csv",) if sane else ()))
+    for lo, hi in (("0.4", "0.3"), ("0.3", "0.3"), ("0.9", None)):
+        def empty(d: Path, lo: str = lo, hi: str | None = hi) -> list[str]:
+            return ["modes", str(PAPER), "--points", "3", "--csv", str(d / "m.csv"),
+                    "--radius-min", lo, *(("--radius-max", hi) if hi else ())]
+        cases.append(Case("new option", f"modes --radius-min {lo} --radius-max {hi}", empty,
+                          names=("--radius-max",) if hi else ("--radius-min", "--radius-max")))
     return cases
 
 

@@ -500,8 +500,10 @@ def test_energy_conserved_by_the_conservative_subset() -> None:
     s = MachineSystem(sc)
     m = s.machine
     y0 = s.initial_state()
-    for name, v in (("set.x_dot", 0.03), ("set.z_dot", 0.05), ("set.theta_dot", -20.0),
-                    ("rider.z_dot", -0.04), ("rider.theta_dot", 30.0)):
+    # from the balance with the set resting on the drums (δ ≈ 1 mm), fast enough that
+    # every nip opens and closes
+    for name, v in (("set.x_dot", 0.09), ("set.z_dot", 0.15), ("set.theta_dot", -20.0),
+                    ("rider.z_dot", -0.12), ("rider.theta_dot", 30.0)):
         y0[m.index(name)] = v
     ev = m.evaluate(NumericBackend(m.model), 0.0, y0, s.params,
                     np.full(len(m.mode_names), float(AUTO)))
@@ -512,11 +514,11 @@ def test_energy_conserved_by_the_conservative_subset() -> None:
     kin0 = E[0] - _energy(m, 0.0, s.initial_state(), s.params, loads)
     drift = np.max(np.abs(E - E[0])) / kin0
     ch = s.channels(t_out, Y)
-    for n in ("front_nip", "rider_nip"):  # the nips bounce: open and closed
+    for n in ("front_nip", "rear_nip", "rider_nip"):  # the nips bounce: open and closed
         fn = ch[f"{n}_normal_force"]
         assert np.any(fn == 0.0) and np.any(fn > 0.0), n
-    # measured: 2.5e-9 of the 15 kJ put in
-    assert drift < 2.5e-8
+    # measured: 2.6e-11 of the 15 kJ put in
+    assert drift < 3e-10
 
 
 # ---- 6. drive torques ---------------------------------------------------------------------------

@@ -44,6 +44,7 @@ from ._args import integer, number, show
 from ._errors import ArgumentError, ArgumentTypeError
 from ._linearise import jacobian
 from ._scene import _MAX, Scene
+from .core.equilibrium import EquilibriumError, nip_key, resting_state
 from .core.machine import AUTO, IN_CONTACT
 from .solve.system import MachineSystem
 
@@ -56,6 +57,12 @@ WEB_SPEED_MAX = _MAX[("drum.drive", "web_speed")]  # [m/s], as in a scene
 _NEWTON_STEPS = 200
 #: Largest relative change of a mode's frequency between neighbouring radii at a crossing.
 _JUMP = 0.25
+#: A scaled residual (each equation over its largest Jacobian entry: a step in the unknowns'
+#: units) at which the operating point is solved where stiff nips leave no descent (the
+#: Jacobian's condition number reaches 1e15).
+_ROUND_OFF = 1e-12
+#: Units of the equations' residuals, by the ending of the state's name.
+_RATE_UNIT = {"x_dot": " m/s²", "z_dot": " m/s²", "theta_dot": " rad/s²", "friction": " N/s"}
 #: Harmonics of the roll's rotation drawn and searched for crossings.
 ORDERS = (1, 2, 3)
 
@@ -179,6 +186,32 @@ class _Linearisation:
                                       len(self.positions) + len(self.speeds))
         self.v_ref = min(n.part.friction.slip_velocity for n in m.nips)
         self.contact = np.array([n.endswith(".contact") for n in m.mode_names])
+        self.idle: list[str] = []  # states without dynamics, found at the first solve
+        self._idle_checked = False
+
+    def _drop_idle(self, y: np.ndarray) -> None:
+        """Drop from the unknowns, the equations and the modes every state besides the
+        positions and speeds whose rate is identically zero (its row of the exact Jacobian
+        vanishes at ``y`` and at a perturbed state, and its rate is 0): with an effect off
+        such a state (a friction state without relaxation, say) has no dynamics, stays at
+        its initial value and would only make the Newton matrix singular."""
+        self._idle_checked = True
+        rng = np.random.default_rng(0)
+        y2 = y.copy()
+        y2[self.unknowns] *= 1.0 + 1e-3 * rng.standard_normal(len(self.unknowns))
+        idle = []
+        sys_ = self.system
+        for yy in (y, y2):
+            f, J = sys_.rhs(self.t, yy), sys_.jac(self.t, yy)
+            idle.append({i for i in self.others if f[i] == 0.0 and not np.any(J[i])})
+        drop = idle[0] & idle[1]
+        if not drop:
+            return
+        self.idle = [self.machine.state_names[i] for i in sorted(drop)]
+        self.others = [i for i in self.others if i not in drop]
+        self.unknowns = self.positions + self.speeds + self.others
+        self.equations = self.velocities + self.speeds + self.others
+        self.fast = self.positions + self.velocities + self.speeds + self.others
 
     # ---- the operating point ------------------------------------------------------------
     def _radius_of(self, y: np.ndarray, name: str) -> float:
@@ -192,34 +225,14 @@ class _Linearisation:
                          if not b.prescribed])
 
     def guess(self, r: float) -> np.ndarray:
-        """The initial guess at radius ``r`` [m]: every free body touching the bodies it
-        rests on (placed in the machine's order), no-slip speeds, friction 0."""
+        """The initial guess at radius ``r`` [m], already near the solution: no-slip speeds
+        from the drums, then every free body resting on the bodies below it with each nip
+        at the static penetration of its law under the load it carries (closed form,
+        :func:`~winder.core.equilibrium.resting_state`; the nips' damping sees the radius
+        growth), friction states 0."""
         m = self.machine
         y = np.array(m.state_initial, dtype=float)
         y[self.i_r] = r
-        centre = {b.name: list(b.centre) for b in m.bodies}
-        placed = {b.name for b in m.bodies if not b.free}
-        for b in m.bodies:
-            if not b.free:
-                continue
-            sup = [(n.a.name, self._radius_of(y, n.a.name) + self._radius_of(y, b.name))
-                   for n in m.nips if n.b is b and n.a.name in placed]
-            cx, cz = centre[b.name]
-            if "x" in b.free and len(sup) >= 2:  # upper intersection of two circles
-                (a1, d1), (a2, d2) = sup[:2]
-                p1, p2 = np.array(centre[a1]), np.array(centre[a2])
-                base = np.linalg.norm(p2 - p1)
-                s = (d1 * d1 - d2 * d2 + base * base) / (2 * base)
-                h = math.sqrt(max(d1 * d1 - s * s, 0.0))
-                e = (p2 - p1) / base
-                cx, cz = p1 + s * e + h * np.array([-e[1], e[0]]) * (1 if e[0] >= 0 else -1)
-            elif sup:
-                cz = max(centre[a][1] + math.sqrt(max(d * d - (cx - centre[a][0]) ** 2, 0.0))
-                         for a, d in sup)
-            centre[b.name] = [float(cx), float(cz)]
-            placed.add(b.name)
-            for c in b.free:
-                y[m.index(f"{b.name}.{c}")] = centre[b.name][0 if c == "x" else 1]
         # no slip, θ̇_b = −θ̇_a r_a / r_b across each nip, from the drums
         omega = {b.name: b.sense * b.part.drive.ratio * self.v / b.part.radius
                  for b in m.bodies if b.prescribed}
@@ -234,7 +247,28 @@ class _Linearisation:
         for b in m.bodies:
             if not b.prescribed and b.name in omega:
                 y[m.index(f"{b.name}.theta_dot")] = omega[b.name]
-        return y
+        movable = {b.name for b in m.bodies if b.free}
+        return resting_state(m, y, self.system.params, movable, t=self.t, rates=True).state
+
+    def _guess(self, r: float, where: str) -> np.ndarray:
+        """:meth:`guess`; a nip too soft for its load or a body that cannot reach its
+        supports there is an :class:`ArgumentError` naming the key."""
+        try:
+            return self.guess(r)
+        except EquilibriumError as exc:
+            raise ArgumentError(f"{where}: at radius = {r:g} m: {exc}") from None
+
+    def continued(self, r: float, where: str, prev: tuple[np.ndarray, np.ndarray]
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """``(start, guess)`` at radius ``r`` [m] continuing ``prev`` = ``(solution,
+        guess)`` of the previous radius: the guess at ``r`` plus the previous solution's
+        departure from its own guess (the slip, the friction, the positions' correction)."""
+        g = self._guess(r, where)
+        y_prev, g_prev = prev
+        y = g.copy()
+        u = self.unknowns
+        y[u] = g[u] + (y_prev[u] - g_prev[u])
+        return y, g
 
     def _residual(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``rhs − target`` on the equations and its exact Jacobian in the unknowns."""
@@ -245,46 +279,111 @@ class _Linearisation:
             J[i_w, i_w] += (f[i_r] + y[i_w] * J[i_r, i_w]) / y[i_r]
         return f[self.equations], J[np.ix_(self.equations, self.unknowns)]
 
-    def solve(self, r: float, where: str) -> np.ndarray:
-        """The operating point at radius ``r`` [m] (an :class:`ArgumentError` if none):
-        damped Newton steps on the exact Jacobian (rows scaled by their largest entry),
-        from :meth:`guess`, to a step below 1e-10 of the unknowns' scale (1 m, 1 rad/s,
-        1 N or their value)."""
-        sys_ = self.system
-        y = self.guess(r)
+    def _scales(self, y: np.ndarray) -> np.ndarray:
+        """The natural scale of each unknown: 1 m for a position (its steps are judged
+        relative to 1 m), the slip speed ``v_ref/r`` [rad/s] for a rotation speed, 1 N for
+        a friction state (or the value, where larger)."""
+        m = self.machine
+        s = []
+        for i in self.unknowns:
+            name = m.state_names[i]
+            if name.endswith("theta_dot"):
+                s.append(self.v_ref / self._radius_of(y, name[:-len(".theta_dot")]))
+            else:
+                s.append(1.0)
+        return np.array(s)
+
+    def _newton(self, y: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
+        """Globalised Newton from ``y`` (changed in place): the exact Jacobian, rows scaled
+        by their largest entry at the start, each step limited so that no surface speed
+        moves by more than half the slip velocity (the slip law saturates beyond a few
+        ``v_ref``), then halved until the scaled residual decreases (Armijo); converged at a
+        step below 1e-10 of the unknowns' scale, or where no step descends any more with the
+        scaled residual at round-off (:data:`_ROUND_OFF`). Returns
+        ``(converged, scaled residual, raw residual)``."""
         u = self.unknowns
         floor = np.ones(len(u))  # [m], [rad/s], [N]
-        converged, res = False, np.array([np.inf])
+        res, J = self._residual(y)
+        D = 1.0 / np.maximum(np.max(np.abs(J), axis=1), 1e-300)
+        merit = np.linalg.norm(D * res)
+        for _ in range(_NEWTON_STEPS):
+            if not (np.all(np.isfinite(J)) and np.isfinite(merit)):
+                return False, D * res, res
+            # least squares: singular where a nip carries no load yet (δ = 0)
+            step = np.linalg.lstsq(J, -res, rcond=None)[0]
+            x0 = y[u].copy()
+            if np.all(np.abs(step) <= 1e-10 * np.maximum(np.abs(x0), floor)):
+                y[u] = x0 + step
+                res, _ = self._residual(y)
+                return True, D * res, res
+            big = np.abs(step[self._speed_slots]) * self._speed_radius(y)
+            step *= min(1.0, float(np.min(self.v_ref / 2 / np.maximum(big, 1e-300),
+                                          initial=np.inf)))
+            lam = 1.0
+            while lam > 1e-6:
+                y[u] = x0 + lam * step
+                res_n, J_n = self._residual(y)
+                m_n = np.linalg.norm(D * res_n)
+                if np.isfinite(m_n) and m_n <= (1 - 1e-4 * lam) * merit or m_n == 0:
+                    break
+                lam /= 2
+            else:  # no descent left: solved if the residual is at round-off
+                y[u] = x0
+                return bool(np.max(np.abs(D * res)) <= _ROUND_OFF), D * res, res
+            res, J, merit = res_n, J_n, m_n
+        return False, D * res, res
+
+    def _trust_region(self, y: np.ndarray) -> bool:
+        """Levenberg–Marquardt (MINPACK) on the exact Jacobian in the unknowns' natural
+        scales, from ``y`` (changed in place): the fallback where the line search stalls."""
+        from scipy.optimize import least_squares
+
+        u = self.unknowns
+        s = self._scales(y)
+        res0, J0 = self._residual(y)
+        D = 1.0 / np.maximum(np.max(np.abs(J0 * s[None, :]), axis=1), 1e-300)
+        x0 = y[u] / s
+        cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+        def both(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            key = z.tobytes()
+            if key not in cache:
+                cache.clear()
+                yy = y.copy()
+                yy[u] = z * s
+                r_, J_ = self._residual(yy)
+                cache[key] = (D * r_, D[:, None] * J_ * s[None, :])
+            return cache[key]
+
+        sol = least_squares(lambda z: both(z)[0], x0, jac=lambda z: both(z)[1], method="lm",
+                            xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=100 * len(u))
+        y[u] = sol.x * s
+        return bool(np.all(np.isfinite(sol.fun)))
+
+    def solve(self, r: float, where: str, start: np.ndarray | None = None) -> np.ndarray:
+        """The operating point at radius ``r`` [m] (an :class:`ArgumentError` if none):
+        globalised Newton steps (:meth:`_newton`; Levenberg–Marquardt where they stall)
+        from ``start`` (the previous radius of a map, continued) or :meth:`guess`, to a
+        step below 1e-10 of the unknowns' scale (1 m, 1 rad/s, 1 N or their value)."""
+        sys_ = self.system
+        converged, scaled, raw = False, np.array([np.inf]), np.array([np.inf])
+        y = self._guess(r, where) if start is None else start.copy()
         sys_.modes[self.contact] = IN_CONTACT  # smooth while solving
         try:
             with np.errstate(all="ignore"):
-                res, J = self._residual(y)
-                D = 1.0 / np.maximum(np.max(np.abs(J), axis=1), 1e-300)
-                merit = np.linalg.norm(D * res)
-                for _ in range(_NEWTON_STEPS):
-                    # least squares: singular where a nip carries no load yet (δ = 0)
-                    step = np.linalg.lstsq(J, -res, rcond=None)[0]
-                    x0 = y[u].copy()
-                    if np.all(np.abs(step) <= 1e-10 * np.maximum(np.abs(x0), floor)):
-                        y[u] = x0 + step
-                        converged = True
-                        break
-                    # the slip law saturates beyond a few v_ref: a speed moves at most
-                    # v_ref/2 of surface speed per step
-                    big = np.abs(step[self._speed_slots]) * self._speed_radius(y)
-                    step *= min(1.0, float(np.min(self.v_ref / 2 / np.maximum(big, 1e-300),
-                                                  initial=np.inf)))
-                    lam = 1.0
-                    while lam > 1e-6:
-                        y[u] = x0 + lam * step
-                        res_n, J_n = self._residual(y)
-                        m_n = np.linalg.norm(D * res_n)
-                        if np.isfinite(m_n) and m_n <= (1 - 1e-4 * lam) * merit or m_n == 0:
+                if not self._idle_checked:
+                    self._drop_idle(y)
+                for attempt in ("newton", "trust_region", "guess"):
+                    if attempt == "guess":
+                        if start is None:
                             break
-                        lam /= 2
-                    else:
+                        y = self._guess(r, where)
+                        start = None
+                    elif attempt == "trust_region":
+                        self._trust_region(y)
+                    converged, scaled, raw = self._newton(y)
+                    if converged:
                         break
-                    res, J, merit = res_n, J_n, m_n
         except (np.linalg.LinAlgError, FloatingPointError, ArithmeticError):
             converged = False
         except Exception as exc:  # a non-finite rhs on the way: no balance
@@ -294,12 +393,24 @@ class _Linearisation:
         finally:
             sys_.modes[self.contact] = AUTO
         v = self.v
-        if not converged:
-            nips = "the nip cannot" if len(self.machine.nips) == 1 else "the nips cannot"
+        nips = "the nip cannot" if len(self.machine.nips) == 1 else "the nips cannot"
+        saturated = self._saturated(y)
+        if converged and saturated:  # gross slip: the friction cannot hold the speeds
             raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s "
                                 f"{nips} carry the roll's torque and weight: no operating "
-                                "point (the balance of rotation and friction has no "
-                                "solution); valid: a lower web speed or a smaller radius")
+                                f"point without gross slip ({saturated[2:]}); valid: a lower "
+                                "web speed or a smaller radius")
+        if not converged:
+            bad = np.where(np.isfinite(scaled), np.abs(scaled), np.inf)
+            k = int(np.argmax(bad)) if len(bad) == len(self.equations) else 0
+            name = self.machine.state_names[self.equations[k]]
+            unit = _RATE_UNIT.get(name.rsplit(".", 1)[-1], "")
+            value = raw[k] if len(raw) == len(self.equations) else math.nan
+            raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s "
+                                f"{nips} carry the roll's torque and weight: no operating "
+                                f"point (the equation of d({name})/dt did not converge: "
+                                f"residual {value:.3g}{unit}{saturated}); valid: a "
+                                "lower web speed or a smaller radius")
         sw = sys_.switches(self.t, y)
         for n in self.machine.nips:
             g = sw[self.machine.switch_names.index(f"{n.name}.contact")]
@@ -313,8 +424,27 @@ class _Linearisation:
                 raise ArgumentError(f"{where}: at radius = {r:g} m the load compresses nip "
                                     f"{n.name!r} by {delta:.4g} m, more than a radius (one "
                                     "axis would lie inside the other body); valid: a smaller "
-                                    "radius or a stiffer nip (contact stiffness)")
+                                    f"radius or a stiffer nip ({nip_key(self.machine, n)})")
         return y
+
+    def _saturated(self, y: np.ndarray) -> str:
+        """``; nip 'N' slips at v_s …`` for each nip whose friction is saturated at the
+        last iterate ``y`` (``|v_s| > 2 v_ref``: ``tanh > 0.96``), else ``""``."""
+        try:
+            with np.errstate(all="ignore"):
+                modes = self.system.modes.copy()
+                modes[self.contact] = IN_CONTACT  # as solved
+                ev = self.system.evaluate_numeric(self.t, y, modes, outputs=False)
+        except Exception:  # noqa: BLE001 - only a diagnosis: the error is raised anyway
+            return ""
+        out = []
+        for n in self.machine.nips:
+            ns = ev.nips[n.name]
+            vs, fn = float(ns.v_s), float(ns.normal_force)
+            if np.isfinite(vs) and abs(vs) > 2 * n.part.friction.slip_velocity and fn > 0:
+                out.append(f"; nip {n.name!r} slips at v_s = {vs:.3g} m/s, its friction "
+                           f"saturated at mu F_n = {n.part.friction.mu * fn:.4g} N")
+        return "".join(out)
 
     def _distance(self, y: np.ndarray, n) -> float:  # noqa: ANN001
         def c(b):  # noqa: ANN001, ANN202
@@ -423,6 +553,8 @@ class ModeMap:
     roll: str
     drum_rotation: dict[str, float] = field(default_factory=dict)
     legacy: bool = False
+    #: per bounce mode its natural frequency ``|λ|/2π`` [Hz] (also where it is overdamped)
+    natural: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def coordinates(self) -> list[str]:
@@ -441,6 +573,23 @@ class ModeMap:
     @property
     def bounce_damping(self) -> np.ndarray:
         return self.dampings[self.main]
+
+    def overdamped(self, mode: str | None = None) -> list[tuple[float, float]]:
+        """The radius ranges ``(first, last)`` [m] over which a bounce mode (default
+        :attr:`main`) is overdamped: its eigenvalue is real (damping ratio 1, damped
+        frequency 0), so it has no oscillation and no crossing there (the nips' damping and
+        the friction relaxation couple into it)."""
+        over = self.frequencies[mode or self.main] == 0.0
+        out, i = [], 0
+        while i < len(over):
+            if over[i]:
+                j = i
+                while j + 1 < len(over) and over[j + 1]:
+                    j += 1
+                out.append((float(self.radius[i]), float(self.radius[j])))
+                i = j
+            i += 1
+        return out
 
     @property
     def rotation_2x(self) -> np.ndarray:
@@ -521,13 +670,44 @@ def wound_length(scene: Scene, v: float) -> float:
     return v * T
 
 
+def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
+                  radius_min: float | None, radius_max: float | None,
+                  names: tuple[str, str]) -> tuple[float, float]:
+    """``(r_min, r_max)`` [m] of a map: the arguments (``names`` in messages) or the
+    roll's initial radius and its radius at the end of the scene's run."""
+    roll, rc = lin.roll.part, lin.rc
+    key = "[roll] core_radius" if scene.legacy else f"[[roll]] {lin.roll.name!r} core_radius"
+    hi = _MAX[("roll", "initial_radius")]
+    if radius_min is None:
+        lo = roll.initial_radius
+    else:
+        lo = number(where, names[0], radius_min, lo=rc, hi=hi, unit="m",
+                    valid=f"a finite radius >= {key} = {rc:g} m and <= {hi:g} m")
+    if radius_max is None:
+        end = math.sqrt(roll.initial_radius**2
+                        + roll.caliper * wound_length(scene, v) / math.pi)
+        if not end > lo:
+            raise ArgumentError(f"{where}: {names[0]} = {lo:g} m is not below the wound "
+                                f"roll's radius at the end of the run ({end:g} m, from the "
+                                f"scene's duration); valid: a smaller {names[0]}, or give "
+                                f"{names[1]} too")
+        return lo, end
+    below = "the roll's initial radius" if radius_min is None else names[0]
+    up = number(where, names[1], radius_max, lo=lo, lo_open=True, hi=hi, unit="m",
+                valid=f"a finite radius > {below} = {lo:g} m and <= {hi:g} m")
+    return lo, up
+
+
 def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
-             web_speed: float | None = None, n: int = 200) -> ModeMap:
+             web_speed: float | None = None, n: int = 200, radius_min: float | None = None,
+             radius_max: float | None = None,
+             _names: tuple[str, str] = ("radius_min", "radius_max")) -> ModeMap:
     """The resonance map over ``radii`` [m] of the wound roll (each ``>=`` its core
-    radius; default: ``n`` points, 2 … 10 000, from its initial radius to its radius at the
-    end of the scene's run, winding one caliper per revolution at no slip:
-    ``r² = r₀² + h L/π`` with ``L`` the paper brought in by the drive's ramp and full
-    speed) at ``web_speed`` [m/s] (``> 0``; default the scene's).
+    radius; default: ``n`` points, 2 … 10 000, from ``radius_min`` [m] (default its initial
+    radius) to ``radius_max`` [m] (default its radius at the end of the scene's run, winding
+    one caliper per revolution at no slip: ``r² = r₀² + h L/π`` with ``L`` the paper brought
+    in by the drive's ramp and full speed)) at ``web_speed`` [m/s] (``> 0``; default the
+    scene's). Each radius starts from the operating point of the one before (continuation).
 
     Raises
     ------
@@ -536,12 +716,13 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     """
     where = "mode_map"
     lin = _linearisation(scene, where, web_speed, lo_open=True)
-    v, rc, roll = lin.v, lin.rc, lin.roll.part
+    v, rc = lin.v, lin.rc
     if radii is None:
         n = integer(where, "n", n, lo=2, hi=MAX_POINTS)
-        r0 = roll.initial_radius
-        r_end = math.sqrt(r0**2 + roll.caliper * wound_length(scene, v) / math.pi)
-        radii = np.linspace(r0, r_end, n)
+        radii = np.linspace(*_radius_range(where, lin, scene, v, radius_min, radius_max,
+                                           _names), n)
+    elif radius_min is not None or radius_max is not None:
+        raise ArgumentError(f"{where}: give radii or {_names[0]}/{_names[1]}, not both")
     try:
         radii = np.asarray(radii, dtype=float)
     except (TypeError, ValueError):
@@ -560,12 +741,21 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     nt = len(lin.coords)
     freq = np.full((nt, len(radii)), np.nan)
     damp = np.full((nt, len(radii)), np.nan)
+    natural = np.full((nt, len(radii)), np.nan)
     slip = np.full((2, len(radii)), np.nan)
-    for i, r in enumerate(radii):
-        ms = lin.modes(lin.solve(float(r), where))
+    prev = None
+    for i, r in enumerate(radii):  # continued in radius from the previous point
+        if prev is None:
+            start, guess = None, None
+        else:
+            start, guess = lin.continued(float(r), where, prev)
+        y = lin.solve(float(r), where, start)
+        prev = (y, guess if guess is not None else lin.guess(float(r)))
+        ms = lin.modes(y)
         for m in ms[:nt]:
             j = lin.coords.index(m.coordinate)
             freq[j, i], damp[j, i] = m.frequency, m.damping_ratio
+            natural[j, i] = m.natural_frequency
         if len(ms) > nt:
             slip[:, i] = ms[nt].natural_frequency, ms[nt].damping_ratio
     drums = {b.name: b.part.drive.ratio * v / (2 * math.pi * b.part.radius)
@@ -574,4 +764,4 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),
                    dict(zip(lin.coords, damp, strict=True)), slip[0], slip[1],
                    ratio * v / (2 * math.pi * radii), v, lin.roll.name, drums,
-                   bool(scene.legacy))
+                   bool(scene.legacy), dict(zip(lin.coords, natural, strict=True)))

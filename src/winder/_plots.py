@@ -385,6 +385,11 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
         f = mm.frequencies[c]
         ax.plot(r, np.where(f > 0, f, np.nan), f"C{i}", lw=2,
                 label="bounce mode (damped)" if one else f"bounce mode {c} (damped)")
+        if np.any(f == 0):  # overdamped (real eigenvalue): a bar along the bottom
+            ax.plot(r, np.where(f == 0, 0.02 + 0.025 * i, np.nan), f"C{i}", lw=4,
+                    solid_capstyle="butt", transform=ax.get_xaxis_transform(),
+                    label=("bounce mode" if one else c) + " overdamped here (real "
+                    "eigenvalue: no oscillation)")
     ax.plot(r, mm.slip_frequency, "C2" if one else "C7", lw=1.0,
             label="slip/torsion mode |λ|/2π (slowest)")
     harmonics = mm.harmonics()

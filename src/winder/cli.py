@@ -300,7 +300,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     from ._scene import load_scene
 
     scene = load_scene(args.scene)
-    mm = mode_map(scene, web_speed=args.web_speed, n=args.points)
+    mm = mode_map(scene, web_speed=args.web_speed, n=args.points, radius_min=args.radius_min,
+                  radius_max=args.radius_max, _names=("--radius-min", "--radius-max"))
     print(f"{scene.name}: modes at {len(mm.radius)} radii, {mm.radius[0]:.3f}-"
           f"{mm.radius[-1]:.3f} m, web speed {mm.web_speed:g} m/s")
     one = len(mm.coordinates) == 1
@@ -308,6 +309,9 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         f, z = mm.frequencies[c], mm.dampings[c]
         print(f"  bounce mode{'' if one else ' ' + c} {f[0]:.1f} -> {f[-1]:.1f} Hz, "
               f"damping ratio {z[0]:.3f} -> {z[-1]:.3f}")
+        for lo, hi in mm.overdamped(c):
+            print(f"  bounce mode{'' if one else ' ' + c} is overdamped (real eigenvalue, no "
+                  f"oscillation, no crossing) at r = {lo:.4f}-{hi:.4f} m")
     for c in mm.coordinates:
         for h in mm.harmonics():
             crit = mm.critical_radii(h, c)
@@ -473,6 +477,12 @@ def _build_parser() -> argparse.ArgumentParser:
                        help="operating web speed [m/s] (default: the scene's)")
     modes.add_argument("--points", type=_POINTS, default=150,
                        help="radii (2 <= points <= 100000, default 150)")
+    modes.add_argument("--radius-min", type=_POSITIVE, metavar="R",
+                       help="smallest radius of the wound roll [m] (default: its initial "
+                       "radius)")
+    modes.add_argument("--radius-max", type=_POSITIVE, metavar="R",
+                       help="largest radius of the wound roll [m] (default: its radius at "
+                       "the end of the scene's run)")
     modes.add_argument("--simulate", action=argparse.BooleanOptionalAction, default=True,
                        help="add the simulated normal-force envelope to the plot")
     modes.set_defaults(func=_cmd_modes)

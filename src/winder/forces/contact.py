@@ -21,7 +21,8 @@ from ._base import ForceElement
 if TYPE_CHECKING:
     from ..core.machine import Evaluation, Machine, NipState
 
-__all__ = ["Contact", "unclamped_force", "normal_force", "push", "static_penetration"]
+__all__ = ["Contact", "unclamped_force", "normal_force", "push", "static_penetration",
+           "rest_penetration"]
 
 
 def unclamped_force(M: Any, law: str, par: Any, delta: Any, delta_dot: Any) -> Any:
@@ -109,3 +110,17 @@ def push(ev: Evaluation, ns: NipState, fn: Any, ft: Any) -> None:
     fz = fn * ns.nz + ft * ns.tz
     ev.add_force(b.body.name, fx, fz, -b.r * ns.nx, -b.r * ns.nz)
     ev.add_force(a.body.name, -fx, -fz, a.r * ns.nx, a.r * ns.nz)
+
+
+def rest_penetration(law: str, par: Any, load: float, delta_dot: float = 0.0) -> float:
+    """``δ`` [m] at which the nip law ``law`` (parameters ``par(key)``) carries ``load`` [N]
+    at rate ``delta_dot`` [m/s], in closed form: linear ``(F − c δ̇)/k``, Hunt–Crossley
+    ``(F / (k (1 + α δ̇)))^(1/p)``; 0 where the load is not positive (or the damping alone
+    carries it), ``inf`` where a Hunt–Crossley nip closing that fast carries no load."""
+    if not load > 0.0:
+        return 0.0
+    k = par("stiffness")
+    if law == "linear":
+        return max((load - par("damping") * delta_dot) / k, 0.0)
+    gain = 1.0 + par("hc_damping") * delta_dot
+    return (load / (k * gain)) ** (1.0 / par("exponent")) if gain > 0.0 else float("inf")
