@@ -289,6 +289,19 @@ CLI = [_cli_case(label, edit, names) for label, edit, names in (
 )]
 
 
+def _fmu_of_two_webs(d: Path) -> list[str]:
+    data = _model("two_drum_winder")
+    _webs(data, {"entry_nip": "far_nip"})
+    p = d / "scene.toml"
+    p.write_text(tomli_w.dumps(data), encoding="utf-8")
+    return ["fmu", str(p), "--out", str(d / "w.fmu")]
+
+
+#: The FMU takes one web: a scene of several is refused before anything is built.
+CLI.append(Case("webs", "fmu of two webs", _fmu_of_two_webs,
+                names=("scene.toml", "[[web]]", "2 webs", "rear_nip, far_nip")))
+
+
 @pytest.mark.parametrize("case", CLI, ids=[c.label for c in CLI])
 def test_cli_refuses_bad_webs(case: Case, tmp_path: Path) -> None:
     """``winder run`` exits 2 with a few lines naming the file and the key, no traceback,
@@ -312,3 +325,31 @@ def test_cli_runs_two_stations(winder_and_line, tmp_path: Path) -> None:
     for ch in ("rear_nip_web_speed", "line_web_speed", "rear_nip_web_force",
                "line_web_force", "span_tension", "set_radius", "set_b_radius"):
         np.testing.assert_array_equal(got[ch], ref[ch])
+
+
+def test_viewer_draws_each_web(winder_and_line) -> None:
+    """The viewer draws one web per ``[[web]]``: the first under ``web``, the others under
+    ``web-NAME``; each path equals the one drawn for its station alone (identity), and
+    ends at the wound roll's contact point ``p_b = c_b − r_b n`` (machines spec §2)."""
+    from winder.viewer import WinderGraph, motion
+
+    scenes = {k: scene_from_dict(copy.deepcopy(winder_and_line[k])) for k in ("b", "ab")}
+    runs = {k: winder.simulate(s, t_end=0.004, method="RK4", backend="pinocchio",
+                               output_step=0.001) for k, s in scenes.items()}
+    times = runs["ab"].t
+    drawn = {k: motion(scenes[k], runs[k], times) for k in scenes}
+    assert [w.name for w in drawn["ab"].webs] == ["rear_nip", "line"]
+    graph = WinderGraph(scenes["ab"])
+    assert [n for n, _ in graph.web_nodes] == ["web", "web-line"]
+    for k in range(len(times)):
+        alone, (first, line) = drawn["b"].web_paths(k)[0], drawn["ab"].web_paths(k)
+        np.testing.assert_allclose(line, alone, rtol=0, atol=1e-9)
+        np.testing.assert_array_equal(first, drawn["ab"].web(k))
+        for path, (a, b) in ((first, ("rear", "set")), (line, ("rear_b", "set_b"))):
+            ca, cb = (np.array([drawn["ab"].bodies[n].x[k], drawn["ab"].bodies[n].z[k]])
+                      for n in (a, b))
+            n = (cb - ca) / np.hypot(*(cb - ca))
+            np.testing.assert_allclose(path[-1], cb - drawn["ab"].bodies[b].radius[k] * n,
+                                       rtol=0, atol=1e-12)
+        poses = {p[1] for p in graph.pose_commands(drawn["ab"], k) if p[0] == "transform"}
+        assert ("web", "s00") in poses and ("web-line", "s00") in poses
