@@ -26,6 +26,7 @@ from cli_corpus import Case, run_case
 
 import winder
 from winder._scene import scene_from_dict
+from winder._sweep_grid import build_grid
 from winder.cli import main
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -177,6 +178,9 @@ def test_several_webs_round_trip_and_replace(winder_and_line) -> None:
     r = s.replace(web={"rear_nip": {"tension": 250.0}, "line": {"span": {"EA": 2e6}}})
     assert (r.webs[0].tension, r.webs[1].span.EA) == (250.0, 2e6)
     assert (s.webs[0].tension, s.webs[1].span.EA) == (1000.0, 1.4e6)
+    grid = build_grid(s, {"web.line.span.EA": [1e6, 2e6], "web.rear_nip.tension": [10.0]})
+    assert [(g.webs[0].tension, g.webs[1].span.EA) for g in grid.scenes] == \
+        [(10.0, 1e6), (10.0, 2e6)]
 
 
 def _second_station(d: dict[str, Any]) -> None:
@@ -353,3 +357,17 @@ def test_viewer_draws_each_web(winder_and_line) -> None:
                                        rtol=0, atol=1e-12)
         poses = {p[1] for p in graph.pose_commands(drawn["ab"], k) if p[0] == "transform"}
         assert ("web", "s00") in poses and ("web-line", "s00") in poses
+
+
+def test_two_stations_compiled_equals_numeric(winder_and_line) -> None:
+    """The generated code of the two-station machine (the default backend) and the numeric
+    Pinocchio path give the same run (RK4, same steps), channel for channel, to 1e-9 of each
+    channel's scale (another path)."""
+    s = scene_from_dict(copy.deepcopy(winder_and_line["ab"]))
+    kw = {"t_end": 0.02, "method": "RK4", "max_step": STEP, "events": False,
+          "output_step": 0.002}
+    fast, slow = (winder.simulate(s, backend=b, **kw) for b in ("compiled", "pinocchio"))
+    assert set(fast) == set(slow)
+    for ch in slow:
+        x, y = np.asarray(slow[ch]), np.asarray(fast[ch])
+        assert np.max(np.abs(x - y)) <= ROUND_OFF * max(1.0, float(np.max(np.abs(x)))), ch
