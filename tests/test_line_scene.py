@@ -234,8 +234,8 @@ BAD = [
     ("torque huge", lambda d: _parent(d).update(drive={"kind": "torque", "torque": -2e8}),
      r"\[roll 'parent'.drive\] torque: .*1e\+08, got -200000000.0"),
     ("second unwinding roll", _second_parent,
-     r"\[roll 'parent2'\] kind: 'unwinding': one span per scene, fed by one unwinding "
-     r"roll, and roll 'parent' already is one \(unwinding rolls: parent, parent2\)"),
+     r"\[roll 'parent2'\] kind: 'unwinding': an unwinding roll feeds a web span, and no "
+     r"\[web.span\] has from = 'parent2'; add one to the web it feeds"),
     ("unwinding without span", lambda d: d["web"].pop("span") and d["web"].update(
         tension=1000.0),
      r"\[roll 'parent'\] kind: 'unwinding': an unwinding roll feeds a web span, and the "

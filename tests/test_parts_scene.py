@@ -246,8 +246,10 @@ BAD = [
     ("no web", lambda d: d.pop("web"),
      r"\[web\]: missing required table: the scene has the wound roll 'set'; add \[web\] with "
      r"entry_nip = .*valid names: front_nip, rear_nip"),
-    ("two webs", lambda d: d.update(web=[d["web"], d["web"]]),
-     r"\[\[web\]\]: a scene has one web, got 2"),
+    ("two webs into one roll", lambda d: d.update(web=[d["web"], d["web"]]),
+     r"\[web #2\] entry_nip: 'rear_nip' enters wound roll 'set', which \[web #1\] already "
+     r"feeds: two webs into one roll; every wound roll is fed by exactly one web \(spec "
+     r"§3\); valid names: nips into the other wound rolls: \(none\)"),
     ("no body", lambda d: [d.pop(k) for k in ("drum", "roll", "rider", "web")] and
      d.update(nip=[]), r"a scene of parts needs at least one body"),
     # keys and values

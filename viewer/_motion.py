@@ -22,11 +22,12 @@ import numpy as np
 from winder._errors import WinderError
 from winder._result import Result
 from winder._scene import Scene
-from winder.core.machine import Body, Machine
+from winder.core.machine import Body, Machine, Web
 from winder.forces.web_tension import exit_point
 
 __all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
-           "check_drawable", "scene_of", "motion", "web_path", "span_web_path", "exit_points",
+           "check_drawable", "scene_of", "motion", "WebMotion", "web_path", "span_web_path",
+           "exit_points",
            "WEB_LEAD", "WEB_ARC_POINTS"]
 
 #: Length of the web's straight run drawn before it meets the entry drum [m] (off-screen).
@@ -144,13 +145,28 @@ class BodyMotion:
 
 
 @dataclass(frozen=True)
+class WebMotion:
+    """One web of a machine at the samples: its ``name``, its entry nip's ``(a, b)`` body
+    names; on a winder line its unwinding roll ``unwind``, exit points ``exit`` [m]
+    (``(len(times), 2)``) and span tension ``span_tension`` [N] (``None`` without the
+    channel); all three ``None`` without a span."""
+
+    name: str
+    entry: tuple[str, str]
+    unwind: str | None = None
+    exit: np.ndarray | None = None
+    span_tension: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
 class Motion:
     """Every body and nip of a machine at ``times`` [s]: ``bodies`` by name, nip normal
     forces [N] by nip name (``None`` when the result has no such channel) and the entry
     nip's ``(a, b)`` body names (``None`` without a web). On a winder line, ``unwind`` is
     the unwinding roll's name, ``exit`` its exit points ``p_u`` [m] (``(len(times), 2)``,
     :func:`exit_points`) and ``span_tension`` the span's tension [N] (``None`` when the
-    result has no ``span_tension`` channel); all three are ``None`` without a span."""
+    result has no ``span_tension`` channel); all three are ``None`` without a span. These
+    are the first web's; ``webs`` has every web (one per wound roll)."""
 
     times: np.ndarray
     bodies: dict[str, BodyMotion]
@@ -159,15 +175,25 @@ class Motion:
     unwind: str | None = None
     exit: np.ndarray | None = None
     span_tension: np.ndarray | None = None
+    webs: tuple[WebMotion, ...] = ()
 
     def web(self, k: int) -> np.ndarray | None:
-        """The web's path at sample ``k`` (:func:`span_web_path` from the exit point
-        on a line, else :func:`web_path` from off-screen), or ``None``."""
+        """The first web's path at sample ``k`` (:meth:`web_paths`), or ``None``."""
         if self.entry is None:
             return None
-        a, b = (self.bodies[n] for n in self.entry)
-        if self.exit is not None:
-            return span_web_path(self.exit[k], (a.x[k], a.z[k]), a.radius[k], a.sense,
+        return self._path(WebMotion("", self.entry, self.unwind, self.exit), k)
+
+    def web_paths(self, k: int) -> list[np.ndarray]:
+        """Every web's path at sample ``k``: :func:`span_web_path` from the exit point on
+        a line, else :func:`web_path` from off-screen."""
+        if not self.webs:  # a Motion built with the first web's fields only
+            return [] if self.entry is None else [self.web(k)]
+        return [self._path(w, k) for w in self.webs]
+
+    def _path(self, w: WebMotion, k: int) -> np.ndarray:
+        a, b = (self.bodies[n] for n in w.entry)
+        if w.exit is not None:
+            return span_web_path(w.exit[k], (a.x[k], a.z[k]), a.radius[k], a.sense,
                                  (b.x[k], b.z[k]), b.radius[k])
         return web_path((a.x[k], a.z[k]), a.radius[k], a.sense, (b.x[k], b.z[k]),
                         b.radius[k])
@@ -206,27 +232,39 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
                                     get("speed"))
     forces = {n: (sample(c) if c in result else None)
               for n, c in nip_channels(scene, m).items()}
-    entry = (m.entry.a.name, m.entry.b.name) if m.entry is not None else None
-    unwind = exit_ = tension = None
-    if getattr(m, "span", None) is not None and m.entry is not None:
-        unwind = m.unwind.name
-        exit_ = exit_points(m, bodies)
-        tension = sample("span_tension") if "span_tension" in result else None
-    return Motion(times, bodies, forces, entry, unwind, exit_, tension)
+    webs = []
+    for w in m.webs:
+        unwind = exit_ = tension = None
+        if w.unwind is not None:
+            unwind = w.unwind.name
+            exit_ = exit_points(m, bodies, w)
+            ch = f"{w.span_channel}span_tension"
+            tension = sample(ch) if ch in result else None
+        webs.append(WebMotion(w.name, (w.entry.a.name, w.entry.b.name), unwind, exit_,
+                              tension))
+    if not webs:
+        return Motion(times, bodies, forces, None)
+    first = webs[0]
+    return Motion(times, bodies, forces, first.entry, first.unwind, first.exit,
+                  first.span_tension, tuple(webs))
 
 
-def exit_points(machine: Machine, bodies: dict[str, BodyMotion]) -> np.ndarray:
-    """The unwinding roll's exit points ``p_u`` [m], one row ``(x, z)`` per sample of
-    ``bodies``: the engine's :func:`winder.forces.web_tension.exit_point` (direction
-    ``t_u`` towards the entry drum's centre, ``p_u = c_u + s·r_u·(−t_z, t_x)``) evaluated
-    on the drawn centres and radii with numpy."""
+def exit_points(machine: Machine, bodies: dict[str, BodyMotion], web: Web | None = None
+                ) -> np.ndarray:
+    """The exit points ``p_u`` [m] of ``web``'s unwinding roll (default: the first web
+    with a span), one row ``(x, z)`` per sample of ``bodies``: the engine's
+    :func:`winder.forces.web_tension.exit_point` (direction ``t_u`` towards the entry
+    drum's centre, ``p_u = c_u + s·r_u·(−t_z, t_x)``) evaluated on the drawn centres and
+    radii with numpy."""
     def kin(b: BodyMotion, body: Body) -> SimpleNamespace:
         return SimpleNamespace(cx=b.x, cz=b.z, r=b.radius, body=body)
 
-    u, a = machine.unwind, machine.entry.a
+    if web is None:
+        web = next(w for w in machine.webs if w.unwind is not None)
+    u, a = web.unwind, web.entry.a
     ev = SimpleNamespace(machine=machine, M=np, bodies={
         u.name: kin(bodies[u.name], u), a.name: kin(bodies[a.name], a)})
-    _, _, ox, oz = exit_point(ev)
+    _, _, ox, oz = exit_point(ev, web)
     return np.column_stack([bodies[u.name].x + ox, bodies[u.name].z + oz])
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import html
 import json
+from types import SimpleNamespace
 
 from ._motion import Motion
 
@@ -29,7 +30,10 @@ def readout_text(m: Motion, k: int) -> str:
     per body its speed [rad/s] and surface speed [m/s]; per nip its normal force [kN]; on
     a winder line the span's tension ``span  T … N`` [N] (``-`` without its channel)."""
     lines = [f"t  {m.times[k]:10.2f} s"]
-    width = max(len(n) for n in (*m.bodies, *m.normal_forces, "span"))
+    spans = [w for w in m.webs if w.unwind is not None] or (
+        [SimpleNamespace(name="", span_tension=m.span_tension)] if m.unwind is not None else [])
+    labels = ["span" if len(spans) == 1 else f"{w.name} span" for w in spans]
+    width = max(len(n) for n in (*m.bodies, *m.normal_forces, "span", *labels))
     for b in m.bodies.values():
         if b.kind == "roll":
             lines.append(f"{b.name:<{width}}  r {b.radius[k]:8.4f} m")
@@ -39,10 +43,10 @@ def readout_text(m: Motion, k: int) -> str:
     for name, f in m.normal_forces.items():
         value = "      -" if f is None else f"{f[k] / 1e3:8.3f}"
         lines.append(f"{name:<{width}}  N {value} kN")
-    if m.unwind is not None:
-        T = m.span_tension
+    for label, w in zip(labels, spans, strict=True):
+        T = w.span_tension
         value = "      -" if T is None else f"{T[k]:8.1f}"
-        lines.append(f"{'span':<{width}}  T {value} N")
+        lines.append(f"{label:<{width}}  T {value} N")
     return "\n".join(lines)
 
 

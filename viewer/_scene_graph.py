@@ -73,6 +73,10 @@ class WinderGraph:
         self.floor_z = min(b.centre[1] - _radius0(b) for b in self.stands) - 0.35
         entry = self.machine.entry
         self.web_width = 1.12 * (entry.b.part.width if entry is not None else self.length)
+        #: Node of each web's strip (``web`` for the first) and its width [m]: 1.12 × the
+        #: width of the roll it enters.
+        self.web_nodes = [("web" if i == 0 else f"web-{w.name}", 1.12 * w.entry.b.part.width)
+                          for i, w in enumerate(self.machine.webs)]
 
     # ---- objects --------------------------------------------------------------------
     def build(self, vis: meshcat.Visualizer) -> None:
@@ -103,10 +107,10 @@ class WinderGraph:
             node["mark"].set_object(g.Box([0.9 * R, 1.01 * length + 0.01, 0.04 * R]),
                                     lam(color=COLOURS["frame"]))
             node["mark"].set_transform(_translation([0.45 * R, 0.0, 0.0]))
-        if self.machine.entry is not None:
+        for node, web_width in self.web_nodes:
             for i in range(WEB_ARC_POINTS):
-                root["web"][f"s{i:02d}"]["strip"].set_object(
-                    g.Box([1.0, self.web_width, WEB_THICKNESS]), lam(color=COLOURS["web"]))
+                root[node][f"s{i:02d}"]["strip"].set_object(
+                    g.Box([1.0, web_width, WEB_THICKNESS]), lam(color=COLOURS["web"]))
         # context: floor and the far side frames carrying the drum bearings (the near ones
         # would hide the nips from the camera)
         # (a base plate 0.5 m wider than the stands: the web comes in past its edge)
@@ -181,15 +185,14 @@ class WinderGraph:
             if b.kind == "roll":
                 r = float(bodies[b.name].radius[k])
                 out.append(("scale", (b.name, "paper"), [r, 1.0, r]))
-        path = m.web(k)
-        if path is not None:
+        for (node, _), path in zip(self.web_nodes, m.web_paths(k), strict=True):
             for i, (p, q) in enumerate(zip(path[:-1], path[1:], strict=True)):
                 d = q - p
                 length = max(float(np.hypot(*d)), 1e-9)
                 S = pin.SE3(pin.utils.rotate("y", math.atan2(-d[1], d[0])),
                             np.array([0.5 * (p[0] + q[0]), 0.0, 0.5 * (p[1] + q[1])]))
-                out.append(("transform", ("web", f"s{i:02d}"), S.homogeneous))
-                out.append(("scale", ("web", f"s{i:02d}", "strip"), [length, 1.0, 1.0]))
+                out.append(("transform", (node, f"s{i:02d}"), S.homogeneous))
+                out.append(("scale", (node, f"s{i:02d}", "strip"), [length, 1.0, 1.0]))
         return out
 
     def show(self, vis: meshcat.Visualizer, m: Motion, k: int) -> None:

@@ -209,7 +209,12 @@ def build_fmu(scene_path: str | Path, out: str | Path) -> Path:
     except ImportError as exc:
         raise FmuError("building an FMU needs pythonfmu: pip install 'winder[fmu]'") from exc
     scene_path = Path(scene_path)
-    load_scene(scene_path)  # validate before packing
+    scene = load_scene(scene_path)  # validate before packing
+    if len(scene.webs) > 1:
+        raise FmuError(f"{scene_path}: [[web]]: {len(scene.webs)} webs "
+                       f"({', '.join(w.name for w in scene.webs)}); the FMU takes a scene "
+                       "with one web (one winding station); valid: one [web] table (run "
+                       "several stations with winder run)")
     out = Path(out)
     if out.suffix != ".fmu":
         raise FmuError(f"output file must end in .fmu, got {str(out)!r}")

@@ -15,6 +15,7 @@ import numpy as np  # noqa: E402
 from ._files import atomic_write, safe_stem  # noqa: E402
 from ._result import Result  # noqa: E402
 from ._scene import Scene  # noqa: E402
+from .parts import WebPart  # noqa: E402
 
 __all__ = ["paper_figures", "machine_figures", "campbell_figure", "normal_force_envelope",
            "window_mean"]
@@ -314,28 +315,36 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
         ax[i].axhline(0.0, color="k", lw=0.5)
     ax[-1].set_xlabel("t [s]")
     paths.append(_save(fig, out / f"{stem}_slip.png"))
-    if "span_tension" in result:
-        paths.append(_span_figure(result, scene, out / f"{stem}_span.png", name))
+    spans = [w for w in scene.webs if w.span is not None]
+    for w in spans:  # one figure per span: STEM_span.png, or STEM_WEB_span.png
+        pre = f"{w.name}_" if len(spans) > 1 else ""
+        if f"{pre}span_tension" in result:
+            paths.append(_span_figure(result, scene, w, pre, out / f"{stem}_{pre}span.png",
+                                      name))
     return paths
 
 
-def _span_figure(result: Result, scene: Scene, path: Path, name: str) -> Path:
-    """The winder line: span tension (and the controller's error), the unwind torque,
-    the radii of the unwinding and the wound roll."""
+def _span_figure(result: Result, scene: Scene, web: WebPart, pre: str, path: Path,
+                 name: str) -> Path:
+    """A winder line: the span tension of ``web`` (channels ``PRE...``; ``pre`` empty for
+    a scene's only span) and its controller's error, the unwind torque, the radii of the
+    unwinding roll and of the wound roll the web enters."""
     t = result.t
-    span = scene.web.span
+    span = web.span
     unwind = next(r for r in scene.rolls if r.name == span.source)
-    wound = [r for r in scene.rolls if r.kind != "unwinding"]
-    fig, ax = _rows(4 if "tension_error" in result else 3)
-    _panel(ax[0], t, [("span tension", result["span_tension"])], "T [N]",
+    entry = next(n for n in scene.nips if n.name == web.entry_nip)
+    wound = [r for r in scene.rolls if r.name == entry.b]
+    error = f"{pre}tension_error"
+    fig, ax = _rows(4 if error in result else 3)
+    _panel(ax[0], t, [("span tension", result[f"{pre}span_tension"])], "T [N]",
            f"{name}: web span tension [N] (EA = {span.EA:.3g} N, L = {span.length:g} m)",
            lw=0.6)
     rows = 1
-    if "tension_error" in result:
-        _panel(ax[1], t, [("set-point − T", result["tension_error"])], "error [N]",
+    if error in result:
+        _panel(ax[1], t, [("set-point − T", result[error])], "error [N]",
                f"tension error of the unwind's controller [N]: peak "
-               f"{np.max(np.abs(result['tension_error'])):.3g} N, RMS "
-               f"{np.sqrt(np.mean(result['tension_error'] ** 2)):.3g} N", lw=0.6)
+               f"{np.max(np.abs(result[error])):.3g} N, RMS "
+               f"{np.sqrt(np.mean(result[error] ** 2)):.3g} N", lw=0.6)
         ax[1].axhline(0.0, color="k", lw=0.5)
         rows = 2
     _panel(ax[rows], t, [(f"roll {unwind.name}", result[f"{unwind.name}_torque"] / 1e3)],

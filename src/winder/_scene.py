@@ -3,8 +3,8 @@ on construction.
 
 Two formats load: the single-drum format (tables ``[drum]``, ``[roll]``, ``[contact]``,
 ``[friction]``; :attr:`Scene.legacy`) and scenes of parts (arrays of tables ``[[drum]]``,
-``[[roll]]``, ``[[rider]]``, ``[[nip]]``, and ``[web]`` with its optional ``[web.span]``
-from an unwinding roll). A single-drum scene is also
+``[[roll]]``, ``[[rider]]``, ``[[nip]]``, and ``[web]`` (or ``[[web]]``, one per wound
+roll) with its optional ``[web.span]`` from an unwinding roll). A single-drum scene is also
 converted to parts (drum "drum", roll "roll", nip "nip", web entering at "nip"), so code
 written for parts reads both.
 
@@ -204,14 +204,16 @@ class Solver:
 class Scene:
     """A complete winder scene. Build one with :func:`load_scene` or :func:`scene_from_dict`.
 
-    The parts (``drums``, ``rolls``, ``riders``, ``nips``, ``web``) describe every scene.
+    The parts (``drums``, ``rolls``, ``riders``, ``nips``, ``webs``) describe every scene;
+    ``web`` is the first (or only) web, or None.
     A scene in the single-drum format (``legacy``) also has ``drum``, ``roll``,
     ``contact`` and ``friction``, and its parts are derived from them (machines spec §8):
     drum "drum" at the origin, sense +1; roll "roll" free in ``z`` at ``(0, R + r0)``,
     sense −1; nip "nip" (a = drum, b = roll); web entering at "nip" with tension 0. In a
     scene of parts those four are None, and ``paper`` is None unless ``[paper]`` is given.
-    A winder line has one unwinding roll (``rolls``, kind ``"unwinding"``) feeding the
-    span ``web.span`` (machines spec §5).
+    Every wound roll is fed by exactly one web (``webs``, one per wound roll, machines spec
+    §3); a winder line has an unwinding roll (``rolls``, kind ``"unwinding"``) feeding the
+    span of a web (``web.span``, machines spec §5).
     """
 
     scene: SceneInfo
@@ -228,6 +230,7 @@ class Scene:
     riders: tuple[RiderPart, ...] = ()
     nips: tuple[NipPart, ...] = ()
     web: WebPart | None = None
+    webs: tuple[WebPart, ...] = ()
     legacy: bool = field(init=False)
 
     def __post_init__(self) -> None:
@@ -236,6 +239,11 @@ class Scene:
         if legacy:  # the parts always follow the single-drum tables
             for name, value in _legacy_parts(self).items():
                 object.__setattr__(self, name, value)
+        # ``webs`` is every web; ``web`` the first (or only) one, kept for code that reads a
+        # single web; given only ``web``, ``webs`` is that one
+        webs = tuple(self.webs) or ((self.web,) if self.web is not None else ())
+        object.__setattr__(self, "webs", webs)
+        object.__setattr__(self, "web", webs[0] if webs else None)
 
     @property
     def name(self) -> str:
@@ -284,16 +292,21 @@ class Scene:
             for key in ("density", "caliper"):
                 if self.paper is not None and roll[key] == getattr(self.paper, key):
                     del roll[key]
-        if self.web is not None:
-            out["web"] = _web_dict(self.web)
+        if len(self.webs) == 1:
+            out["web"] = _web_dict(self.webs[0])
+        elif self.webs:  # [[web]], one table per wound roll
+            out["web"] = [_web_dict(w, named=True) for w in self.webs]
         out["solver"] = _table_dict(self.solver)
         return out
 
 
-def _web_dict(web: WebPart) -> dict[str, Any]:
+def _web_dict(web: WebPart, *, named: bool = False) -> dict[str, Any]:
     """``[web]`` as a TOML table: with a span, ``[web.span]`` (its roll under the key
-    ``from``) and no ``tension`` (the span's state)."""
+    ``from``) and no ``tension`` (the span's state); its name only if ``named`` or not the
+    default (its entry nip's)."""
     out = _table_dict(web)
+    if not named and web.name == web.entry_nip:
+        del out["name"]
     if web.span is not None:
         del out["tension"]
         out["span"] = {"from": out["span"].pop("source"), **out["span"]}
@@ -371,7 +384,7 @@ def _legacy_parts(scene: Scene) -> dict[str, Any]:
         "nips": (NipPart(name="nip", a="drum", b="roll",
                          contact=ContactLaw(**dataclasses.asdict(scene.contact)),
                          friction=FrictionLaw(**dataclasses.asdict(scene.friction))),),
-        "web": WebPart(entry_nip="nip", tension=0.0),
+        "webs": (WebPart(entry_nip="nip", tension=0.0),),
     }
 
 
@@ -462,8 +475,8 @@ _PART_SPEC: dict[str, dict[str, tuple]] = {
     "nip[].friction": _SPEC["friction"],
     "roll[].drive": {"kind": ("str", True, None), "torque": ("num", False, None),
                      "tension": ("num", False, _POS), "bandwidth": ("num", False, _POS)},
-    "web": {"entry_nip": ("ref", True, None), "tension": ("num", False, _NONNEG),
-            "span": ("table", False, None)},
+    "web": {"name": ("name", False, None), "entry_nip": ("ref", True, None),
+            "tension": ("num", False, _NONNEG), "span": ("table", False, None)},
     "web.span": {"from": ("ref", True, None), "length": ("num", True, _POS),
                  "EA": ("num", True, _POS), "T_in": ("num", False, _NONNEG),
                  "initial_tension": ("num", False, _NONNEG)},
@@ -850,24 +863,44 @@ def _parse_roll(source: str, label: str, raw: Mapping[str, Any], paper: Paper | 
     return RollPart(**kw)
 
 
-def _parse_web(source: str, data: Mapping[str, Any]) -> WebPart | None:
-    """``[web]`` and its ``[web.span]`` (spec §3, §5, §8)."""
+def _parse_webs(source: str, data: Mapping[str, Any]) -> list[tuple[str, WebPart]]:
+    """``[web]`` (one table) or ``[[web]]`` (an array of tables, one per wound roll), each
+    with its optional ``[web.span]`` (spec §3, §5, §8): ``(label, web)`` pairs, the label
+    naming the table in messages (``web``; ``web 'name'`` or ``web #2`` in an array)."""
     web_raw = data.get("web")
-    if isinstance(web_raw, list):
-        raise SceneError(f"{source}: [[web]]: a scene has one web, got {len(web_raw)} "
-                         "([[web]] is an array); write a single [web] table")
     if web_raw is None:
-        return None
-    kw = _parse_table(source, "web", web_raw, specs=_PART_SPEC)
-    if "span" in web_raw:
-        if "tension" in web_raw:
-            raise _fail(source, "web", "tension",
-                        f"{show(web_raw['tension'])}: with [web.span] the tension is the "
-                        "span's state (spec §5); valid: remove tension (the span's "
-                        "initial_tension sets where it starts)")
-        sp = _parse_table(source, "web.span", web_raw["span"], specs=_PART_SPEC)
-        kw["span"] = SpanPart(source=sp.pop("from"), **sp)
-    return WebPart(**kw)
+        return []
+    if isinstance(web_raw, list):
+        if not web_raw:
+            raise SceneError(f"{source}: [[web]]: an empty array of webs; give one [[web]] "
+                             "table per wound roll, each with entry_nip, or leave web out "
+                             "(a scene without wound rolls)")
+        elements = []
+        for i, raw in enumerate(web_raw):
+            label = f"web #{i + 1}"
+            if not isinstance(raw, dict):
+                raise SceneError(f"{source}: [{label}] must be a table of keys, got "
+                                 f"{show(raw)} ({type(raw).__name__})")
+            if "name" in raw:
+                label = f"web {_check_part_name(source, label, raw['name'])!r}"
+            elements.append((label, raw))
+    else:
+        elements = [("web", web_raw)]
+    webs = []
+    for label, raw in elements:
+        kw = _parse_table(source, label, raw, spec_name="web", specs=_PART_SPEC)
+        if "span" in raw:
+            if "tension" in raw:
+                raise _fail(source, label, "tension",
+                            f"{show(raw['tension'])}: with [web.span] the tension is the "
+                            "span's state (spec §5); valid: remove tension (the span's "
+                            "initial_tension sets where it starts)")
+            slabel = f"{label}.span"
+            sp = _parse_table(source, slabel, raw["span"], spec_name="web.span",
+                              specs=_PART_SPEC)
+            kw["span"] = SpanPart(source=sp.pop("from"), **sp)
+        webs.append((label, WebPart(**kw)))
+    return webs
 
 
 def _parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
@@ -903,18 +936,20 @@ def _parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
             kw[key] = law(**_parse_table(source, f"{label}.{key}", raw.get(key, {}),
                                          spec_name=f"nip[].{key}", specs=spec))
         nips.append(NipPart(**kw))
-    web = _parse_web(source, data)
-    _check_references(source, drums, rolls, riders, nips, web)
+    webs = _parse_webs(source, data)
+    _check_references(source, drums, rolls, riders, nips, webs)
+    _check_overlaps(source, drums, rolls, nips)
     return {"drums": tuple(drums), "rolls": tuple(rolls), "riders": tuple(riders),
-            "nips": tuple(nips), "web": web}
+            "nips": tuple(nips), "webs": tuple(w for _, w in webs)}
 
 
 def _check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
-                      riders: list[RiderPart], nips: list[NipPart], web: WebPart | None
-                      ) -> None:
+                      riders: list[RiderPart], nips: list[NipPart],
+                      webs: list[tuple[str, WebPart]]) -> None:
     """Unique names, and every ``a``, ``b``, ``rides``, ``entry_nip``, ``from`` naming a
-    part of the right kind; nips that can be assembled; one span per unwinding roll
-    (machines spec §8)."""
+    part of the right kind; nips that can be assembled; every wound roll fed by exactly
+    one web (``webs``: ``(label, web)``), one span per unwinding roll (machines spec
+    §3, §8)."""
     kinds: dict[str, str] = {}
     for kind, parts in (("drum", drums), ("roll", rolls), ("rider", riders), ("nip", nips)):
         for i, p in enumerate(parts):
@@ -971,60 +1006,122 @@ def _check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
                         f"{', '.join(f'{n.name} ({n.a}, {n.b})' for n in nips) or '(none)'}")
     wound = [r.name for r in rolls if r.kind == "wound"]
     entries = [n.name for n in nips if kinds[n.a] == "drum" and n.b in wound]
-    if web is None:
-        if wound:
-            valid = ", ".join(entries) or "(none: no nip joins a drum, a, to the roll, b)"
-            raise SceneError(f"{source}: [web]: missing required table: the scene has the "
-                             f"wound roll {wound[0]!r}; add [web] with entry_nip = the nip "
-                             f"where the web enters it; valid names: {valid}")
-        _check_span(source, kinds, rolls, web)
-        return
-    if web.entry_nip not in entries:
+    if not webs and wound:
+        valid = ", ".join(entries) or "(none: no nip joins a drum, a, to the roll, b)"
+        raise SceneError(f"{source}: [web]: missing required table: the scene has the "
+                         f"wound roll {wound[0]!r}; add [web] with entry_nip = the nip "
+                         f"where the web enters it; valid names: {valid}")
+    fed: dict[str, str] = {}  # wound roll -> the label of the web that feeds it
+    names: dict[str, str] = {}  # web name -> its label
+    for label, web in webs:
         ref = web.entry_nip
-        if kinds.get(ref) == "nip":
-            nip = next(n for n in nips if n.name == ref)
-            what = (f"is nip {ref!r} joining {kinds[nip.a]} {nip.a!r} (a) and "
-                    f"{kinds[nip.b]} {nip.b!r} (b); the web enters a wound roll (b) from "
-                    "the drum it wraps (a)")
-        else:
-            what = f"is {kinds[ref]} {ref!r}, not a nip" if ref in kinds else \
-                "is not a nip of the scene"
-        raise _fail(source, "web", "entry_nip", f"{show(ref)} {what}; valid names: "
-                                                f"{', '.join(entries) or '(none)'}")
-    _check_span(source, kinds, rolls, web)
+        if ref not in entries:
+            if kinds.get(ref) == "nip":
+                nip = next(n for n in nips if n.name == ref)
+                what = (f"is nip {ref!r} joining {kinds[nip.a]} {nip.a!r} (a) and "
+                        f"{kinds[nip.b]} {nip.b!r} (b); the web enters a wound roll (b) "
+                        "from the drum it wraps (a)")
+            else:
+                what = f"is {kinds[ref]} {ref!r}, not a nip" if ref in kinds else \
+                    "is not a nip of the scene"
+            raise _fail(source, label, "entry_nip", f"{show(ref)} {what}; valid names: "
+                                                    f"{', '.join(entries) or '(none)'}")
+        roll = next(n.b for n in nips if n.name == ref)
+        if roll in fed:
+            free = [e for e in entries if next(n.b for n in nips if n.name == e) not in fed]
+            raise _fail(source, label, "entry_nip",
+                        f"{ref!r} enters wound roll {roll!r}, which [{fed[roll]}] already "
+                        "feeds: two webs into one roll; every wound roll is fed by exactly "
+                        "one web (spec §3); valid names: nips into the other wound rolls: "
+                        f"{', '.join(free) or '(none)'}")
+        fed[roll] = label
+        if web.name in names:
+            raise _fail(source, label, "name",
+                        f"{web.name!r} is already the name of [{names[web.name]}]; every "
+                        "web needs its own name (default: its entry_nip); valid: a name "
+                        f"not taken ({', '.join(names)})")
+        if web.name != ref and web.name in kinds:
+            raise _fail(source, label, "name",
+                        f"{web.name!r} is already the name of {kinds[web.name]} "
+                        f"{web.name!r}; a web's name is its entry nip's or one no part "
+                        f"has (taken: {', '.join(kinds)})")
+        names[web.name] = label
+    _check_span(source, kinds, rolls, webs)
+    for roll in wound:
+        if roll not in fed:
+            valid = [n.name for n in nips if n.b == roll and kinds[n.a] == "drum"]
+            raise _fail(source, f"roll {roll!r}", "kind",
+                        "'wound': no web feeds this wound roll, so its paper would come "
+                        "from nowhere (spec §3: every wound roll is fed by exactly one "
+                        "web); add a [[web]] with entry_nip = the nip where its web enters "
+                        "it; valid names: "
+                        f"{', '.join(valid) or '(none: no nip joins a drum, a, to it, b)'}"
+                        ", or make it kind = 'unwinding' with its own span")
 
 
 def _check_span(source: str, kinds: Mapping[str, str], rolls: list[RollPart],
-                web: WebPart | None) -> None:
-    """One span per scene, fed by the one unwinding roll its ``from`` names (spec §5);
-    ``kinds`` maps every part's name to its kind."""
+                webs: list[tuple[str, WebPart]]) -> None:
+    """Every unwinding roll feeds exactly one web's span, and every span starts at an
+    unwinding roll (spec §5); ``kinds`` maps every part's name to its kind."""
     unwinding = [r.name for r in rolls if r.kind == "unwinding"]
-    if len(unwinding) > 1:
-        raise _fail(source, f"roll {unwinding[1]!r}", "kind",
-                    f"'unwinding': one span per scene, fed by one unwinding roll, and roll "
-                    f"{unwinding[0]!r} already is one (unwinding rolls: "
-                    f"{', '.join(unwinding)}); valid: kind = 'wound' here, or one unwinding "
-                    "roll")
-    span = web.span if web is not None else None
-    if span is None:
-        if unwinding:
-            raise _fail(source, f"roll {unwinding[0]!r}", "kind",
-                        f"'unwinding': an unwinding roll feeds a web span, and the scene has "
-                        f"no [web.span]; add [web.span] with from = {unwinding[0]!r} (and "
-                        "[web] entry_nip, where the web enters the wound roll)")
-        return
-    if span.source not in unwinding:
+    spans = [(label, w.span) for label, w in webs if w.span is not None]
+    source_of: dict[str, str] = {}
+    for label, span in spans:
         ref = span.source
-        if kinds.get(ref) == "roll":
-            what = f"is roll {ref!r} of kind 'wound', not an unwinding roll"
-        elif ref in kinds:
-            what = f"is {kinds[ref]} {ref!r}, not an unwinding roll"
-        else:
-            what = "is not a roll of the scene"
-        raise _fail(source, "web.span", "from",
-                    f"{show(ref)} {what}; the span starts at the unwinding roll that feeds "
-                    "it; valid names: "
-                    f"{', '.join(unwinding) or '(none: no roll has kind = unwinding)'}")
+        if ref not in unwinding:
+            if kinds.get(ref) == "roll":
+                what = f"is roll {ref!r} of kind 'wound', not an unwinding roll"
+            elif ref in kinds:
+                what = f"is {kinds[ref]} {ref!r}, not an unwinding roll"
+            else:
+                what = "is not a roll of the scene"
+            raise _fail(source, f"{label}.span", "from",
+                        f"{show(ref)} {what}; the span starts at the unwinding roll that "
+                        "feeds it; valid names: "
+                        f"{', '.join(unwinding) or '(none: no roll has kind = unwinding)'}")
+        if ref in source_of:
+            raise _fail(source, f"{label}.span", "from",
+                        f"{ref!r} already feeds the span of [{source_of[ref]}]: an "
+                        "unwinding roll pays off one web; valid names: unwinding rolls "
+                        "feeding no span: "
+                        f"{', '.join(u for u in unwinding if u not in source_of) or '(none)'}")
+        source_of[ref] = label
+    for name in unwinding:
+        if name not in source_of:
+            first = not spans and len(webs) <= 1
+            raise _fail(source, f"roll {name!r}", "kind",
+                        "'unwinding': an unwinding roll feeds a web span, and "
+                        + ("the scene has no [web.span]; add [web.span] with from = "
+                           f"{name!r} (and [web] entry_nip, where the web enters the wound "
+                           "roll)" if first else
+                           f"no [web.span] has from = {name!r}; add one to the web it "
+                           "feeds, or make it kind = 'wound' with a web of its own"))
+
+
+def _check_overlaps(source: str, drums: list[DrumPart], rolls: list[RollPart],
+                    nips: list[NipPart]) -> None:
+    """No two drums or rolls whose circles overlap at the start (their ``centre`` and
+    initial radius) without a nip between them (spec §8): nothing would carry the force
+    between them. Riders are left out: the machine places a rider on top of the roll it
+    rides, and the twin-drum winder of spec §10 starts its rider inside the drums'
+    circles (a small set in the valley), a contact it does not model."""
+    circles: list[tuple[str, str, float, float, float]] = []  # kind, name, x, z, radius
+    for d in drums:
+        circles.append(("drum", d.name, *d.centre, d.radius))
+    for r in rolls:
+        circles.append(("roll", r.name, *r.centre, r.initial_radius))
+    joined = {frozenset((n.a, n.b)) for n in nips}
+    for i, (ka, a, xa, za, ra) in enumerate(circles):
+        for kb, b, xb, zb, rb in circles[i + 1:]:
+            gap = math.hypot(xb - xa, zb - za) - (ra + rb)
+            if gap < -1e-9 * (ra + rb) and frozenset((a, b)) not in joined:
+                raise _fail(source, f"{kb} {b!r}", "centre",
+                            f"{kb} {b!r} (radius {rb:.6g} m at ({xb:.6g}, {zb:.6g}) m) "
+                            f"overlaps {ka} {a!r} (radius {ra:.6g} m at ({xa:.6g}, "
+                            f"{za:.6g}) m) by {-gap:.4g} m at the start, and no [[nip]] "
+                            "joins them, so nothing carries the force between them; valid: "
+                            "centres at least the sum of the radii apart, or a [[nip]] with "
+                            f"a = {a!r}, b = {b!r}")
 
 
 def _check_rest_on_nip(scene: Scene) -> None:

@@ -35,7 +35,7 @@ import pinocchio as pin
 
 from .._mass_law import paper_roll_mass
 
-__all__ = ["Machine", "Body", "Nip", "Evaluation", "AUTO", "FREE", "IN_CONTACT", "CORE_AUTO",
+__all__ = ["Machine", "Body", "Nip", "Web", "Evaluation", "AUTO", "FREE", "IN_CONTACT", "CORE_AUTO",
            "WINDING", "AT_CORE"]
 
 AUTO, FREE, IN_CONTACT = -1, 0, 1
@@ -72,13 +72,37 @@ class Nip:
     index: int
 
 
+@dataclass
+class Web:
+    """A web (machines.md §3, §5): it enters its wound roll ``entry.b`` at the nip ``entry``
+    from the drum ``entry.a``, under a constant tension or that of its ``span`` from the
+    unwinding roll ``unwind``. ``key`` prefixes the names of its parameters (``web.tension``)
+    and ``channel`` its channels (``web_speed``, ``web_force``): empty for a scene's only
+    web, else ``NAME.`` and ``NAME_``; ``span_key``/``span_channel`` likewise for its span
+    (``span.tension``, ``span_tension``, ``tension_error``), empty when it is the only span
+    (machines.md §9)."""
+
+    name: str
+    part: Any
+    entry: Nip
+    span: Any = None
+    unwind: Body | None = None
+    key: str = ""
+    channel: str = ""
+    span_key: str = ""
+    span_channel: str = ""
+
+
 class Machine:
     """The machine of a scene: model, layout, parameters, modes, channels, dynamics.
 
     Parameters
     ----------
     scene: a :class:`~winder.Scene` (its parts: ``drums``, ``rolls``, ``riders``,
-        ``nips``, ``web``).
+        ``nips``, ``webs``; an object with only ``web`` is read as that one web).
+
+    ``webs`` lists the :class:`Web` s; ``web``, ``entry`` are the first web's part and
+    entry nip, ``span``, ``unwind`` the first span and its unwinding roll (None without).
     """
 
     def __init__(self, scene: Any) -> None:
@@ -107,11 +131,25 @@ class Machine:
         self.nips = [Nip(n.name, self.body[n.a], self.body[n.b], n, i)
                      for i, n in enumerate(scene.nips)]
         self.nip = {n.name: n for n in self.nips}
-        self.web = scene.web
-        self.entry = self.nip[scene.web.entry_nip] if scene.web is not None else None
+        parts = tuple(getattr(scene, "webs", None) or ()) or \
+            ((scene.web,) if getattr(scene, "web", None) is not None else ())
+        spans = sum(getattr(w, "span", None) is not None for w in parts)
+        self.webs: list[Web] = []
+        for w in parts:
+            name = getattr(w, "name", None) or w.entry_nip
+            span = getattr(w, "span", None)
+            several, spanned = len(parts) > 1, spans > 1
+            self.webs.append(Web(name, w, self.nip[w.entry_nip], span,
+                                 self.body[span.source] if span is not None else None,
+                                 f"{name}." if several else "", f"{name}_" if several else "",
+                                 f"{name}." if spanned else "", f"{name}_" if spanned else ""))
+        first = self.webs[0] if self.webs else None
+        self.web = first.part if first is not None else None
+        self.entry = first.entry if first is not None else None
         self.rolls = [b for b in self.bodies if b.kind == "roll"]
-        self.span = getattr(scene.web, "span", None) if scene.web is not None else None
-        self.unwind = self.body[self.span.source] if self.span is not None else None
+        spanned = next((w for w in self.webs if w.span is not None), None)
+        self.span = spanned.span if spanned is not None else None
+        self.unwind = spanned.unwind if spanned is not None else None
         if self.span is not None and not fx.web_tension:
             from .._errors import ModelError
 
@@ -233,8 +271,8 @@ class Machine:
         for n in self.nips:
             for ch in ("normal_force", "friction_force", "slip_velocity", "penetration"):
                 self.channel(f"{n.name}_{ch}")
-        if self.entry is not None:
-            self.channel("web_speed")
+        for w in self.webs:
+            self.channel(f"{w.channel}web_speed")
 
     def _initial_rate(self, b: Body, c: str) -> float:
         """Spec §7: translational velocities 0; a roll its initial speed, a torque-driven
@@ -289,6 +327,8 @@ class Machine:
                       [f"{n.name}:{n.a.name}:{n.b.name}:{n.part.contact.law}"
                        for n in self.nips],
                       [self.entry.name if self.entry else ""],
+                      *([f"{w.name}:{w.entry.name}:{w.unwind.name if w.unwind else ''}"
+                         for w in self.webs],) * (len(self.webs) > 1),
                       [f"{x.name}:{len(x.part.load)}" for x in self.bodies
                        if x.kind == "rider"]):
             h.update(("|".join(group) + "#").encode())
@@ -368,7 +408,10 @@ class Evaluation:
         self.fext_extra: dict[str, list[Any]] = {}  # local-frame spatial forces by body
         #: actuator torques about the bodies' axes [N·m], operation sense (drives)
         self.drive_torques: dict[str, Any] = {}
-        self.span_rate: Any = 0.0  # dT/dt of the web span [N/s] (web_tension sets it)
+        #: dT/dt of each web's span [N/s] by web name (web_tension sets it); ``span_rate``
+        #: that of the first span
+        self.span_rates: dict[str, Any] = {}
+        self.span_rate: Any = 0.0
         self.gravity: Any = 0.0  # [m/s²], set by the gravity effect
 
     # access by name
@@ -589,6 +632,6 @@ class Evaluation:
             ch(f"{nip.name}_friction_force", ns.friction_force)
             ch(f"{nip.name}_slip_velocity", ns.v_s)
             ch(f"{nip.name}_penetration", ns.delta)
-        if mach.entry is not None:
-            a = self.bodies[mach.entry.a.name]
-            ch("web_speed", a.omega * a.r)
+        for w in mach.webs:
+            a = self.bodies[w.entry.a.name]
+            ch(f"{w.channel}web_speed", a.omega * a.r)

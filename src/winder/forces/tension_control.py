@@ -27,42 +27,51 @@ from typing import TYPE_CHECKING
 from ._base import ForceElement
 
 if TYPE_CHECKING:
-    from ..core.machine import Evaluation, Machine
+    from ..core.machine import Evaluation, Machine, Web
 
 __all__ = ["TensionControl"]
 
 
 class TensionControl(ForceElement):
-    """The unwind's tension controller; state ``ROLL.tension_integral`` [N·s]."""
+    """The unwind's tension controller, one per tension-controlled unwinding roll (on the
+    span of its web); state ``ROLL.tension_integral`` [N·s]."""
 
     name = "tension_control"
     order = 45  # after web_tension (the span's tension and its rate)
 
     def declare(self, machine: Machine) -> None:
-        b = machine.unwind
-        machine.parameter(f"{b.name}.tension_setpoint", b.part.drive.tension)
-        machine.parameter(f"{b.name}.bandwidth", b.part.drive.bandwidth)
-        machine.state(f"{b.name}.tension_integral", 0.0)
-        machine.channel("tension_error")
+        for w in machine.webs:
+            b = w.unwind
+            if b is None or not b.controlled:
+                continue
+            machine.parameter(f"{b.name}.tension_setpoint", b.part.drive.tension)
+            machine.parameter(f"{b.name}.bandwidth", b.part.drive.bandwidth)
+            machine.state(f"{b.name}.tension_integral", 0.0)
+            machine.channel(f"{w.span_channel}tension_error")
 
     def apply(self, ev: Evaluation) -> None:
-        m = ev.machine
-        b = m.unwind
+        for w in ev.machine.webs:
+            if w.unwind is not None and w.unwind.controlled:
+                self._control(ev, w)
+
+    @staticmethod
+    def _control(ev: Evaluation, w: Web) -> None:
+        b, k = w.unwind, w.span_key
         n = b.name
-        u, a = ev.bodies[n], ev.bodies[m.entry.a.name]
-        T = ev.x("span.tension")
+        u, a = ev.bodies[n], ev.bodies[w.entry.a.name]
+        T = ev.x(f"{k}span.tension")
         T_set = ev.p(f"{n}.tension_setpoint")
         wc = ev.p(f"{n}.bandwidth")
         e = T_set - T
         ev.set_rate(f"{n}.tension_integral", e)
         r, J = u.r, u.inertia
-        g = ev.p("span.EA") * r / (ev.p("span.length") * J)
+        g = ev.p(f"{k}span.EA") * r / (ev.p(f"{k}span.length") * J)
         kd, kp, ki = 3.0 * wc / g, 3.0 * wc * wc / g - r, wc ** 3 / g
         v2 = a.omega * a.r * a.body.sense
         a_dot = a.alpha_prescribed if a.alpha_prescribed is not None else 0.0
         v2_dot = a_dot * a.r * a.body.sense
         w_ref_dot = (v2_dot * r - v2 * u.r_dot) / (r * r)
         tau = (J * w_ref_dot - r * T_set - kp * e
-               - ki * ev.x(f"{n}.tension_integral") + kd * ev.span_rate)
+               - ki * ev.x(f"{n}.tension_integral") + kd * ev.span_rates[w.name])
         ev.drive_torques[n] = tau
-        ev.set_channel("tension_error", e)
+        ev.set_channel(f"{w.span_channel}tension_error", e)

@@ -18,27 +18,27 @@ __all__ = ["WebMomentum"]
 
 
 class WebMomentum(ForceElement):
-    """Momentum flux of the web at the entry nip and at the unwinding roll's exit point;
-    channel ``web_force`` [N] (at the entry)."""
+    """Momentum flux of each web at its own entry nip and at its unwinding roll's exit
+    point; channel ``web_force`` [N] (at the entry; ``WEB_web_force`` with several webs)."""
 
     name = "web_momentum"
     order = 40
 
     def declare(self, machine: Machine) -> None:
-        if machine.entry is not None:
-            machine.channel("web_force")
+        for w in machine.webs:
+            machine.channel(f"{w.channel}web_force")
 
     def apply(self, ev: Evaluation) -> None:
         m = ev.machine
-        entry = m.entry
-        if entry is not None:
+        for w in m.webs:
+            entry = w.entry
             ns, b = ev.nips[entry.name], ev.bodies[entry.b.name]
             u = ns.u_a if m.scene.effects.contact else ns.u_b
             f = b.mass_rate * u
             ev.add_force(b.body.name, f * ns.tx, f * ns.tz, -b.r * ns.nx, -b.r * ns.nz)
-            ev.set_channel("web_force", f)
-        if m.unwind is not None:
-            un = ev.bodies[m.unwind.name]
-            f = un.mass_rate * un.r * un.speed
-            tx, tz, ox, oz = exit_point(ev)
-            ev.add_force(un.body.name, f * tx, f * tz, ox, oz)
+            ev.set_channel(f"{w.channel}web_force", f)
+            if w.unwind is not None:
+                un = ev.bodies[w.unwind.name]
+                f = un.mass_rate * un.r * un.speed
+                tx, tz, ox, oz = exit_point(ev, w)
+                ev.add_force(un.body.name, f * tx, f * tz, ox, oz)

@@ -16,18 +16,18 @@ from typing import TYPE_CHECKING, Any
 from ._base import ForceElement
 
 if TYPE_CHECKING:
-    from ..core.machine import Evaluation, Machine
+    from ..core.machine import Evaluation, Machine, Web
 
 __all__ = ["WebTension", "exit_point"]
 
 
-def exit_point(ev: Evaluation) -> tuple[Any, Any, Any, Any]:
-    """``(t_x, t_z, o_x, o_z)``: the unit direction ``t_u`` in which the web leaves the
-    unwinding roll (towards the entry drum's centre) and the exit point ``p_u − c_u``
+def exit_point(ev: Evaluation, web: Web) -> tuple[Any, Any, Any, Any]:
+    """``(t_x, t_z, o_x, o_z)``: the unit direction ``t_u`` in which ``web`` leaves its
+    unwinding roll (towards its entry drum's centre) and the exit point ``p_u − c_u``
     [m], on the side where the roll's surface moves along ``+t_u`` when it turns in its
     operation sense."""
-    m, M = ev.machine, ev.M
-    u, a = ev.bodies[m.unwind.name], ev.bodies[m.entry.a.name]
+    M = ev.M
+    u, a = ev.bodies[web.unwind.name], ev.bodies[web.entry.a.name]
     dx, dz = a.cx - u.cx, a.cz - u.cz
     d = M.sqrt(dx * dx + dz * dz)
     tx, tz = dx / d, dz / d
@@ -36,40 +36,46 @@ def exit_point(ev: Evaluation) -> tuple[Any, Any, Any, Any]:
 
 
 class WebTension(ForceElement):
-    """The web's tension on the wound roll (and on the unwinding roll of a span)."""
+    """Each web's tension on its wound roll (and on the unwinding roll of its span)."""
 
     name = "web_tension"
     order = 40
 
     def declare(self, machine: Machine) -> None:
-        span = machine.span
-        if span is not None:
-            t0 = span.T_in if span.initial_tension is None else span.initial_tension
-            machine.state("span.tension", t0)
-            machine.parameter("span.length", span.length)
-            machine.parameter("span.EA", span.EA)
-            machine.parameter("span.T_in", span.T_in)
-            machine.channel("span_tension")
-        elif machine.entry is not None:
-            machine.parameter("web.tension", machine.web.tension)
+        for w in machine.webs:
+            span, k = w.span, w.span_key
+            if span is not None:
+                t0 = span.T_in if span.initial_tension is None else span.initial_tension
+                machine.state(f"{k}span.tension", t0)
+                machine.parameter(f"{k}span.length", span.length)
+                machine.parameter(f"{k}span.EA", span.EA)
+                machine.parameter(f"{k}span.T_in", span.T_in)
+                machine.channel(f"{w.span_channel}span_tension")
+            else:
+                machine.parameter(f"{w.key}web.tension", w.part.tension)
 
     def apply(self, ev: Evaluation) -> None:
-        m = ev.machine
-        entry = m.entry
-        if entry is None:
-            return
-        ns, b = ev.nips[entry.name], ev.bodies[entry.b.name]
-        if m.span is None:
-            T = ev.p("web.tension")
+        for w in ev.machine.webs:
+            self._web(ev, w)
+
+    @staticmethod
+    def _web(ev: Evaluation, w: Web) -> None:
+        ns, b = ev.nips[w.entry.name], ev.bodies[w.entry.b.name]
+        if w.span is None:
+            T = ev.p(f"{w.key}web.tension")
         else:
-            state = ev.x("span.tension")
-            u = ev.bodies[m.unwind.name]
+            k = w.span_key
+            state = ev.x(f"{k}span.tension")
+            u = ev.bodies[w.unwind.name]
             v1, v2 = u.r * u.speed, ns.u_a
-            ev.span_rate = (ev.p("span.EA") * (v2 - v1) + v1 * ev.p("span.T_in")
-                            - v2 * state) / ev.p("span.length")
-            ev.set_rate("span.tension", ev.span_rate)
-            ev.set_channel("span_tension", state)
+            rate = (ev.p(f"{k}span.EA") * (v2 - v1) + v1 * ev.p(f"{k}span.T_in")
+                    - v2 * state) / ev.p(f"{k}span.length")
+            if not ev.span_rates:
+                ev.span_rate = rate
+            ev.span_rates[w.name] = rate
+            ev.set_rate(f"{k}span.tension", rate)
+            ev.set_channel(f"{w.span_channel}span_tension", state)
             T = ev.M.fmax(state, 0.0)
-            tx, tz, ox, oz = exit_point(ev)
+            tx, tz, ox, oz = exit_point(ev, w)
             ev.add_force(u.body.name, T * tx, T * tz, ox, oz)
         ev.add_force(b.body.name, -T * ns.tx, -T * ns.tz, -b.r * ns.nx, -b.r * ns.nz)

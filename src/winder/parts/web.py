@@ -1,6 +1,6 @@
-"""The web (machines spec §3, §5, §8 ``[web]``, ``[web.span]``): where the paper enters
-the wound roll, and under which tension: a constant one, or the state of an elastic span
-from an unwinding roll."""
+"""The webs (machines spec §3, §5, §8 ``[web]``/``[[web]]``, ``[web.span]``): where the
+paper enters each wound roll, and under which tension: a constant one, or the state of an
+elastic span from an unwinding roll. Every wound roll is fed by exactly one web."""
 
 from __future__ import annotations
 
@@ -26,10 +26,16 @@ class SpanPart:
 
 @dataclass(frozen=True)
 class WebPart:
-    """``[web]``: entry_nip (the name of the nip where the web enters its wound roll: ``a``
-    a drum, ``b`` a wound roll), tension [0, 1e7] [N] (constant; 0 and unused with a
-    span), span (:class:`SpanPart` or None)."""
+    """``[web]`` (or one ``[[web]]`` element): entry_nip (the name of the nip where the web
+    enters its wound roll: ``a`` a drum, ``b`` a wound roll), tension [0, 1e7] [N]
+    (constant; 0 and unused with a span), span (:class:`SpanPart` or None), name (None:
+    the entry nip's name; it prefixes the web's channels in a scene of several webs)."""
 
     entry_nip: str
     tension: float = 0.0
     span: SpanPart | None = None
+    name: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.name is None:
+            object.__setattr__(self, "name", self.entry_nip)

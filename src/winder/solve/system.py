@@ -172,7 +172,11 @@ class MachineSystem:
     def ended(self, t: float, y: np.ndarray) -> None:
         """Record that the run ends at ``t`` [s] in state ``y``: an unwinding roll reached
         its core (machines.md §1)."""
-        roll = self.machine.unwind.name if self.machine.unwind is not None else "?"
+        m = self.machine
+        spent = [w.unwind.name for w in m.webs if w.unwind is not None
+                 and y[m.index(f"{w.unwind.name}.radius")]
+                 <= w.unwind.part.core_radius * (1.0 + 1e-9)]
+        roll = spent[0] if spent else (m.unwind.name if m.unwind is not None else "?")
         self.end = (float(t), np.array(y, dtype=float),
                     f"the unwinding roll {roll!r} ran out of web (its radius reached the "
                     f"core) at t = {t:.6g} s: the run ends there")
