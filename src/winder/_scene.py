@@ -552,7 +552,7 @@ def _parse_table(source: str, table: str, raw: Any, *, spec_name: str | None = N
         elif kind == "sense":
             if isinstance(value, bool) or value not in (1, -1):
                 raise _fail(source, table, key, f"{show(value)} is not a sense; valid: 1 or "
-                                                 "-1 (the operation direction, spec §1)")
+                                                 "-1 (the operation direction, docs/model.md §1)")
             out[key] = int(value)
         elif kind == "axes":
             out[key] = _parse_axes(source, table, key, value)
@@ -804,7 +804,7 @@ def _parse_roll(source: str, label: str, raw: Mapping[str, Any], paper: Paper | 
         if kw["free"]:
             raise _fail(source, label, "free",
                         f"{show(list(kw['free']))}: an unwinding roll's centre is fixed "
-                        "(spec §1); valid: [] (or leave free out)")
+                        "(docs/model.md §1); valid: [] (or leave free out)")
     kw["drive"] = _parse_roll_drive(source, label, kw, raw)
     kw.setdefault("initial_radius", kw["core_radius"])
     for key in ("density", "caliper"):
@@ -830,7 +830,7 @@ def _parse_web(source: str, data: Mapping[str, Any]) -> WebPart | None:
         if "tension" in web_raw:
             raise _fail(source, "web", "tension",
                         f"{show(web_raw['tension'])}: with [web.span] the tension is the "
-                        "span's state (spec §5); valid: remove tension (the span's "
+                        "span's state, docs/model.md §6; valid: remove tension (the span's "
                         "initial_tension sets where it starts)")
         sp = _parse_table(source, "web.span", web_raw["span"], specs=_PART_SPEC)
         kw["span"] = SpanPart(source=sp.pop("from"), **sp)
