@@ -180,10 +180,15 @@ def main(argv: list[str] | None = None) -> int:
                                                  rerun=args.rerun, load=load,
                                                  tag=f"variant{i}")))
                 for i, (name, load) in enumerate(VARIANTS.items())]
+    runs = [(f"{name}: run", f"{r.meta['method']} at rtol {r.meta['rtol']:g}: "
+             f"{r.meta['wall_time']:.1f} s wall, {r.meta['rhs_evaluations'] / 1e6:.1f} M "
+             f"evaluations, {r.meta['events']:,} located events")
+            for name, r in (("two_drum_winder", two), ("winder_line", line))]
     print("| quantity | value |\n|---|---|")
     for title, rows in (("two_drum_winder", two_drum_numbers(two)),
                         ("two_drum_winder, rider load", variants),
-                        ("winder_line", line_numbers(line, ramp_end))):
+                        ("winder_line", line_numbers(line, ramp_end)),
+                        ("integration", runs)):
         for name, value in rows:
             print(f"| {title}: {name} | {value} |")
     return 0
