@@ -1135,8 +1135,8 @@ _KEY_DOC: dict[tuple[str, str], tuple[str, str, str | None]] = {
     ("drum.drive", "web_acceleration"): ("m/s²", "ramp of the surface (web) speed a_w; "
                                          "0: full speed from t = 0", None),
     ("drum.drive", "web_speed"): ("m/s", "speed_profile: the surface speed v_w the ramp "
-                                  "reaches (required); torque: the initial surface speed",
-                                  None),
+                                  "reaches; torque: the initial surface speed",
+                                  "required (kind speed_profile); 0 (kind torque)"),
     ("drum.drive", "torque"): ("N·m", "kind torque: the drive torque (operation sense), "
                                "constant or an input", None),
     ("roll", "core_radius"): ("m", "outer radius r_c of the empty core", None),
@@ -1203,8 +1203,8 @@ _KEY_DOC: dict[tuple[str, str], tuple[str, str, str | None]] = {
                                "feed-forward, gains from bandwidth", None),
     ("roll[].drive", "torque"): ("N·m", "kind torque: the unwind torque (operation sense), "
                                  "constant or an input", None),
-    ("roll[].drive", "tension"): ("N", "kind tension_control: the tension set-point T* "
-                                  "(required)", None),
+    ("roll[].drive", "tension"): ("N", "kind tension_control: the tension set-point T*",
+                                  "required (kind tension_control)"),
     ("roll[].drive", "bandwidth"): ("rad/s", "kind tension_control: the closed loop's "
                                     "bandwidth ω_c (its three poles at −ω_c)", None),
     ("rider[]", "name"): ("-", "the part's name (unique; names its channels)", None),
