@@ -87,3 +87,26 @@ def test_a_nip_has_one_colour_in_run_figures_and_resonance_map(tmp_path, monkeyp
         assert {"two_drum_winder_nip_forces.png", "two_drum_winder_slip.png",
                 "modes.png"} <= figures, (n, figures)
         assert {c for _, c in hits} == {want[n]}, (n, hits)
+
+
+def test_fig4_of_a_run_shows_the_whole_torque(tmp_path, monkeypatch):
+    """The paper scene's first 60 s (ramp, first lift-offs): Fig. 4's full panel holds the
+    drum torque's extremes, the zoom's title states the share of samples it clips."""
+    res = winder.simulate(MODELS / "paper_winding.toml", t_end=60.0)
+    torque = res["drum_torque"]
+    limits: dict[str, list] = {}
+    save = _plots._save
+
+    def capture(fig, path: Path) -> Path:
+        limits[Path(path).name] = [(a.get_ylim(), a.get_title()) for a in fig.axes]
+        return save(fig, path)
+
+    monkeypatch.setattr(_plots, "_save", capture)
+    _plots.paper_figures(res, tmp_path, closeup=res)
+    (_, _), ((flo, fhi), ftitle), ((zlo, zhi), ztitle) = \
+        limits["paper_winding_fig4_speeds_torque.png"]
+    assert flo <= torque.min() and fhi >= torque.max()
+    assert f"full range {torque.min():.0f} to {torque.max():.0f} N m" in ftitle
+    clipped = np.mean((torque < zlo) | (torque > zhi))
+    assert 0.0 < clipped < 0.2  # the zoom does leave the impacts out, and says how many
+    assert f"{clipped:.2%} of samples lie outside" in ztitle
