@@ -5,7 +5,8 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.winder-installed
 OUT    ?= out
 
-.PHONY: demo test test-slow bench peers fmu docs-figures lint chromium clean venv pin-casadi
+.PHONY: demo test test-slow bench peers fmu docs-figures lint chromium clean venv pin-casadi \
+	scene-reference readme-numbers
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -69,6 +70,15 @@ bench: $(STAMP)
 # Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
 peers: $(STAMP)
 	$(PY) benchmarks/peers/study.py
+
+# docs/scene-reference.md from the scene schema (src/winder/_scene.py); a test fails when stale.
+scene-reference: $(STAMP)
+	$(PY) -m winder.scene_reference --out docs/scene-reference.md
+
+# The README's quoted numbers of the two-drum winder and the winder line, from the demo's
+# results in $(OUT)/ (run where missing): a table to paste.
+readme-numbers: $(STAMP) pin-casadi
+	$(PY) benchmarks/readme_numbers.py --out $(OUT)
 
 # The README's resonance map (committed under docs/).
 docs-figures: $(STAMP)

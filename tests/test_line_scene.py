@@ -199,7 +199,7 @@ def _second_parent(d: dict) -> None:
 BAD = [
     # the unwinding roll
     ("unwinding free z", lambda d: _parent(d).update(free=["z"]),
-     r"\[roll 'parent'\] free: \['z'\]: an unwinding roll's centre is fixed \(spec §1\); "
+     r"\[roll 'parent'\] free: \['z'\]: an unwinding roll's centre is fixed \(docs/model.md §1\); "
      r"valid: \[\]"),
     ("unwinding free xz", lambda d: _parent(d).update(free=["x", "z"]),
      r"\[roll 'parent'\] free: \['x', 'z'\]: an unwinding roll's centre is fixed"),
@@ -256,8 +256,8 @@ BAD = [
     ("span from missing", lambda d: d["web"]["span"].pop("from"),
      r"\[web.span\] from: missing required key"),
     ("span with tension", lambda d: d["web"].update(tension=1000.0),
-     r"\[web\] tension: 1000.0: with \[web.span\] the tension is the span's state "
-     r"\(spec §5\); valid: remove tension"),
+     r"\[web\] tension: 1000.0: with \[web.span\] the tension is the span's state, "
+     r"docs/model.md §6; valid: remove tension"),
     ("span without entry", lambda d: d["web"].pop("entry_nip"),
      r"\[web\] entry_nip: missing required key"),
     ("span length 0", lambda d: d["web"]["span"].update(length=0.0),

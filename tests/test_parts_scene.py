@@ -248,8 +248,8 @@ BAD = [
      r"entry_nip = .*valid names: front_nip, rear_nip"),
     ("two webs into one roll", lambda d: d.update(web=[d["web"], d["web"]]),
      r"\[web #2\] entry_nip: 'rear_nip' enters wound roll 'set', which \[web #1\] already "
-     r"feeds: two webs into one roll; every wound roll is fed by exactly one web \(spec "
-     r"§3\); valid names: nips into the other wound rolls: \(none\)"),
+     r"feeds: two webs into one roll; every wound roll is fed by exactly one web; valid "
+     r"names: nips into the other wound rolls: \(none\)"),
     ("no body", lambda d: [d.pop(k) for k in ("drum", "roll", "rider", "web")] and
      d.update(nip=[]), r"a scene of parts needs at least one body"),
     # keys and values

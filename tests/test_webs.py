@@ -200,7 +200,7 @@ def _webs(d: dict[str, Any], *more: dict[str, Any]) -> None:
 BAD = [
     ("wound roll without web", _second_station,
      r"\[roll 'set2'\] kind: 'wound': no web feeds this wound roll, so its paper would come "
-     r"from nowhere \(spec §3: every wound roll is fed by exactly one web\); add a \[\[web\]\] "
+     r"from nowhere \(every wound roll is fed by exactly one web\); add a \[\[web\]\] "
      r"with entry_nip = .*valid names: far_nip"),
     ("two webs into one roll", lambda d: _webs(d, {"entry_nip": "front_nip", "name": "w2"}),
      r"\[web 'w2'\] entry_nip: 'front_nip' enters wound roll 'set', which \[web #1\] already "

@@ -338,7 +338,8 @@ def write_markdown(cases: list[Case], rows: list[dict[str, Any]], ratios: list[d
          "Regenerate with `make peers` (`benchmarks/peers/`, MuJoCo from pip: the `peers` "
          "extra). The MuJoCo model (`benchmarks/peers/mujoco_winder.py`) is written from the "
          "scene as MJCF: drum hinge about +y, roll on a slide along z with a hinge about −y "
-         "(spec §1). The nip and the relaxed slip force are spec §4's laws computed in Python "
+         "([model.md](model.md) §1). The nip and the relaxed slip force are the laws of "
+         "[model.md](model.md) §4 computed in Python "
          "and applied through `qfrc_applied` (MuJoCo's own contact is off), so the ways differ "
          "only in the mass terms. `tests/test_peers.py` holds the MuJoCo model to winder with "
          "the mass held constant, and checks the free-spin closed forms.", "",
@@ -346,8 +347,9 @@ def write_markdown(cases: list[Case], rows: list[dict[str, Any]], ratios: list[d
          "step from the radius; nothing else. This is the zero-relative-velocity convention: "
          "the paper silently arrives with the roll's own velocity, so the web flux is *not* "
          "added (on top of the overwrite it would count the arriving paper twice).",
-         "- **(b) overwrite + −(∂M/∂r·ṙ) q̇**: the same plus spec §3's missing term and the "
-         "web flux `ṁ u`, by hand through `qfrc_applied`: the winder's equations.",
+         "- **(b) overwrite + −(∂M/∂r·ṙ) q̇**: the same plus the missing term of "
+         "[model.md](model.md) §3 and the web flux `ṁ u`, by hand through `qfrc_applied`: "
+         "the winder's equations.",
          "- **(c) winder**: `winder.simulate(method=\"DOPRI5\")` at rtol 1e-3 … 1e-9 "
          "(atol = rtol/100), the whole call.", "",
          "Times are this process's CPU time (`time.process_time`): the same as the wall time "
@@ -356,7 +358,8 @@ def write_markdown(cases: list[Case], rows: list[dict[str, Any]], ratios: list[d
          "Errors: the largest deviation over the output grid, scaled by the channel's "
          "largest magnitude, against winder at rtol 1e-10 (against the closed form for free "
          "spin); the *error* column is the worst channel. The overwrite's h → 0 limit is "
-         "winder's `variable_mass = false` mode (spec §3), so its plateau below is exact. "
+         "winder's `variable_mass = false` mode ([model.md](model.md) §3), so its plateau "
+         "below is exact. "
          f"Machine: {machine}; the whole study took {total[0] / 60:.1f} min "
          f"({total[1] / 60:.1f} min of CPU time).", "",
          "## Headline", "", *headline(cases, ratios, costs), "",

@@ -18,7 +18,7 @@ from ._scene import Scene  # noqa: E402
 from .parts import WebPart  # noqa: E402
 
 __all__ = ["paper_figures", "machine_figures", "campbell_figure", "normal_force_envelope",
-           "window_mean"]
+           "window_mean", "nip_colours", "NIP_COLOURS"]
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
@@ -77,7 +77,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
             a.legend()
         return [_save(fig, out / f"{stem}_fig2_free_spin.png")]
 
-    fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    fig, ax = plt.subplots(3, 1, figsize=(9, 9.5), sharex=True)
     ax[0].plot(t, result["drum_speed"], label="drum Ω")
     ax[0].plot(t, result["roll_speed"], label="roll ω", alpha=0.8)
     ax[0].set_ylabel("speed [rad/s]")
@@ -89,14 +89,9 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     ax[0].legend()
     ax[0].set_title(f"{name}: drum and roll speed, drum torque "
                     f"({'with' if web else 'without'} web momentum, Fig. {4 if web else 5})")
-    ax[1].plot(t, result["drum_torque"], color="C3", lw=0.6)
-    ax[1].set_ylabel("drum torque [N m]")
-    lo, hi = np.percentile(result["drum_torque"][t > 45], [0.5, 99.5]) if t[-1] > 50 else \
-        np.percentile(result["drum_torque"], [0.5, 99.5])
-    pad = 0.3 * (hi - lo) + 1.0
-    ax[1].set_ylim(lo - pad, hi + pad)
-    ax[1].axhline(0.0, color="k", lw=0.5)
-    ax[1].set_xlabel("t [s]")
+    torque = result["drum_torque"]
+    _torque_panels(ax[1], ax[2], t, torque)
+    ax[2].set_xlabel("t [s]")
     for a in ax:
         a.grid(True, alpha=0.3)
     paths.append(_save(fig, out / f"{stem}_fig{4 if web else 5}_speeds_torque.png"))
@@ -153,6 +148,41 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
         a.grid(True, alpha=0.3)
     paths.append(_save(fig, out / f"{stem}_fig8_normal_force.png"))
     return paths
+
+
+def _torque_panels(full: plt.Axes, zoom: plt.Axes, t: np.ndarray, torque: np.ndarray
+                   ) -> None:
+    """The drum torque [N·m] twice: ``full`` on its whole range (the impacts of a bouncing
+    roll), ``zoom`` on the range of its 0.5–99.5 percentiles (after t = 45 s in a long
+    run) with its mean over 0.5 s, saying in its title what it leaves out."""
+    lo_all, hi_all = float(np.min(torque)), float(np.max(torque))
+    full.plot(t, torque, color="C3", lw=0.6)
+    full.set_ylabel("drum torque [N m]")
+    full.set_title(f"drum torque, full range {lo_all:.0f} to {hi_all:.0f} N m", fontsize=10)
+    full.axhline(0.0, color="k", lw=0.5)
+    late = t > 45 if t[-1] > 50 else np.ones_like(t, dtype=bool)
+    lo, hi = np.percentile(torque[late], [0.5, 99.5])
+    pad = 0.3 * (hi - lo) + 1.0
+    zoom.plot(t, torque, color="C3", lw=0.6)
+    zoom.plot(*window_mean(t, torque), color="k", lw=0.8, label="mean over 0.5 s")
+    zoom.set_ylim(lo - pad, hi + pad)
+    zoom.axhline(0.0, color="k", lw=0.5)
+    zoom.set_ylabel("drum torque [N m]")
+    clipped = np.mean((torque < lo - pad) | (torque > hi + pad))
+    zoom.set_title(f"zoom on {lo - pad:.0f} to {hi + pad:.0f} N m: clipped, {clipped:.2%} of "
+                   f"samples lie outside (full range {lo_all:.0f} to {hi_all:.0f} N m above)",
+                   fontsize=10)
+    zoom.legend(fontsize=8, loc="upper right")
+
+
+#: Colours of the nips, by their place in the scene: a nip has the same colour in every
+#: figure (run figures, resonance maps). C3 (red) is left out: it marks critical radii.
+NIP_COLOURS = ("C0", "C1", "C2", "C4", "C5", "C6", "C8", "C9")
+
+
+def nip_colours(scene: Scene) -> dict[str, str]:
+    """Colour of each nip of ``scene`` by name (the single-drum nip is ``"nip"``)."""
+    return {n.name: NIP_COLOURS[i % len(NIP_COLOURS)] for i, n in enumerate(scene.nips)}
 
 
 def _parts_scene(result: Result, scene: Scene | None) -> Scene:
@@ -220,7 +250,7 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     stem = safe_stem(result.meta.get("scene", scene.name))
     t = result.t
     paths: list[Path] = []
-    color = {n.name: f"C{i % 10}" for i, n in enumerate(scene.nips)}
+    color = nip_colours(scene)
     nip_label = {n.name: f"nip {n.name} ({n.a}–{n.b})" for n in scene.nips}
 
     # drums: speeds, then one torque row per drum
@@ -376,14 +406,15 @@ _HARMONIC_STYLE = {"1x": "-", "2x": "--", "3x": ":"}
 
 
 def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
-                    title: str = "", envelopes: dict[str, tuple[str, str]] | None = None
-                    ) -> Path:
+                    title: str = "", envelopes: dict[str, tuple[str, str]] | None = None,
+                    colours: dict[str, str] | None = None) -> Path:
     """Resonance map (:class:`winder.ModeMap`): the bounce modes (one line per free
     coordinate) and the slowest slip/torsion mode against the radius, the 1×/2×/3× roll
     rotation lines and the drums' rotation, every crossing of a harmonic with a bounce mode
     marked; with ``result``, the simulated normal-force envelopes below on the same radius
     axis (``envelopes``: label → (force channel, radius channel); default the single-drum
-    ``normal_force`` against ``radius``)."""
+    ``normal_force`` against ``radius``; ``colours``: label → colour, :func:`nip_colours`
+    when the labels are nip names, so that a nip has its colour of the run figures)."""
     mm = mode_map
     rows = 2 if result is not None else 1
     fig, axes = plt.subplots(rows, 1, figsize=(8, 4.2 * rows), sharex=True, squeeze=False)
@@ -438,9 +469,10 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
         pairs = envelopes or {"": ("normal_force", "radius")}
         for i, (label, (force, radius)) in enumerate(pairs.items()):
             rr, lo, hi, _ = normal_force_envelope(result, force=force, radius=radius)
-            b.fill_between(rr, lo / 1e3, hi / 1e3, color=f"C{i + 1}", alpha=0.5, lw=0,
+            colour = (colours or {}).get(label, NIP_COLOURS[i % len(NIP_COLOURS)])
+            b.fill_between(rr, lo / 1e3, hi / 1e3, color=colour, alpha=0.5, lw=0,
                            label=label or None)
-            b.plot(rr, hi / 1e3, f"C{i + 1}", lw=0.6)
+            b.plot(rr, hi / 1e3, color=colour, lw=0.6)
         for _, _, rc in crossings:
             b.axvline(rc, color="C3", lw=0.8, alpha=0.5)
         if len(pairs) > 1:

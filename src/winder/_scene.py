@@ -598,7 +598,7 @@ def _parse_table(source: str, table: str, raw: Any, *, spec_name: str | None = N
         elif kind == "sense":
             if isinstance(value, bool) or value not in (1, -1):
                 raise _fail(source, table, key, f"{show(value)} is not a sense; valid: 1 or "
-                                                 "-1 (the operation direction, spec §1)")
+                                                 "-1 (the operation direction, docs/model.md §1)")
             out[key] = int(value)
         elif kind == "axes":
             out[key] = _parse_axes(source, table, key, value)
@@ -850,7 +850,7 @@ def _parse_roll(source: str, label: str, raw: Mapping[str, Any], paper: Paper | 
         if kw["free"]:
             raise _fail(source, label, "free",
                         f"{show(list(kw['free']))}: an unwinding roll's centre is fixed "
-                        "(spec §1); valid: [] (or leave free out)")
+                        "(docs/model.md §1); valid: [] (or leave free out)")
     kw["drive"] = _parse_roll_drive(source, label, kw, raw)
     kw.setdefault("initial_radius", kw["core_radius"])
     for key in ("density", "caliper"):
@@ -893,7 +893,7 @@ def _parse_webs(source: str, data: Mapping[str, Any]) -> list[tuple[str, WebPart
             if "tension" in raw:
                 raise _fail(source, label, "tension",
                             f"{show(raw['tension'])}: with [web.span] the tension is the "
-                            "span's state (spec §5); valid: remove tension (the span's "
+                            "span's state, docs/model.md §6; valid: remove tension (the span's "
                             "initial_tension sets where it starts)")
             slabel = f"{label}.span"
             sp = _parse_table(source, slabel, raw["span"], spec_name="web.span",
@@ -1032,7 +1032,7 @@ def _check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
             raise _fail(source, label, "entry_nip",
                         f"{ref!r} enters wound roll {roll!r}, which [{fed[roll]}] already "
                         "feeds: two webs into one roll; every wound roll is fed by exactly "
-                        "one web (spec §3); valid names: nips into the other wound rolls: "
+                        "one web; valid names: nips into the other wound rolls: "
                         f"{', '.join(free) or '(none)'}")
         fed[roll] = label
         if web.name in names:
@@ -1052,7 +1052,7 @@ def _check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
             valid = [n.name for n in nips if n.b == roll and kinds[n.a] == "drum"]
             raise _fail(source, f"roll {roll!r}", "kind",
                         "'wound': no web feeds this wound roll, so its paper would come "
-                        "from nowhere (spec §3: every wound roll is fed by exactly one "
+                        "from nowhere (every wound roll is fed by exactly one "
                         "web); add a [[web]] with entry_nip = the nip where its web enters "
                         "it; valid names: "
                         f"{', '.join(valid) or '(none: no nip joins a drum, a, to it, b)'}"
@@ -1220,3 +1220,169 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
         raise SceneError(f"{p}: not a scene: arrays or tables nested too deeply for TOML "
                          "parsing (a scene is a few flat tables)") from None
     return scene_from_dict(data, source=str(p))
+
+
+# ---- key documentation (docs/scene-reference.md) ---------------------------------------
+# A self-contained block: the unit and meaning of every scene key, and the default where
+# it is not a plain dataclass default. ``winder.scene_reference`` joins it with _SPEC,
+# _PART_SPEC, _MAX and _CHOICES (type, range, required) into docs/scene-reference.md; a
+# test regenerates that file and fails when it is stale, and fails on a key of the
+# schemas missing here. Keys of a scene of parts that repeat a single-drum key
+# (``drum[] radius`` is ``drum radius``) fall back to it through _KEY_DOC_ALIAS.
+
+#: (table of _SPEC/_PART_SPEC, key) -> (unit, meaning, default text or None: the
+#: dataclass default, or "required").
+_KEY_DOC: dict[tuple[str, str], tuple[str, str, str | None]] = {
+    ("scene", "name"): ("-", "the scene's name, in titles, messages and the result",
+                        "the file name without .toml"),
+    ("scene", "duration"): ("s", "simulated time of a run", None),
+    ("scene", "output_step"): ("s", "time between result samples; at most duration, and "
+                               "at most 1e7 samples per run", None),
+    ("scene", "gravity"): ("m/s²", "gravitational acceleration g, along −z", None),
+    ("effects", "variable_mass"): ("-", "the −Ẏv force of mass that joins a body from "
+                                   "rest; off: m(r) and J(r) still follow the radius, the "
+                                   "term is dropped (the naive overwrite)", None),
+    ("effects", "web_momentum"): ("-", "the momentum flux ṁ u the web brings into a wound "
+                                  "roll (and the leaving paper takes out of an unwinding "
+                                  "one)", None),
+    ("effects", "web_tension"): ("-", "the web tension's pull on the wound roll at its "
+                                 "entry nip (and on the unwinding roll)", None),
+    ("effects", "gravity"): ("-", "gravity; off: g = 0", None),
+    ("effects", "imbalance"): ("-", "the centre-of-mass offset com_offset; off: e = 0",
+                               None),
+    ("effects", "contact"): ("-", "the nips' normal and friction forces", None),
+    ("effects", "slip_relaxation"): ("-", "the friction force relaxes towards the "
+                                     "steady slip force over relaxation_length (a state "
+                                     "per nip); off: F_t = F_ss; needs contact", None),
+    ("effects", "rider_load"): ("-", "the riders' applied line load; off: only their "
+                                "weight", None),
+    ("drum", "radius"): ("m", "drum radius R", None),
+    ("drum", "inertia"): ("kg·m²", "polar moment of inertia J_d about the drum axis", None),
+    ("drum", "mass"): ("kg", "drum mass", None),
+    ("drum.drive", "kind"): ("-", "speed_profile: the drum's speed is prescribed, its "
+                             "torque follows from inverse dynamics; torque: the drum is "
+                             "free and driven by an input torque", None),
+    ("drum.drive", "web_acceleration"): ("m/s²", "ramp of the surface (web) speed a_w; "
+                                         "0: full speed from t = 0", None),
+    ("drum.drive", "web_speed"): ("m/s", "speed_profile: the surface speed v_w the ramp "
+                                  "reaches; torque: the initial surface speed",
+                                  "required (kind speed_profile); 0 (kind torque)"),
+    ("drum.drive", "torque"): ("N·m", "kind torque: the drive torque (operation sense), "
+                               "constant or an input", None),
+    ("roll", "core_radius"): ("m", "outer radius r_c of the empty core", None),
+    ("roll", "core_mass"): ("kg", "mass of the core", None),
+    ("roll", "core_inertia"): ("kg·m²", "polar inertia of the core about its axis", None),
+    ("roll", "width"): ("m", "roll width L (cross-machine)", None),
+    ("roll", "initial_radius"): ("m", "radius at t = 0; at least core_radius",
+                                 "core_radius"),
+    ("roll", "initial_speed"): ("rad/s", "speed at t = 0 (operation sense)", None),
+    ("roll", "com_offset"): ("m", "distance e of the centre of mass from the roll axis "
+                             "(imbalance); below min(core_radius, √(core_inertia / "
+                             "core_mass))", None),
+    ("roll", "initial_height"): ("m", "height z of the roll axis at t = 0, above the drum "
+                                 "radius (e.g. to drop the roll onto the drum)",
+                                 "static balance on the nip"),
+    ("paper", "density"): ("kg/m³", "paper density ρ", None),
+    ("paper", "caliper"): ("m", "paper thickness h, added to the radius once per "
+                           "revolution", None),
+    ("contact", "law"): ("-", "linear: F_n = max(0, k δ + c δ̇); hunt_crossley: F_n = "
+                         "max(0, k δ^p (1 + α δ̇))", None),
+    ("contact", "stiffness"): ("N/m (N/m^p)", "stiffness k of the nip", None),
+    ("contact", "damping"): ("N·s/m", "damping c of the linear law", None),
+    ("contact", "exponent"): ("-", "exponent p of the Hunt–Crossley law", None),
+    ("contact", "hc_damping"): ("s/m", "damping α of the Hunt–Crossley law", None),
+    ("friction", "mu"): ("-", "friction coefficient μ: F_ss = μ F_n tanh(v_s / v_ref)",
+                         None),
+    ("friction", "slip_velocity"): ("m/s", "slip velocity scale v_ref of the tanh law",
+                                    None),
+    ("friction", "relaxation_length"): ("m", "relaxation length σ: dF_t/dt = (|u_a| + "
+                                        "v_min)/σ (F_ss − F_t)", None),
+    ("friction", "min_speed"): ("m/s", "speed v_min added in the relaxation rate (keeps it "
+                                "finite at standstill)", None),
+    ("solver", "method"): ("-", "integrator; auto is DOPRI5", None),
+    ("solver", "rtol"): ("-", "relative tolerance", None),
+    ("solver", "atol"): ("state units", "absolute tolerance", None),
+    ("solver", "max_rhs"): ("-", "budget: most right-hand side evaluations of a run (a "
+                            "whole number)", None),
+    ("solver", "backend"): ("-", "compiled: the generated code; pinocchio: the numeric "
+                            "Pinocchio path (the cross-check)", None),
+    ("solver", "max_wall"): ("s", "budget: most wall-clock time of a run", None),
+    ("drum[]", "name"): ("-", "the part's name (unique; names its channels)", "required"),
+    ("drum[]", "centre"): ("m", "axis position [x, z]", None),
+    ("drum[]", "sense"): ("-", "operation direction: +1 turns the top surface towards +x",
+                          None),
+    ("drum[]", "drive"): ("-", "the drive, a sub-table: keys below", None),
+    ("drum[].drive", "ratio"): ("-", "kind speed_profile: the drum runs at ratio × the "
+                                "profile's surface speed", None),
+    ("roll[]", "name"): ("-", "the part's name (unique; names its channels)", None),
+    ("roll[]", "kind"): ("-", "wound: grows, ṙ = +h·speed/2π; unwinding: shrinks, ṙ = "
+                         "−h·speed/2π, fixed centre, feeds [web.span]; the run ends where "
+                         "it reaches its core", None),
+    ("roll[]", "centre"): ("m", "axis position [x, z]: the initial guess of the free "
+                           "coordinates (static balance), the value of the fixed ones", None),
+    ("roll[]", "free"): ("-", "the axes its centre moves along", '["z"] (wound), [] '
+                         "(unwinding)"),
+    ("roll[]", "sense"): ("-", "operation direction: −1 turns the bottom surface towards "
+                          "+x (a roll on a drum)", None),
+    ("roll[]", "density"): ("kg/m³", "paper density ρ", "[paper] density"),
+    ("roll[]", "caliper"): ("m", "paper thickness h", "[paper] caliper"),
+    ("roll[]", "drive"): ("-", "unwinding rolls only: the unwind drive, a sub-table: keys "
+                          "below", "none (free)"),
+    ("roll[].drive", "kind"): ("-", "torque: a torque (negative brakes); tension_control: "
+                               "the unwind holds the span tension by PI with inertia "
+                               "feed-forward, gains from bandwidth", None),
+    ("roll[].drive", "torque"): ("N·m", "kind torque: the unwind torque (operation sense), "
+                                 "constant or an input", None),
+    ("roll[].drive", "tension"): ("N", "kind tension_control: the tension set-point T*",
+                                  "required (kind tension_control)"),
+    ("roll[].drive", "bandwidth"): ("rad/s", "kind tension_control: the closed loop's "
+                                    "bandwidth ω_c (its three poles at −ω_c)", None),
+    ("rider[]", "name"): ("-", "the part's name (unique; names its channels)", None),
+    ("rider[]", "rides"): ("-", "name of the paper roll it rests on (through a [[nip]] "
+                           "with a = that roll, b = the rider)", None),
+    ("rider[]", "radius"): ("m", "rider radius (constant)", None),
+    ("rider[]", "mass"): ("kg", "rider mass", None),
+    ("rider[]", "inertia"): ("kg·m²", "polar inertia of the rider", None),
+    ("rider[]", "x"): ("m", "horizontal position of its axis (fixed; it moves along z)",
+                       None),
+    ("rider[]", "load"): ("m, N/m", "line-load schedule [[radius of the ridden roll, line "
+                          "load], ...], radii strictly increasing, interpolated linearly, "
+                          "held beyond the ends; the force is −width × load along z",
+                          "[] (no load)"),
+    ("nip[]", "name"): ("-", "the part's name (unique; names its channels)", None),
+    ("nip[]", "a"): ("-", "the lower or supplying body (the drum under a roll, the roll "
+                     "under a rider)", None),
+    ("nip[]", "b"): ("-", "the other body", None),
+    ("nip[]", "contact"): ("-", "the contact law, a sub-table: the keys of [contact]",
+                           "required while effects.contact is on"),
+    ("nip[]", "friction"): ("-", "the friction law, a sub-table: the keys of [friction]",
+                            None),
+    ("web", "entry_nip"): ("-", "the nip where the web enters the wound roll (a: the drum "
+                           "it wraps, b: the roll)", None),
+    ("web", "tension"): ("N", "constant web tension (not with [web.span])", None),
+    ("web", "span"): ("-", "an elastic span from an unwinding roll, a sub-table: keys "
+                      "below", "none"),
+    ("web.span", "from"): ("-", "the unwinding roll that feeds the span", None),
+    ("web.span", "length"): ("m", "span length L_s", None),
+    ("web.span", "EA"): ("N", "axial stiffness EA of the web", None),
+    ("web.span", "T_in"): ("N", "tension wound into the unwinding roll", None),
+    ("web.span", "initial_tension"): ("N", "span tension at t = 0", "T_in"),
+}
+#: Tables of a scene of parts whose keys, where not in _KEY_DOC, are those of a
+#: single-drum table.
+_KEY_DOC_ALIAS = {"drum[]": "drum", "drum[].drive": "drum.drive", "roll[]": "roll",
+                  "nip[].contact": "contact", "nip[].friction": "friction"}
+
+
+def key_doc(table: str, key: str) -> tuple[str, str, str | None]:
+    """``(unit, meaning, default text or None)`` of ``key`` of the schema table ``table``
+    (a table of ``_SPEC`` or ``_PART_SPEC``); KeyError where it is not documented."""
+    if (table, key) in _KEY_DOC:
+        return _KEY_DOC[(table, key)]
+    if table in _KEY_DOC_ALIAS:
+        alias = _KEY_DOC_ALIAS[table]
+        if (alias, key) in _KEY_DOC:
+            return _KEY_DOC[(alias, key)]
+        if table == "roll[]" and ("paper", key) in _KEY_DOC:
+            return _KEY_DOC[("paper", key)]
+    raise KeyError((table, key))

@@ -321,7 +321,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         atomic_write(csv, csv_writer(mm.as_columns(), fmt="%.10g"))
         print(f"  table written to {csv}")
     if plot is not None:
-        from ._plots import campbell_figure
+        from ._plots import campbell_figure, nip_colours
         from ._simulate import simulate
 
         result = None
@@ -332,7 +332,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
             n.name: (f"{n.name}_normal_force", f"{mm.roll}_radius") for n in scene.nips
             if mm.roll in (n.a, n.b)}
         path = campbell_figure(mm, plot, result=result, envelopes=nips or None,
-                               title=f"Resonance map of {scene.name}")
+                               title=f"Resonance map of {scene.name}",
+                               colours=nip_colours(scene))
         print(f"  figure written to {path}")
     return 0
 

@@ -1,0 +1,198 @@
+"""The README's quoted numbers of the two-drum winder and the winder line, computed from
+the demo's results (``make readme-numbers``): prints a table to paste.
+
+Reads ``out/two_drum_winder.npz`` and ``out/winder_line.npz`` (written by ``make demo``)
+where they exist and were run from the current scene files at the default settings;
+otherwise runs the scene (minutes on a loaded machine) and writes the result there. The
+three rider-load variants the README compares are kept the same way as
+``out/two_drum_winder_variant<i>.npz``.
+
+Run:  python benchmarks/readme_numbers.py [--out out] [--rerun]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import winder
+from winder._plots import normal_force_envelope, window_mean
+
+ROOT = Path(__file__).resolve().parents[1]
+MODELS = ROOT / "models"
+
+
+#: The rider-load variants of the two-drum winder the README compares: name -> the
+#: rider's line-load schedule [[set radius m, N/m], ...].
+VARIANTS = {"load held at 3 kN/m": [[0.05, 3000.0]],
+            "light rider, 0.3 kN/m throughout": [[0.05, 300.0]],
+            "no applied load": [[0.05, 0.0]]}
+
+
+def result_of(model: str, out: Path, *, rerun: bool = False, load: list | None = None,
+              tag: str = "") -> winder.Result:
+    """The default run of ``models/<model>.toml`` (with the rider's ``load`` schedule
+    replaced, if given, saved as ``<model>_<tag>.npz``): ``out/<model>.npz`` if it holds
+    that run (same scene, default method and tolerances, whole duration), else a new run,
+    saved there."""
+    scene = winder.load_scene(MODELS / f"{model}.toml")
+    if load is not None:
+        scene = scene.replace(rider={scene.riders[0].name: {"load": load}})
+    path = out / (f"{model}_{tag}.npz" if tag else f"{model}.npz")
+    if path.is_file() and not rerun:
+        res = winder.load_result(path)
+        same = (json.dumps(res.meta.get("scene_dict"), sort_keys=True)
+                == json.dumps(scene.to_dict(), sort_keys=True)
+                and res.meta.get("rtol") == scene.solver.rtol
+                and abs(float(res.t[-1]) - scene.scene.duration) < 1e-9)
+        if same:
+            print(f"{path}: reused", file=sys.stderr)
+            return res
+        print(f"{path}: from another scene or settings; running again", file=sys.stderr)
+    print(f"running {path.stem} (a few minutes) ...", file=sys.stderr, flush=True)
+    res = winder.simulate(scene, progress=sys.stderr.isatty())
+    out.mkdir(parents=True, exist_ok=True)
+    res.to_npz(path)
+    return res
+
+
+def two_drum_numbers(res: winder.Result) -> list[tuple[str, str]]:
+    """The two-drum winder section: nip forces, the bounce band, its open shares, peaks,
+    bounces."""
+    t = res.t
+    nips = ("front_nip", "rear_nip", "rider_nip")
+    f = {n: res[f"{n}_normal_force"] for n in nips}
+    r = res["set_radius"]
+    rows: list[tuple[str, str]] = []
+    rows.append(("nip forces at rest (t = 0) [kN]",
+                 ", ".join(f"{n} {f[n][0] / 1e3:.1f}" for n in nips)))
+    opened = {n: np.flatnonzero(f[n] <= 0.0) for n in nips}
+    firsts = {n: int(o[0]) for n, o in opened.items() if len(o)}
+    if not firsts:
+        rows.append(("bounce band", "no nip opens"))
+        return rows
+    i0 = min(firsts.values())
+    i1 = max(int(o[-1]) for o in opened.values() if len(o))
+    band = slice(i0, i1 + 1)
+    rows.append(("bounce band: first to last opening of any nip",
+                 f"t = {t[i0]:.1f}–{t[i1]:.1f} s, r = {r[i0]:.3f}–{r[i1]:.3f} m"))
+    rows.append(("first opening per nip (set radius) [m]",
+                 ", ".join(f"{n} {r[i]:.3f}" for n, i in sorted(firsts.items(),
+                                                                  key=lambda kv: kv[1]))))
+    rows.append(("share of samples open, inside the band [%]",
+                 ", ".join(f"{n} {100 * np.mean(f[n][band] <= 0):.1f}" for n in nips)))
+    rows.append(("share of samples open, whole run [%]",
+                 ", ".join(f"{n} {100 * np.mean(f[n] <= 0):.1f}" for n in nips)))
+    rows.append(("force peak inside the band [kN]",
+                 ", ".join(f"{n} {np.max(f[n][band]) / 1e3:.1f}" for n in nips)))
+    tm = window_mean(t, t)[0]
+    winding = (tm > 65.0) & ((tm < t[i0]) | (tm > t[i1]))  # after the ramp, off the band
+    rows.append(("nip force while winding outside the band (t > 65 s), 0.5 s means [kN]",
+                 ", ".join(f"{n} {np.min(window_mean(t, f[n])[1][winding]) / 1e3:.1f}–"
+                           f"{np.max(window_mean(t, f[n])[1][winding]) / 1e3:.1f}"
+                           for n in nips)))
+    for body in ("rider", "set"):
+        z = res[f"{body}_z"]
+        bounce = 1e3 * (z - np.interp(t, *window_mean(t, z)))
+        rows.append((f"{body} bounce in the band, z less its 0.5 s mean [mm]",
+                     f"+{np.max(bounce[band]):.2f} / {np.min(bounce[band]):.2f}"))
+    x = res["set_x"]
+    rows.append(("set x in the band, relative to its value at the band's start [mm]",
+                 f"{1e3 * (np.min(x[band]) - x[i0]):+.2f} to "
+                 f"{1e3 * (np.max(x[band]) - x[i0]):+.2f} (front drum at x < 0)"))
+    after = t > t[i1]
+    if np.any(after):
+        half = []
+        for n in nips:
+            _, lo, hi, _ = normal_force_envelope(res, force=f"{n}_normal_force",
+                                                 radius="set_radius")
+            tw = window_mean(t, t)[0]
+            k = tw[: len(hi)] > t[i1]
+            half.append(np.max((hi - lo)[k]) / 2 if np.any(k) else 0.0)
+        rows.append(("above the band: largest half peak-to-peak force over 0.5 s [kN]",
+                     ", ".join(f"{n} {h / 1e3:.1f}" for n, h in zip(nips, half, strict=True))))
+    return rows
+
+
+def variant_numbers(res: winder.Result) -> str:
+    """Whether and where a variant's nips open: first opening radius, shares open (whole
+    run and inside its band), the peak force."""
+    nips = ("front_nip", "rear_nip", "rider_nip")
+    f = {n: res[f"{n}_normal_force"] for n in nips}
+    peak = max(float(np.max(v)) for v in f.values())
+    tpeak = res.t[int(np.argmax(np.max(np.array(list(f.values())), axis=0)))]
+    opened = np.flatnonzero(np.any(np.array(list(f.values())) <= 0.0, axis=0))
+    if not len(opened):
+        return f"no nip opens; peak force {peak / 1e3:.1f} kN at t = {tpeak:.1f} s"
+    i0, i1 = int(opened[0]), int(opened[-1])
+    r = res["set_radius"]
+    band = slice(i0, i1 + 1)
+    return (f"band r = {r[i0]:.3f}–{r[i1]:.3f} m; open, whole run: "
+            + ", ".join(f"{n} {100 * np.mean(f[n] <= 0):.1f} %" for n in nips)
+            + "; inside the band: "
+            + ", ".join(f"{n} {100 * np.mean(f[n][band] <= 0):.1f} %" for n in nips)
+            + f"; peak force {peak / 1e3:.1f} kN")
+
+
+def line_numbers(res: winder.Result, ramp_end: float) -> list[tuple[str, str]]:
+    """The winder line section: the tension error at the ramp's start and end, its RMS,
+    inside the bounce band, and the unwind torque."""
+    t, e = res.t, res["tension_error"]
+    rows: list[tuple[str, str]] = []
+    start = t < 5.0
+    i = int(np.argmax(np.abs(np.where(start, e, 0.0))))
+    rows.append(("tension error peak at the ramp's start (t < 5 s) [N]",
+                 f"{e[i]:+.3f} at t = {t[i]:.2f} s"))
+    end = np.abs(t - ramp_end) < 5.0
+    j = int(np.argmax(np.abs(np.where(end, e, 0.0))))
+    rows.append((f"tension error peak at the ramp's end ({ramp_end:.2f} ± 5 s) [N]",
+                 f"{e[j]:+.3f} at t = {t[j]:.2f} s"))
+    rows.append(("tension error RMS over the run [N]", f"{np.sqrt(np.mean(e ** 2)):.3g}"))
+    f = [res[f"{n}_normal_force"] for n in ("front_nip", "rear_nip", "rider_nip")]
+    open_any = np.flatnonzero(np.any(np.array(f) <= 0.0, axis=0))
+    if len(open_any):
+        band = slice(int(open_any[0]), int(open_any[-1]) + 1)
+        rows.append((f"largest |tension error| in the bounce band (t = {t[open_any[0]]:.1f}–"
+                     f"{t[open_any[-1]]:.1f} s) [N]", f"{np.max(np.abs(e[band])):.2g}"))
+    tau = res["parent_torque"] / 1e3
+    late = t > ramp_end + 5.0
+    rows.append(("unwind torque: peak during the ramp; range after it [kN m]",
+                 f"{np.max(tau[t <= ramp_end]):+.2f}; {np.min(tau[late]):+.2f} to "
+                 f"{np.max(tau[late]):+.2f}"))
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=ROOT / "out",
+                    help="the demo's output folder (default out/)")
+    ap.add_argument("--rerun", action="store_true", help="run the scenes even if out/ has them")
+    args = ap.parse_args(argv)
+    two = result_of("two_drum_winder", args.out, rerun=args.rerun)
+    line = result_of("winder_line", args.out, rerun=args.rerun)
+    drive = winder.load_scene(MODELS / "two_drum_winder.toml").drums[0].drive
+    ramp_end = drive.web_speed / drive.web_acceleration
+    variants = [(name, variant_numbers(result_of("two_drum_winder", args.out,
+                                                 rerun=args.rerun, load=load,
+                                                 tag=f"variant{i}")))
+                for i, (name, load) in enumerate(VARIANTS.items())]
+    runs = [(f"{name}: run", f"{r.meta['method']} at rtol {r.meta['rtol']:g}: "
+             f"{r.meta['wall_time']:.1f} s wall, {r.meta['rhs_evaluations'] / 1e6:.1f} M "
+             f"evaluations, {r.meta['events']:,} located events")
+            for name, r in (("two_drum_winder", two), ("winder_line", line))]
+    print("| quantity | value |\n|---|---|")
+    for title, rows in (("two_drum_winder", two_drum_numbers(two)),
+                        ("two_drum_winder, rider load", variants),
+                        ("winder_line", line_numbers(line, ramp_end)),
+                        ("integration", runs)):
+        for name, value in rows:
+            print(f"| {title}: {name} | {value} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

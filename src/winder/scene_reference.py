@@ -1,0 +1,327 @@
+"""The scene reference (``docs/scene-reference.md``), generated from the scene schema.
+
+Every table and key of both scene formats with its type, unit, range, default and
+meaning, joined from the declarations in :mod:`winder._scene` (``_SPEC``, ``_PART_SPEC``,
+``_MAX``, ``_CHOICES``, ``_KEY_DOC``) and the parts' dataclass defaults, then the result
+channels. Regenerate with ``make scene-reference`` or::
+
+    python -m winder.scene_reference [--out docs/scene-reference.md] [--check]
+
+``--check`` writes nothing and exits 1 when the file differs from what the schema gives.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import re
+import sys
+from pathlib import Path
+
+from . import _scene as sc
+from .parts import (
+    ContactLaw,
+    DrumPart,
+    FrictionLaw,
+    NipPart,
+    RiderPart,
+    RollPart,
+    SpanPart,
+    SpeedProfileDrive,
+    TensionControl,
+    TorqueDrive,
+    UnwindTorqueDrive,
+    WebPart,
+)
+from .solve.system import CHANNELS, EXTRA_CHANNELS
+
+__all__ = ["reference", "main", "CHANNEL_DOC", "LEGACY_CHANNEL_DOC"]
+
+#: The dataclasses whose defaults a schema table's keys take (the first that has the
+#: field; ``from`` of ``[web.span]`` is the field ``source``).
+_DEFAULTS_FROM: dict[str, tuple[type, ...]] = {
+    "scene": (sc.SceneInfo,), "effects": (sc.Effects,), "drum": (sc.Drum,),
+    "drum.drive": (sc.Drive,), "roll": (sc.Roll,), "paper": (sc.Paper,),
+    "contact": (ContactLaw,), "friction": (FrictionLaw,), "solver": (sc.Solver,),
+    "drum[]": (DrumPart,), "drum[].drive": (SpeedProfileDrive, TorqueDrive),
+    "roll[]": (RollPart,), "roll[].drive": (UnwindTorqueDrive, TensionControl),
+    "rider[]": (RiderPart,), "nip[]": (NipPart,), "nip[].contact": (ContactLaw,),
+    "nip[].friction": (FrictionLaw,), "web": (WebPart,), "web.span": (SpanPart,),
+}
+
+#: Result channels of a single-drum scene: name -> (unit, meaning).
+LEGACY_CHANNEL_DOC: dict[str, tuple[str, str]] = {
+    "t": ("s", "time"),
+    "drum_speed": ("rad/s", "drum speed Ω (operation sense)"),
+    "drum_torque": ("N·m", "drum drive torque (inverse dynamics for a speed profile, the "
+                           "input for a torque drive)"),
+    "roll_speed": ("rad/s", "roll speed ω (operation sense)"),
+    "roll_accel": ("rad/s²", "roll angular acceleration ω̇"),
+    "roll_angle": ("rad", "roll angle φ (operation sense)"),
+    "radius": ("m", "roll radius r"),
+    "mass": ("kg", "roll mass m(r)"),
+    "inertia": ("kg·m²", "roll polar inertia J(r) about its axis"),
+    "mass_rate": ("kg/s", "ṁ"),
+    "inertia_rate": ("kg·m²/s", "J̇"),
+    "z": ("m", "height of the roll axis above the drum axis"),
+    "z_dot": ("m/s", "ż"),
+    "normal_force": ("N", "nip normal force F_n on the roll (0: in the air)"),
+    "friction_force": ("N", "nip friction force F_t on the roll, along +x"),
+    "slip_velocity": ("m/s", "slip v_s = Ω R − ω r"),
+    "drum_angle": ("rad", "drum angle"),
+    "web_speed": ("m/s", "surface speed of the drum the web wraps, Ω R"),
+    "z_accel": ("m/s²", "z̈"),
+    "web_force": ("N", "web momentum force ṁ u on the roll"),
+    "penetration": ("m", "nip penetration δ = R + r − z (negative: open)"),
+}
+
+#: Result channels of a scene of parts: name pattern -> (unit, meaning). ``BODY`` is any
+#: drum, roll or rider, ``ROLL`` a paper roll, ``RIDER`` a rider, ``NIP`` a nip.
+CHANNEL_DOC: dict[str, tuple[str, str]] = {
+    "t": ("s", "time"),
+    "BODY_speed": ("rad/s", "speed in the body's operation sense (s θ̇)"),
+    "BODY_angle": ("rad", "angle in the operation sense (s θ)"),
+    "BODY_accel": ("rad/s²", "angular acceleration in the operation sense"),
+    "BODY_torque": ("N·m", "driven body: its drive torque (inverse dynamics for a speed "
+                           "profile, the input or the controller's torque otherwise); "
+                           "undriven body: the torque of the nip friction and web forces "
+                           "about its axis; operation sense, without gravity, imbalance "
+                           "and −Ẏv"),
+    "BODY_x": ("m", "centre x, for a body free along x"),
+    "BODY_x_dot": ("m/s", "ẋ"),
+    "BODY_x_accel": ("m/s²", "ẍ"),
+    "BODY_z": ("m", "centre z, for a body free along z"),
+    "BODY_z_dot": ("m/s", "ż"),
+    "BODY_z_accel": ("m/s²", "z̈"),
+    "ROLL_radius": ("m", "radius r of a paper roll"),
+    "ROLL_mass": ("kg", "mass m(r)"),
+    "ROLL_inertia": ("kg·m²", "polar inertia J(r) about its axis"),
+    "ROLL_mass_rate": ("kg/s", "ṁ (negative for an unwinding roll)"),
+    "ROLL_inertia_rate": ("kg·m²/s", "J̇"),
+    "RIDER_load": ("N", "applied rider load along z (negative: downwards)"),
+    "NIP_normal_force": ("N", "normal force F_n (0: open)"),
+    "NIP_friction_force": ("N", "friction force F_t, on b along +t"),
+    "NIP_slip_velocity": ("m/s", "slip v_s = u_a − u_b"),
+    "NIP_penetration": ("m", "penetration δ = r_a + r_b − |c_b − c_a| (negative: open)"),
+    "web_speed": ("m/s", "surface speed of the drum at the entry nip"),
+    "web_force": ("N", "web momentum force ṁ u on the wound roll"),
+    "span_tension": ("N", "web span tension T (a state; the forces use max(T, 0))"),
+    "tension_error": ("N", "the unwind controller's error T* − T"),
+}
+
+
+def _kind_text(table: str, key: str, kind: str) -> str:
+    choices = sc._CHOICES.get((table, key))
+    if choices:
+        return "string: " + ", ".join(f"`{c}`" for c in choices)
+    return {"num": "number", "bool": "boolean", "str": "string", "name": "name",
+            "ref": "name of a part", "pair": "[x, z]", "sense": "+1 or −1",
+            "axes": 'list of "x", "z"', "load": "list of [radius, line_load]",
+            "table": "sub-table"}[kind]
+
+
+def _num(x: float) -> str:
+    """``x`` as in a scene file: 1e6, not 1e+06."""
+    return re.sub(r"e([+-])0*(\d)", lambda m: "e" + m.group(1).replace("+", "") + m.group(2),
+                  f"{x:g}")
+
+
+def _range_text(table: str, key: str, kind: str, bound: tuple | None) -> str:
+    if kind == "num":
+        hi = sc._MAX.get((table, key))
+        if bound is None:
+            return f"\\|x\\| ≤ {_num(hi)}" if hi is not None else "any finite"
+        lo, lo_open = bound
+        left = f"({_num(lo)}" if lo_open else f"[{_num(lo)}"
+        if (table, key) == ("solver", "max_wall"):
+            return f"{left}, ∞)"
+        return f"{left}, {_num(hi)}]" if hi is not None else f"{left}, ∞)"
+    if kind == "pair":
+        return f"each \\|·\\| ≤ {_num(sc.MAX_COORD)}"
+    if kind == "name":
+        return "1–40 letters, digits, _ or -, first a letter or _"
+    if kind == "load":
+        return (f"radius (0, {_num(sc.MAX_LOAD_RADIUS)}], line load "
+                f"[0, {_num(sc.MAX_LINE_LOAD)}]")
+    if (table, key) == ("scene", "name"):
+        return f"1–{sc.MAX_NAME} printable characters"
+    return ""
+
+
+def _default_text(table: str, key: str, required: bool, given: str | None) -> str:
+    if given is not None:
+        return given
+    if required:
+        return "required"
+    field = "source" if key == "from" else key
+    for cls in _DEFAULTS_FROM.get(table, ()):
+        for f in dataclasses.fields(cls):
+            if f.name == field and f.default is not dataclasses.MISSING:
+                v = f.default
+                if v is None:
+                    return "none"
+                if isinstance(v, bool):
+                    return "true" if v else "false"
+                if isinstance(v, str):
+                    return f'"{v}"'
+                if isinstance(v, tuple):
+                    return "[" + ", ".join(f'"{x}"' if isinstance(x, str) else _num(x)
+                                           for x in v) + "]"
+                return _num(v)
+            if f.name == field and f.default_factory is not dataclasses.MISSING:
+                return "see its keys"
+    return "—"
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")
+
+
+def _table(table: str, spec: dict[str, tuple], skip: tuple[str, ...] = ()) -> list[str]:
+    lines = ["| key | type | unit | range | default | meaning |", "|---|---|---|---|---|---|"]
+    for key, (kind, required, bound) in spec.items():
+        if key in skip:
+            continue
+        unit, meaning, given = sc.key_doc(table, key)
+        lines.append(f"| `{key}` | {_cell(_kind_text(table, key, kind))} | {_cell(unit)} | "
+                     f"{_range_text(table, key, kind, bound)} | "
+                     f"{_cell(_default_text(table, key, required, given))} | "
+                     f"{_cell(meaning)} |")
+    return lines
+
+
+#: Headings of the schema tables (TOML spelling).
+_HEADINGS = {
+    "scene": "[scene]", "effects": "[effects]", "solver": "[solver]", "paper": "[paper]",
+    "drum": "[drum]", "drum.drive": "[drum.drive]", "roll": "[roll]",
+    "contact": "[contact]", "friction": "[friction]",
+    "drum[]": "[[drum]]", "drum[].drive": "[[drum]] drive",
+    "roll[]": "[[roll]]", "roll[].drive": "[[roll]] drive (unwinding rolls)",
+    "rider[]": "[[rider]]", "nip[]": "[[nip]]", "nip[].contact": "[[nip]] contact",
+    "nip[].friction": "[[nip]] friction", "web": "[web]", "web.span": "[web.span]",
+}
+_DRIVE_NOTE = {
+    "paper": "The default paper of every roll: optional in a scene of parts (each "
+             "`[[roll]]` may give its own `density` and `caliper`), required in the "
+             "single-drum format. Where the table is given, both keys are required.",
+    "drum.drive": "Keys by kind: " + "; ".join(
+        f"`{k}`: {', '.join(v)}" for k, v in sc._DRIVE_KEYS.items() if k != "speed_profile")
+    + "; `speed_profile`: kind, web_acceleration, web_speed.",
+    "drum[].drive": "Keys by kind: " + "; ".join(
+        f"`{k}`: {', '.join(v)}" for k, v in sc._DRIVE_KEYS.items()) + ".",
+    "roll[].drive": "Keys by kind: " + "; ".join(
+        f"`{k}`: {', '.join(v)}" for k, v in sc._UNWIND_DRIVE_KEYS.items()) + ".",
+}
+
+
+def _section(table: str, spec: dict[str, tuple], skip: tuple[str, ...] = ()) -> list[str]:
+    out = [f"### `{_HEADINGS[table]}`", ""]
+    if table in _DRIVE_NOTE:
+        out += [_DRIVE_NOTE[table], ""]
+    return out + _table(table, spec, skip) + [""]
+
+
+def reference() -> str:
+    """The text of ``docs/scene-reference.md`` (Markdown)."""
+    lines = [
+        "# Scene reference",
+        "",
+        "<!-- Generated by `python -m winder.scene_reference` (make scene-reference) from "
+        "the scene schema in src/winder/_scene.py; do not edit by hand. -->",
+        "",
+        "Scene files are TOML. There are two formats: **scenes of parts** (arrays of "
+        "tables `[[drum]]`, `[[roll]]`, `[[rider]]`, `[[nip]]` and a `[web]` table) and "
+        "the **single-drum format** (single tables `[drum]`, `[roll]`, `[contact]`, "
+        "`[friction]`: one drum, one roll, one nip). `[scene]`, `[effects]` and `[solver]` "
+        "are common to both. Units are SI; the physics behind each key (frames, senses, "
+        "the nip and mass laws) is in [model.md](model.md).",
+        "",
+        "An unknown table or key, a missing required key, a wrong type, a non-finite value "
+        "or one outside its range stops the run with exit status 2 and a message naming "
+        "the file, the table (an element of an array by its name) and the key. Inline "
+        "tables (`drive = { kind = \"torque\" }`) and sub-tables written after their array "
+        "element (`[[drum]]` then `[drum.drive]`) are the same TOML. Ranges: `(a, b]` "
+        "excludes a, `[a, b]` includes it; `|x| ≤ b` bounds the magnitude.",
+        "",
+        "## Tables of both formats",
+        "",
+    ]
+    for t in ("scene", "effects", "solver"):
+        lines += _section(t, sc._SPEC[t])
+    lines += ["## Scenes of parts", "",
+              "A part's name names its result channels and its sweep key paths "
+              "(`nip.rear_nip.contact.stiffness`). References (`a`, `b`, `rides`, "
+              "`entry_nip`, `from`) must name an existing part of the right kind. Every "
+              "wound roll needs a web entering it at a nip whose `a` is a drum.", ""]
+    lines += _section("paper", sc._SPEC["paper"])
+    for t in ("drum[]", "drum[].drive", "roll[]", "roll[].drive", "rider[]", "nip[]",
+              "nip[].contact", "nip[].friction", "web", "web.span"):
+        lines += _section(t, sc._PART_SPEC[t])
+    lines += ["## Single-drum format", "",
+              "Means: drum \"drum\" at the origin (sense +1), roll \"roll\" free along z "
+              "above it (sense −1), nip \"nip\" (a = drum, b = roll), web entering at "
+              "\"nip\" with tension 0. `[scene]`, `[drum]`, `[drum.drive]`, `[roll]` and "
+              "`[paper]` are required, `[contact]` while `effects.contact` is on.", ""]
+    for t in ("drum", "drum.drive", "roll", "paper", "contact", "friction"):
+        lines += _section(t, sc._SPEC[t])
+    lines += ["## Result channels", "",
+              "One column each, SI units, first column `t` (CSV and NPZ alike).", "",
+              "### Single-drum format", "",
+              "The first 16 are the standard set; the others are winder's extras.", "",
+              "| channel | unit | meaning |", "|---|---|---|"]
+    for ch in (*CHANNELS, *EXTRA_CHANNELS):
+        unit, meaning = LEGACY_CHANNEL_DOC[ch]
+        lines.append(f"| `{ch}` | {unit} | {_cell(meaning)} |")
+    lines += ["", "### Scenes of parts", "",
+              "`BODY` is the name of any drum, roll or rider, `ROLL` of a paper roll, "
+              "`RIDER` of a rider, `NIP` of a nip; `web_speed` and `web_force` exist with a "
+              "web, `span_tension` with `[web.span]`, `tension_error` with an unwind of kind "
+              "`tension_control`.", "",
+              "| channel | unit | meaning |", "|---|---|---|"]
+    for ch, (unit, meaning) in CHANNEL_DOC.items():
+        lines.append(f"| `{ch}` | {unit} | {_cell(meaning)} |")
+    return "\n".join(lines) + "\n"
+
+
+def channel_pattern(name: str, bodies: dict[str, str]) -> str | None:
+    """The :data:`CHANNEL_DOC` pattern of the channel ``name`` of a scene of parts, or
+    None; ``bodies`` maps every part name to its kind (``drum``, ``roll``, ``rider``,
+    ``nip``)."""
+    if name in CHANNEL_DOC:
+        return name
+    for part, kind in sorted(bodies.items(), key=lambda kv: -len(kv[0])):
+        if not name.startswith(part + "_"):
+            continue
+        rest = name[len(part) + 1:]
+        keys = {"nip": ("NIP",), "roll": ("ROLL", "BODY"), "rider": ("RIDER", "BODY"),
+                "drum": ("BODY",)}[kind]
+        for k in keys:
+            if f"{k}_{rest}" in CHANNEL_DOC:
+                return f"{k}_{rest}"
+    return None
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=Path("docs/scene-reference.md"),
+                    help="file to write (default docs/scene-reference.md)")
+    ap.add_argument("--check", action="store_true",
+                    help="write nothing; exit 1 if the file is not up to date")
+    args = ap.parse_args(argv)
+    text = reference()
+    if args.check:
+        old = args.out.read_text(encoding="utf-8") if args.out.is_file() else ""
+        if old != text:
+            print(f"{args.out} is stale: run make scene-reference", file=sys.stderr)
+            return 1
+        return 0
+    from ._files import atomic_write
+
+    atomic_write(args.out, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    rows = len(re.findall(r"^\| `", text, re.M))
+    print(f"wrote {args.out} ({rows} keys and channels)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,93 @@
+"""The README's numbers script (benchmarks/readme_numbers.py) against made-up results whose
+answers are known by construction: band, open shares inside it and over the whole run,
+peaks, the tension error at the ramp's ends."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import winder
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def rn():
+    spec = importlib.util.spec_from_file_location("readme_numbers",
+                                                  ROOT / "benchmarks" / "readme_numbers.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _two_drum() -> winder.Result:
+    """200 s at 0.01 s. The band is t = 100.00–139.99 s: inside it the front nip is open
+    every 4th sample (25 %), the rear every 5th (20 %) from t = 101 s, the rider every 2nd
+    (50 %) from t = 100 s; whole run: 4000 of 20 001 samples are in the band."""
+    t = np.round(np.arange(20_001) * 0.01, 10)
+    n = t.size
+    i = np.arange(n)
+    radius = 0.05 + 0.55 * t / 200.0
+    front = np.full(n, 20e3)
+    rear = np.full(n, 20e3)
+    rider = np.full(n, 15e3)
+    band = (i >= 10_000) & (i < 14_000)
+    front[band & (i % 4 == 0)] = 0.0
+    rear[band & (i % 5 == 0) & (i >= 10_100)] = 0.0
+    rider[band & (i % 2 == 0)] = 0.0
+    front[12_001] = 79.2e3  # the peaks, inside the band
+    rear[12_003] = 66.5e3
+    rider[12_005] = 64.4e3
+    rider[13_998] = 0.0  # the last opening of any nip: t = 139.98 s
+    zeros = np.zeros(n)
+    return winder.Result({"t": t, "front_nip_normal_force": front,
+                          "rear_nip_normal_force": rear, "rider_nip_normal_force": rider,
+                          "set_radius": radius, "set_z": 0.4 + zeros, "rider_z": 1.0 + zeros,
+                          "set_x": zeros})
+
+
+def test_two_drum_numbers_known_by_construction(rn):
+    rows = dict(rn.two_drum_numbers(_two_drum()))
+    r = lambda tt: 0.05 + 0.55 * tt / 200.0  # noqa: E731
+    assert rows["bounce band: first to last opening of any nip"] == \
+        f"t = 100.0–140.0 s, r = {r(100.0):.3f}–{r(139.98):.3f} m"
+    assert rows["first opening per nip (set radius) [m]"] == \
+        f"front_nip {r(100.0):.3f}, rider_nip {r(100.0):.3f}, rear_nip {r(101.0):.3f}"
+    n_band = 13_998 - 10_000 + 1
+    front = len(range(10_000, 13_999, 4))
+    rear = len(range(10_100, 13_999, 5))
+    rider = len(range(10_000, 13_999, 2))  # 13 998 is even: already counted
+    assert rows["share of samples open, inside the band [%]"] == (
+        f"front_nip {100 * front / n_band:.1f}, rear_nip {100 * rear / n_band:.1f}, "
+        f"rider_nip {100 * rider / n_band:.1f}")
+    assert rows["share of samples open, whole run [%]"] == (
+        f"front_nip {100 * front / 20_001:.1f}, rear_nip {100 * rear / 20_001:.1f}, "
+        f"rider_nip {100 * rider / 20_001:.1f}")
+    assert rows["force peak inside the band [kN]"] == \
+        "front_nip 79.2, rear_nip 66.5, rider_nip 64.4"
+
+
+def test_line_numbers_known_by_construction(rn):
+    t = np.round(np.arange(40_001) * 0.01, 10)
+    e = 1e-3 * np.sin(t)
+    e[20] = 0.631  # t = 0.20 s
+    e[5977] = -0.558  # t = 59.77 s
+    e[5990] = 0.4
+    tau = np.where(t <= 59.57, 5.82e3 * t / 59.57, -1.05e3)
+    tau[7000] = -1.11e3
+    res = winder.Result({"t": t, "tension_error": e, "parent_torque": tau,
+                         **{f"{n}_normal_force": np.full(t.size, 1e4)
+                            for n in ("front_nip", "rear_nip", "rider_nip")}})
+    rows = dict(rn.line_numbers(res, 59.57))
+    assert rows["tension error peak at the ramp's start (t < 5 s) [N]"] == \
+        "+0.631 at t = 0.20 s"
+    assert rows["tension error peak at the ramp's end (59.57 ± 5 s) [N]"] == \
+        "-0.558 at t = 59.77 s"
+    rms = np.sqrt(np.mean(e ** 2))
+    assert rows["tension error RMS over the run [N]"] == f"{rms:.3g}"
+    assert rows["unwind torque: peak during the ramp; range after it [kN m]"] == \
+        "+5.82; -1.11 to -1.05"

@@ -1,0 +1,170 @@
+"""The scene reference (docs/scene-reference.md) is generated from the scene schema and up
+to date; its defaults are what loading gives; every result channel is documented; the
+README and docs send users to no file outside the package."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+import winder
+from winder import _scene as sc
+from winder.scene_reference import (
+    CHANNEL_DOC,
+    LEGACY_CHANNEL_DOC,
+    _num,
+    channel_pattern,
+    main,
+    reference,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "scene-reference.md"
+
+
+def test_reference_is_up_to_date():
+    """Stale file (a key, bound, unit or default changed without regenerating) fails."""
+    assert DOC.read_text(encoding="utf-8") == reference(), \
+        "docs/scene-reference.md is stale: run make scene-reference"
+    assert main(["--check", "--out", str(DOC)]) == 0
+
+
+def test_check_flags_a_stale_file(tmp_path):
+    stale = tmp_path / "ref.md"
+    stale.write_text(reference().replace("| `caliper` |", "| `thickness` |"), encoding="utf-8")
+    assert main(["--check", "--out", str(stale)]) == 1
+    assert main(["--out", str(stale)]) == 0
+    assert main(["--check", "--out", str(stale)]) == 0
+
+
+def _rows(text: str) -> dict[str, dict[str, list[str]]]:
+    """Section heading -> key -> cells of its row."""
+    out: dict[str, dict[str, list[str]]] = {}
+    head = ""
+    for line in text.splitlines():
+        if line.startswith("### "):
+            head = line[4:].strip("`")
+            out[head] = {}
+        m = re.match(r"\| `([^`]+)` \| (.*) \|$", line)
+        if m and head:
+            out[head][m.group(1)] = [c.strip() for c in re.split(r"(?<!\\)\|", m.group(2))]
+    return out
+
+
+def test_every_schema_key_is_listed_once_with_unit_and_meaning():
+    rows = _rows(reference())
+    heads = {"scene": "[scene]", "effects": "[effects]", "solver": "[solver]",
+             "paper": "[paper]", "drum": "[drum]", "drum.drive": "[drum.drive]",
+             "roll": "[roll]", "contact": "[contact]", "friction": "[friction]"}
+    tables = [(heads[t], t, spec) for t, spec in sc._SPEC.items()]
+    tables += [(h, t, sc._PART_SPEC[t]) for t, h in (
+        ("drum[]", "[[drum]]"), ("drum[].drive", "[[drum]] drive"), ("roll[]", "[[roll]]"),
+        ("roll[].drive", "[[roll]] drive (unwinding rolls)"), ("rider[]", "[[rider]]"),
+        ("nip[]", "[[nip]]"), ("nip[].contact", "[[nip]] contact"),
+        ("nip[].friction", "[[nip]] friction"), ("web", "[web]"), ("web.span", "[web.span]"))]
+    for head, table, spec in tables:
+        assert set(rows[head]) == set(spec), head
+        for key, cells in rows[head].items():
+            kind, unit, rng, default, meaning = cells
+            assert unit and meaning and default, (head, key)
+            if spec[key][1]:
+                assert default.startswith("required"), (head, key, default)
+            if spec[key][0] == "num":
+                hi = sc._MAX.get((table, key))
+                if hi is not None:  # the upper bound the parser enforces is the one shown
+                    assert _num(hi) in rng, (head, key, rng)
+
+
+def test_documented_ranges_are_the_parsers():
+    """A value just past a documented bound is refused, the bound itself accepted."""
+    base = winder.load_scene(ROOT / "models" / "paper_winding.toml")
+    rows = _rows(reference())
+    rng = rows["[paper]"]["caliper"][2]
+    assert rng == "(0, 0.1]"
+    base.replace(paper={"caliper": 0.1})
+    with pytest.raises(winder.SceneError, match="caliper"):
+        base.replace(paper={"caliper": 0.1000001})
+    with pytest.raises(winder.SceneError, match="caliper"):
+        base.replace(paper={"caliper": 0.0})
+
+
+def test_documented_defaults_are_what_loading_gives():
+    """The defaults shown for the keys a minimal scene of parts leaves out are the values
+    the loaded scene has."""
+    scene = winder.scene_from_dict({
+        "scene": {"duration": 1.0},
+        "paper": {"density": 800.0, "caliper": 1e-4},
+        "drum": [{"name": "d", "radius": 0.5, "inertia": 10.0, "mass": 100.0,
+                  "centre": [0.0, 0.0], "drive": {"kind": "speed_profile",
+                                                  "web_speed": 1.0}}],
+        "roll": [{"name": "r", "centre": [0.0, 0.6], "core_radius": 0.1,
+                  "core_mass": 10.0, "core_inertia": 0.1, "width": 1.0}],
+        "nip": [{"name": "n", "a": "d", "b": "r", "contact": {"stiffness": 1e8}}],
+        "web": {"entry_nip": "n"},
+    })
+    rows = _rows(reference())
+    got = {
+        "[scene]": {k: getattr(scene.scene, k) for k in ("output_step", "gravity")},
+        "[solver]": {k: getattr(scene.solver, k) for k in ("rtol", "atol", "max_rhs",
+                                                           "max_wall", "method", "backend")},
+        "[[drum]]": {"sense": scene.drums[0].sense},
+        "[[drum]] drive": {"ratio": scene.drums[0].drive.ratio,
+                           "web_acceleration": scene.drums[0].drive.web_acceleration},
+        "[[roll]]": {"sense": scene.rolls[0].sense, "kind": scene.rolls[0].kind,
+                     "com_offset": scene.rolls[0].com_offset,
+                     "initial_speed": scene.rolls[0].initial_speed},
+        "[[nip]] friction": {k: getattr(scene.nips[0].friction, k)
+                             for k in ("mu", "slip_velocity", "relaxation_length",
+                                       "min_speed")},
+        "[[nip]] contact": {k: getattr(scene.nips[0].contact, k)
+                            for k in ("law", "damping", "exponent", "hc_damping")},
+        "[web]": {"tension": scene.web.tension},
+    }
+    for head, values in got.items():
+        for key, value in values.items():
+            shown = rows[head][key][3]
+            want = f'"{value}"' if isinstance(value, str) else _num(value)
+            assert shown == want, (head, key, shown, value)
+    assert scene.rolls[0].initial_radius == scene.rolls[0].core_radius
+    assert rows["[[roll]]"]["initial_radius"][3] == "core_radius"
+    assert scene.rolls[0].free == ("z",)
+    assert rows["[[roll]]"]["free"][3].startswith('["z"] (wound)')
+
+
+@pytest.mark.parametrize("model", ["two_drum_winder", "winder_line"])
+def test_every_channel_of_a_scene_of_parts_is_documented(model):
+    scene = winder.load_scene(ROOT / "models" / f"{model}.toml")
+    res = winder.simulate(scene, t_end=0.02, output_step=0.01)
+    kinds = {p.name: k for k, parts in (("drum", scene.drums), ("roll", scene.rolls),
+                                        ("rider", scene.riders), ("nip", scene.nips))
+             for p in parts}
+    names = list(res)
+    missing = [n for n in names if channel_pattern(n, kinds) is None]
+    assert not missing
+    used = {channel_pattern(n, kinds) for n in names}
+    assert {"BODY_torque", "NIP_penetration", "ROLL_radius", "web_speed"} <= used
+    if model == "winder_line":
+        assert {"span_tension", "tension_error"} <= used
+
+
+def test_every_channel_of_a_single_drum_scene_is_documented():
+    res = winder.simulate(ROOT / "models" / "paper_winding.toml", t_end=0.02)
+    names = list(res)
+    assert set(names) == set(LEGACY_CHANNEL_DOC)
+    assert set(CHANNEL_DOC) >= {"t", "NIP_normal_force", "BODY_speed"}
+
+
+def test_readme_and_docs_point_only_to_files_of_the_package():
+    """Users get the repository, not the specification folder beside it: no reference to
+    it, and every local Markdown link resolves."""
+    texts = {p: p.read_text(encoding="utf-8") for p in
+             [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]}
+    for path, text in texts.items():
+        for bad in ("../shared", "shared/spec", "winder-model.md", "machines.md", "spec §"):
+            assert bad not in text, (path.name, bad)
+        for link in re.findall(r"\]\(([^)#:]+)(?:#[^)]*)?\)", text):
+            assert (path.parent / link).exists(), (path.name, link)
+    assert "docs/scene-reference.md" in texts[ROOT / "README.md"]
+    assert "docs/model.md" in texts[ROOT / "README.md"]
