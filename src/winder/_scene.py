@@ -434,12 +434,12 @@ _NUMBERS: dict[tuple[str, str], tuple[float | None, str]] = {
     ("roll", "initial_radius"): (10.0, "m"), ("roll", "initial_speed"): (1e5, "rad/s"),
     ("roll", "com_offset"): (10.0, "m"), ("roll", "initial_height"): (1e3, "m"),
     ("paper", "density"): (1e5, "kg/m³"), ("paper", "caliper"): (0.1, "m"),
-    ("contact", "stiffness"): (1e18, "N/m"), ("contact", "damping"): (1e12, "N·s/m"),
+    ("contact", "stiffness"): (1e18, "N/m (N/m^p)"), ("contact", "damping"): (1e12, "N·s/m"),
     ("contact", "exponent"): (3.0, "-"), ("contact", "hc_damping"): (1e4, "s/m"),
     ("friction", "mu"): (10.0, "-"), ("friction", "slip_velocity"): (1e3, "m/s"),
     ("friction", "relaxation_length"): (1e3, "m"), ("friction", "min_speed"): (1e3, "m/s"),
     ("solver", "rtol"): (RTOL_MAX, "-"),
-    ("solver", "atol"): (1.0, ""),  # in each state's own unit: none in common
+    ("solver", "atol"): (1.0, "state units"),  # in each state's own unit
     ("solver", "max_rhs"): (1e12, "-"), ("solver", "max_wall"): (None, "s"),
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,
@@ -1231,14 +1231,15 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
 # (``drum[] radius`` is ``drum radius``) fall back to it through _KEY_DOC_ALIAS.
 
 #: (table of _SPEC/_PART_SPEC, key) -> (unit, meaning, default text or None: the
-#: dataclass default, or "required").
-_KEY_DOC: dict[tuple[str, str], tuple[str, str, str | None]] = {
+#: dataclass default, or "required"). The unit of a numeric key is None here: it is
+#: declared once, in :data:`_NUMBERS`, and :func:`key_doc` reads it from there.
+_KEY_DOC: dict[tuple[str, str], tuple[str | None, str, str | None]] = {
     ("scene", "name"): ("-", "the scene's name, in titles, messages and the result",
                         "the file name without .toml"),
-    ("scene", "duration"): ("s", "simulated time of a run", None),
-    ("scene", "output_step"): ("s", "time between result samples; at most duration, and "
+    ("scene", "duration"): (None, "simulated time of a run", None),
+    ("scene", "output_step"): (None, "time between result samples; at most duration, and "
                                "at most 1e7 samples per run", None),
-    ("scene", "gravity"): ("m/s²", "gravitational acceleration g, along −z", None),
+    ("scene", "gravity"): (None, "gravitational acceleration g, along −z", None),
     ("effects", "variable_mass"): ("-", "the −Ẏv force of mass that joins a body from "
                                    "rest; off: m(r) and J(r) still follow the radius, the "
                                    "term is dropped (the naive overwrite)", None),
@@ -1256,63 +1257,63 @@ _KEY_DOC: dict[tuple[str, str], tuple[str, str, str | None]] = {
                                      "per nip); off: F_t = F_ss; needs contact", None),
     ("effects", "rider_load"): ("-", "the riders' applied line load; off: only their "
                                 "weight", None),
-    ("drum", "radius"): ("m", "drum radius R", None),
-    ("drum", "inertia"): ("kg·m²", "polar moment of inertia J_d about the drum axis", None),
-    ("drum", "mass"): ("kg", "drum mass", None),
+    ("drum", "radius"): (None, "drum radius R", None),
+    ("drum", "inertia"): (None, "polar moment of inertia J_d about the drum axis", None),
+    ("drum", "mass"): (None, "drum mass", None),
     ("drum.drive", "kind"): ("-", "speed_profile: the drum's speed is prescribed, its "
                              "torque follows from inverse dynamics; torque: the drum is "
                              "free and driven by an input torque", None),
-    ("drum.drive", "web_acceleration"): ("m/s²", "ramp of the surface (web) speed a_w; "
+    ("drum.drive", "web_acceleration"): (None, "ramp of the surface (web) speed a_w; "
                                          "0: full speed from t = 0", None),
-    ("drum.drive", "web_speed"): ("m/s", "speed_profile: the surface speed v_w the ramp "
+    ("drum.drive", "web_speed"): (None, "speed_profile: the surface speed v_w the ramp "
                                   "reaches; torque: the initial surface speed",
                                   "required (kind speed_profile); 0 (kind torque)"),
-    ("drum.drive", "torque"): ("N·m", "kind torque: the drive torque (operation sense), "
+    ("drum.drive", "torque"): (None, "kind torque: the drive torque (operation sense), "
                                "constant or an input", None),
-    ("roll", "core_radius"): ("m", "outer radius r_c of the empty core", None),
-    ("roll", "core_mass"): ("kg", "mass of the core", None),
-    ("roll", "core_inertia"): ("kg·m²", "polar inertia of the core about its axis", None),
-    ("roll", "width"): ("m", "roll width L (cross-machine)", None),
-    ("roll", "initial_radius"): ("m", "radius at t = 0; at least core_radius",
+    ("roll", "core_radius"): (None, "outer radius r_c of the empty core", None),
+    ("roll", "core_mass"): (None, "mass of the core", None),
+    ("roll", "core_inertia"): (None, "polar inertia of the core about its axis", None),
+    ("roll", "width"): (None, "roll width L (cross-machine)", None),
+    ("roll", "initial_radius"): (None, "radius at t = 0; at least core_radius",
                                  "core_radius"),
-    ("roll", "initial_speed"): ("rad/s", "speed at t = 0 (operation sense)", None),
-    ("roll", "com_offset"): ("m", "distance e of the centre of mass from the roll axis "
+    ("roll", "initial_speed"): (None, "speed at t = 0 (operation sense)", None),
+    ("roll", "com_offset"): (None, "distance e of the centre of mass from the roll axis "
                              "(imbalance); below min(core_radius, √(core_inertia / "
                              "core_mass))", None),
-    ("roll", "initial_height"): ("m", "height z of the roll axis at t = 0, above the drum "
+    ("roll", "initial_height"): (None, "height z of the roll axis at t = 0, above the drum "
                                  "radius (e.g. to drop the roll onto the drum)",
                                  "static balance on the nip"),
-    ("paper", "density"): ("kg/m³", "paper density ρ", None),
-    ("paper", "caliper"): ("m", "paper thickness h, added to the radius once per "
+    ("paper", "density"): (None, "paper density ρ", None),
+    ("paper", "caliper"): (None, "paper thickness h, added to the radius once per "
                            "revolution", None),
     ("contact", "law"): ("-", "linear: F_n = max(0, k δ + c δ̇); hunt_crossley: F_n = "
                          "max(0, k δ^p (1 + α δ̇))", None),
-    ("contact", "stiffness"): ("N/m (N/m^p)", "stiffness k of the nip", None),
-    ("contact", "damping"): ("N·s/m", "damping c of the linear law", None),
-    ("contact", "exponent"): ("-", "exponent p of the Hunt–Crossley law", None),
-    ("contact", "hc_damping"): ("s/m", "damping α of the Hunt–Crossley law", None),
-    ("friction", "mu"): ("-", "friction coefficient μ: F_ss = μ F_n tanh(v_s / v_ref)",
+    ("contact", "stiffness"): (None, "stiffness k of the nip", None),
+    ("contact", "damping"): (None, "damping c of the linear law", None),
+    ("contact", "exponent"): (None, "exponent p of the Hunt–Crossley law", None),
+    ("contact", "hc_damping"): (None, "damping α of the Hunt–Crossley law", None),
+    ("friction", "mu"): (None, "friction coefficient μ: F_ss = μ F_n tanh(v_s / v_ref)",
                          None),
-    ("friction", "slip_velocity"): ("m/s", "slip velocity scale v_ref of the tanh law",
+    ("friction", "slip_velocity"): (None, "slip velocity scale v_ref of the tanh law",
                                     None),
-    ("friction", "relaxation_length"): ("m", "relaxation length σ: dF_t/dt = (|u_a| + "
+    ("friction", "relaxation_length"): (None, "relaxation length σ: dF_t/dt = (|u_a| + "
                                         "v_min)/σ (F_ss − F_t)", None),
-    ("friction", "min_speed"): ("m/s", "speed v_min added in the relaxation rate (keeps it "
+    ("friction", "min_speed"): (None, "speed v_min added in the relaxation rate (keeps it "
                                 "finite at standstill)", None),
     ("solver", "method"): ("-", "integrator; auto is DOPRI5", None),
-    ("solver", "rtol"): ("-", "relative tolerance", None),
-    ("solver", "atol"): ("state units", "absolute tolerance", None),
-    ("solver", "max_rhs"): ("-", "budget: most right-hand side evaluations of a run (a "
+    ("solver", "rtol"): (None, "relative tolerance", None),
+    ("solver", "atol"): (None, "absolute tolerance", None),
+    ("solver", "max_rhs"): (None, "budget: most right-hand side evaluations of a run (a "
                             "whole number)", None),
     ("solver", "backend"): ("-", "compiled: the generated code; pinocchio: the numeric "
                             "Pinocchio path (the cross-check)", None),
-    ("solver", "max_wall"): ("s", "budget: most wall-clock time of a run", None),
+    ("solver", "max_wall"): (None, "budget: most wall-clock time of a run", None),
     ("drum[]", "name"): ("-", "the part's name (unique; names its channels)", "required"),
     ("drum[]", "centre"): ("m", "axis position [x, z]", None),
     ("drum[]", "sense"): ("-", "operation direction: +1 turns the top surface towards +x",
                           None),
     ("drum[]", "drive"): ("-", "the drive, a sub-table: keys below", None),
-    ("drum[].drive", "ratio"): ("-", "kind speed_profile: the drum runs at ratio × the "
+    ("drum[].drive", "ratio"): (None, "kind speed_profile: the drum runs at ratio × the "
                                 "profile's surface speed", None),
     ("roll[]", "name"): ("-", "the part's name (unique; names its channels)", None),
     ("roll[]", "kind"): ("-", "wound: grows, ṙ = +h·speed/2π; unwinding: shrinks, ṙ = "
@@ -1324,26 +1325,26 @@ _KEY_DOC: dict[tuple[str, str], tuple[str, str, str | None]] = {
                          "(unwinding)"),
     ("roll[]", "sense"): ("-", "operation direction: −1 turns the bottom surface towards "
                           "+x (a roll on a drum)", None),
-    ("roll[]", "density"): ("kg/m³", "paper density ρ", "[paper] density"),
-    ("roll[]", "caliper"): ("m", "paper thickness h", "[paper] caliper"),
+    ("roll[]", "density"): (None, "paper density ρ", "[paper] density"),
+    ("roll[]", "caliper"): (None, "paper thickness h", "[paper] caliper"),
     ("roll[]", "drive"): ("-", "unwinding rolls only: the unwind drive, a sub-table: keys "
                           "below", "none (free)"),
     ("roll[].drive", "kind"): ("-", "torque: a torque (negative brakes); tension_control: "
                                "the unwind holds the span tension by PI with inertia "
                                "feed-forward, gains from bandwidth", None),
-    ("roll[].drive", "torque"): ("N·m", "kind torque: the unwind torque (operation sense), "
+    ("roll[].drive", "torque"): (None, "kind torque: the unwind torque (operation sense), "
                                  "constant or an input", None),
-    ("roll[].drive", "tension"): ("N", "kind tension_control: the tension set-point T*",
+    ("roll[].drive", "tension"): (None, "kind tension_control: the tension set-point T*",
                                   "required (kind tension_control)"),
-    ("roll[].drive", "bandwidth"): ("rad/s", "kind tension_control: the closed loop's "
+    ("roll[].drive", "bandwidth"): (None, "kind tension_control: the closed loop's "
                                     "bandwidth ω_c (its three poles at −ω_c)", None),
     ("rider[]", "name"): ("-", "the part's name (unique; names its channels)", None),
     ("rider[]", "rides"): ("-", "name of the paper roll it rests on (through a [[nip]] "
                            "with a = that roll, b = the rider)", None),
-    ("rider[]", "radius"): ("m", "rider radius (constant)", None),
-    ("rider[]", "mass"): ("kg", "rider mass", None),
-    ("rider[]", "inertia"): ("kg·m²", "polar inertia of the rider", None),
-    ("rider[]", "x"): ("m", "horizontal position of its axis (fixed; it moves along z)",
+    ("rider[]", "radius"): (None, "rider radius (constant)", None),
+    ("rider[]", "mass"): (None, "rider mass", None),
+    ("rider[]", "inertia"): (None, "polar inertia of the rider", None),
+    ("rider[]", "x"): (None, "horizontal position of its axis (fixed; it moves along z)",
                        None),
     ("rider[]", "load"): ("m, N/m", "line-load schedule [[radius of the ridden roll, line "
                           "load], ...], radii strictly increasing, interpolated linearly, "
@@ -1357,16 +1358,18 @@ _KEY_DOC: dict[tuple[str, str], tuple[str, str, str | None]] = {
                            "required while effects.contact is on"),
     ("nip[]", "friction"): ("-", "the friction law, a sub-table: the keys of [friction]",
                             None),
+    ("web", "name"): ("-", "the web's name, in its channels and messages where a scene has "
+                      "several webs ([[web]], one per wound roll)", "its entry_nip"),
     ("web", "entry_nip"): ("-", "the nip where the web enters the wound roll (a: the drum "
                            "it wraps, b: the roll)", None),
-    ("web", "tension"): ("N", "constant web tension (not with [web.span])", None),
+    ("web", "tension"): (None, "constant web tension (not with [web.span])", None),
     ("web", "span"): ("-", "an elastic span from an unwinding roll, a sub-table: keys "
                       "below", "none"),
     ("web.span", "from"): ("-", "the unwinding roll that feeds the span", None),
-    ("web.span", "length"): ("m", "span length L_s", None),
-    ("web.span", "EA"): ("N", "axial stiffness EA of the web", None),
-    ("web.span", "T_in"): ("N", "tension wound into the unwinding roll", None),
-    ("web.span", "initial_tension"): ("N", "span tension at t = 0", "T_in"),
+    ("web.span", "length"): (None, "span length L_s", None),
+    ("web.span", "EA"): (None, "axial stiffness EA of the web", None),
+    ("web.span", "T_in"): (None, "tension wound into the unwinding roll", None),
+    ("web.span", "initial_tension"): (None, "span tension at t = 0", "T_in"),
 }
 #: Tables of a scene of parts whose keys, where not in _KEY_DOC, are those of a
 #: single-drum table.
@@ -1377,12 +1380,12 @@ _KEY_DOC_ALIAS = {"drum[]": "drum", "drum[].drive": "drum.drive", "roll[]": "rol
 def key_doc(table: str, key: str) -> tuple[str, str, str | None]:
     """``(unit, meaning, default text or None)`` of ``key`` of the schema table ``table``
     (a table of ``_SPEC`` or ``_PART_SPEC``); KeyError where it is not documented."""
-    if (table, key) in _KEY_DOC:
-        return _KEY_DOC[(table, key)]
-    if table in _KEY_DOC_ALIAS:
+    doc = _KEY_DOC.get((table, key))
+    if doc is None and table in _KEY_DOC_ALIAS:
         alias = _KEY_DOC_ALIAS[table]
-        if (alias, key) in _KEY_DOC:
-            return _KEY_DOC[(alias, key)]
-        if table == "roll[]" and ("paper", key) in _KEY_DOC:
-            return _KEY_DOC[("paper", key)]
-    raise KeyError((table, key))
+        doc = _KEY_DOC.get((alias, key)) or (
+            _KEY_DOC.get(("paper", key)) if table == "roll[]" else None)
+    if doc is None:
+        raise KeyError((table, key))
+    unit, meaning, default = doc
+    return (_UNITS[(table, key)] if unit is None else unit), meaning, default

@@ -198,7 +198,8 @@ _HEADINGS = {
     "drum[]": "[[drum]]", "drum[].drive": "[[drum]] drive",
     "roll[]": "[[roll]]", "roll[].drive": "[[roll]] drive (unwinding rolls)",
     "rider[]": "[[rider]]", "nip[]": "[[nip]]", "nip[].contact": "[[nip]] contact",
-    "nip[].friction": "[[nip]] friction", "web": "[web]", "web.span": "[web.span]",
+    "nip[].friction": "[[nip]] friction", "web": "[web] or [[web]] (one per wound roll)",
+    "web.span": "[web.span]",
 }
 _DRIVE_NOTE = {
     "paper": "The default paper of every roll: optional in a scene of parts (each "
@@ -276,7 +277,10 @@ def reference() -> str:
               "`BODY` is the name of any drum, roll or rider, `ROLL` of a paper roll, "
               "`RIDER` of a rider, `NIP` of a nip; `web_speed` and `web_force` exist with a "
               "web, `span_tension` with `[web.span]`, `tension_error` with an unwind of kind "
-              "`tension_control`.", "",
+              "`tension_control`. With several webs, `web_speed` and `web_force` are "
+              "`WEB_web_speed` and `WEB_web_force` (`WEB` the web's name); with several "
+              "spans, `span_tension` and `tension_error` are `WEB_span_tension` and "
+              "`WEB_tension_error`.", "",
               "| channel | unit | meaning |", "|---|---|---|"]
     for ch, (unit, meaning) in CHANNEL_DOC.items():
         lines.append(f"| `{ch}` | {unit} | {_cell(meaning)} |")
