@@ -39,6 +39,10 @@ def test_check_flags_a_stale_file(tmp_path):
     assert main(["--check", "--out", str(stale)]) == 0
 
 
+#: The heading of the web's table: one [web], or one [[web]] per wound roll.
+WEB = "[web] or [[web]] (one per wound roll)"
+
+
 def _rows(text: str) -> dict[str, dict[str, list[str]]]:
     """Section heading -> key -> cells of its row."""
     out: dict[str, dict[str, list[str]]] = {}
@@ -63,7 +67,8 @@ def test_every_schema_key_is_listed_once_with_unit_and_meaning():
         ("drum[]", "[[drum]]"), ("drum[].drive", "[[drum]] drive"), ("roll[]", "[[roll]]"),
         ("roll[].drive", "[[roll]] drive (unwinding rolls)"), ("rider[]", "[[rider]]"),
         ("nip[]", "[[nip]]"), ("nip[].contact", "[[nip]] contact"),
-        ("nip[].friction", "[[nip]] friction"), ("web", "[web]"), ("web.span", "[web.span]"))]
+        ("nip[].friction", "[[nip]] friction"), ("web", WEB),
+        ("web.span", "[web.span]"))]
     for head, table, spec in tables:
         assert set(rows[head]) == set(spec), head
         for key, cells in rows[head].items():
@@ -120,7 +125,7 @@ def test_documented_defaults_are_what_loading_gives():
                                        "min_speed")},
         "[[nip]] contact": {k: getattr(scene.nips[0].contact, k)
                             for k in ("law", "damping", "exponent", "hc_damping")},
-        "[web]": {"tension": scene.web.tension},
+        WEB: {"tension": scene.web.tension},
     }
     for head, values in got.items():
         for key, value in values.items():
@@ -131,6 +136,8 @@ def test_documented_defaults_are_what_loading_gives():
     assert rows["[[roll]]"]["initial_radius"][3] == "core_radius"
     assert scene.rolls[0].free == ("z",)
     assert rows["[[roll]]"]["free"][3].startswith('["z"] (wound)')
+    assert scene.web.name == scene.web.entry_nip
+    assert rows[WEB]["name"][3] == "its entry_nip"
 
 
 @pytest.mark.parametrize("model", ["two_drum_winder", "winder_line"])
