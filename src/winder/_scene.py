@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ._args import RTOL_MAX, check_real, show
+from ._args import ATOL_MAX, RTOL_MAX, check_real, show
 from ._errors import ArgumentError, ArgumentTypeError, SceneError
 from .parts import (
     AXES,
@@ -188,7 +188,7 @@ class Friction(FrictionLaw):
 
 @dataclass(frozen=True)
 class Solver:
-    """``[solver]``: method (one of :data:`METHODS`), rtol (0, 0.1] [-], atol (0, 1]
+    """``[solver]``: method (one of :data:`METHODS`), rtol (0, 0.1] [-], atol (0, 1e-3]
     [state units], max_rhs (guard: an integer 1 … 1e12 of right-hand side evaluations),
     backend (one of :data:`BACKENDS`), max_wall (guard: wall-clock seconds, > 0) [s]."""
 
@@ -420,7 +420,7 @@ _MAX: dict[tuple[str, str], float] = {
     ("contact", "exponent"): 3.0, ("contact", "hc_damping"): 1e4,
     ("friction", "mu"): 10.0, ("friction", "slip_velocity"): 1e3,
     ("friction", "relaxation_length"): 1e3, ("friction", "min_speed"): 1e3,
-    ("solver", "rtol"): RTOL_MAX, ("solver", "atol"): 1.0, ("solver", "max_rhs"): 1e12,
+    ("solver", "rtol"): RTOL_MAX, ("solver", "atol"): ATOL_MAX, ("solver", "max_rhs"): 1e12,
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,
             ("solver", "method"): METHODS, ("solver", "backend"): BACKENDS}
