@@ -111,20 +111,32 @@ class _Beyond(Exception):
 
 
 def _guard(system: MachineSystem, bounds: list[tuple[int, int, int]], solver: OdeSolver,
-           y_a: np.ndarray, t_out: np.ndarray, filled: int) -> None:
+           y_a: np.ndarray, t_b: float, y_b: np.ndarray, t_out: np.ndarray,
+           filled: int) -> None:
     """The guard of every accepted step (as the compiled integrators',
-    :func:`~winder.solve.integrators.guard_step`): where a nip's ``NIP.overlap`` is beyond
-    its bound at the step's end, at an output sample inside it, or on the straight path
-    from the step's start ``y_a`` to its end (closest approach from ``NIP.dx``,
-    ``NIP.dz``), raise :class:`_Beyond` at the crossing. ``bounds``: the switching
-    functions ``(overlap, dx, dz)`` of each nip."""
+    :func:`~winder.solve.integrators.guard_step`), on its kept part from its start
+    ``y_a`` to ``(t_b, y_b)`` (the step's end or its first event): where a nip's
+    ``NIP.overlap`` is beyond its bound at that end, at an output sample inside it, or on
+    the straight path between (closest approach from ``NIP.dx``, ``NIP.dz``), raise
+    :class:`_Beyond` at the crossing. ``bounds``: the switching functions ``(overlap, dx,
+    dz)`` of each nip."""
     if not bounds:
         return
-    t_a, t_b, y_b = float(solver.t_old), float(solver.t), solver.y
+    t_a = float(solver.t_old)
     sol: Any = None
 
     def over(t: float, y: np.ndarray, go: int) -> float:
         return float(system.switches(t, y)[go])
+
+    def beyond(go: int, t_c: float, y_c: np.ndarray) -> _Beyond:
+        """At the crossing of ``go`` on the interpolant before ``t_c``, on its far side."""
+        t_x, y_x = _locate((lambda t, y: over(t, y, go), True), sol, t_a, t_c, y_c)
+        for _ in range(64):
+            if over(t_x, y_x, go) > 0.0 or t_x >= t_c:
+                break
+            t_x = min(t_c, float(np.nextafter(t_x, math.inf)))
+            y_x = y_c if t_x == t_c else sol(t_x)
+        return _Beyond(t_x, np.array(y_x, dtype=float))
 
     points = [(float(ts), None) for ts in t_out[filled:np.searchsorted(t_out, t_b, "right")]]
     for t_c, _ in [*points, (t_b, None)]:
@@ -140,9 +152,7 @@ def _guard(system: MachineSystem, bounds: list[tuple[int, int, int]], solver: Od
         if not all(np.isfinite(g[go]) for go in crossed) or t_c <= t_a:
             raise _Beyond(t_c, np.array(y_c, dtype=float))
         sol = sol or solver.dense_output()
-        t_x, y_x = min((_locate((lambda t, y, go=go: over(t, y, go), True), sol, t_a, t_c,
-                                 y_c) for go in crossed), key=lambda e: e[0])
-        raise _Beyond(t_x, np.array(y_x, dtype=float))
+        raise min((beyond(go, t_c, y_c) for go in crossed), key=lambda e: e.t)
     g0, g1 = system.switches(t_a, y_a), system.switches(t_b, y_b)
     h = t_b - t_a
 
@@ -164,6 +174,11 @@ def _guard(system: MachineSystem, bounds: list[tuple[int, int, int]], solver: Od
         th = 0.5 * (th + max(0.0, (-b2 - math.sqrt(max(disc, 0.0))) / d2))
         if not over(t_a + th * h, line(th), go) > 0.0:
             continue
+        sol = sol or solver.dense_output()
+        for q in np.linspace(0.0, 1.0, 65)[1:]:  # where the interpolant passes beyond
+            y_q = sol(t_a + q * h)
+            if over(t_a + q * h, y_q, go) > 0.0:
+                raise beyond(go, t_a + q * h, y_q)
         th = brentq(lambda q, go=go: over(t_a + q * h, line(q), go), 0.0, th,
                     xtol=4 * np.finfo(float).eps)
         while not over(t_a + th * h, line(th), go) > 0.0:  # on the far side of the root
@@ -194,8 +209,6 @@ def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
                                    "method (Radau, BDF) or a looser/tighter rtol",
                                    float(solver.t), solver.y)
             guards.steps += 1
-            _guard(system, bounds, solver, y_a, t_out, filled)
-            y_a = np.array(solver.y, dtype=float)
             t_a, t_b, y_b = float(solver.t_old), float(solver.t), solver.y
             hit, t_lim, y_lim, sol = -1, t_b, y_b, None
             for i, (g, new_pos) in enumerate(events):
@@ -204,6 +217,8 @@ def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
                     t_ev, y_ev = _locate(events[i], sol, t_a, t_b, y_b)
                     if hit < 0 or t_ev < t_lim:
                         hit, t_lim, y_lim = i, t_ev, y_ev
+            _guard(system, bounds, solver, y_a, t_lim, y_lim, t_out, filled)
+            y_a = np.array(y_b, dtype=float)
             while filled < len(t_out) and t_out[filled] <= t_lim:
                 if t_out[filled] == t_b:
                     Ys[:, filled] = y_b

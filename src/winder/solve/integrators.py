@@ -301,25 +301,39 @@ def _chord(fns: np.ndarray, table: np.ndarray, t: float, hh: float, y0: np.ndarr
 
 @njit
 def guard_step(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh: float,
-               tb: np.ndarray, p: np.ndarray, m: np.ndarray, y0: np.ndarray,
-               y1: np.ndarray, yt: np.ndarray, g: np.ndarray, g0: np.ndarray,
-               t_out: np.ndarray, k: int) -> tuple[float, bool]:
-    """The guard of an accepted step from ``(t, y0)`` to ``(t + hh, y1)`` with the dense
-    output ``rc``, whose output samples start at ``t_out[k]`` (``g``, ``g0``: switching
-    function buffers): ``(θ, straight)``, the first ``θ`` in ``(0, 1]`` where a nip is
-    beyond its penetration bound (:func:`beyond_bound`) at the step's end, at a sample
-    inside it or on its straight path (``straight``: the state there is on that path,
-    else on ``rc``); ``θ = 2`` for none."""
+               th_end: float, tb: np.ndarray, p: np.ndarray, m: np.ndarray,
+               y0: np.ndarray, y1: np.ndarray, yt: np.ndarray, g: np.ndarray,
+               g0: np.ndarray, t_out: np.ndarray, k: int) -> tuple[float, np.ndarray]:
+    """The guard of the kept part ``[0, θ_end]`` of an accepted step from ``(t, y0)`` to
+    ``(t + hh, y1)`` with the dense output ``rc`` (cut at a mode switch at ``θ_end``; 1
+    for none), whose output samples start at ``t_out[k]`` (``g``, ``g0``: switching
+    function buffers): ``(θ, state)``, the first ``θ`` where a nip is beyond its
+    penetration bound (:func:`beyond_bound`) at the kept part's end, at a sample inside
+    it or on its straight path (a step that jumps through the other body: located on
+    ``rc`` where a scan of it finds the crossing, else on that path); ``θ = 2`` and an
+    empty state for none."""
+    n = y0.shape[0]
+    ye = y1
+    if th_end < 1.0:
+        ye = np.empty(n)
+        _dense(rc, th_end, ye)
     best, straight = 2.0, False
     switches(fns, tb, t, y0, p, m, g0)
-    switches(fns, tb, t + hh, y1, p, m, g)
+    switches(fns, tb, t + th_end * hh, ye, p, m, g)
     if beyond_bound(table, g) >= 0:
-        best = _first_beyond(fns, table, rc, t, hh, 1.0, tb, p, m, yt, g)
-        switches(fns, tb, t + hh, y1, p, m, g)
-    th = _chord(fns, table, t, hh, y0, y1, g0, tb, p, m, yt, g)
-    if th < best:
-        best, straight = th, True
-    while k < t_out.shape[0] and t_out[k] <= t + min(best, 1.0) * hh:
+        best = _first_beyond(fns, table, rc, t, hh, th_end, tb, p, m, yt, g)
+        switches(fns, tb, t + th_end * hh, ye, p, m, g)
+    th = _chord(fns, table, t, th_end * hh, y0, ye, g0, tb, p, m, yt, g)
+    if th * th_end < best:  # where the dense output passes beyond, if it does
+        best, straight = th * th_end, True
+        for j in range(1, 65):
+            tj = th_end * j / 64.0
+            _dense(rc, tj, yt)
+            if _beyond_at(fns, table, tb, t + tj * hh, yt, p, m, g):
+                best = _first_beyond(fns, table, rc, t, hh, tj, tb, p, m, yt, g)
+                straight = False
+                break
+    while k < t_out.shape[0] and t_out[k] <= t + min(best, th_end) * hh:
         th = max(0.0, (t_out[k] - t) / hh)
         _dense(rc, th, yt)
         if _beyond_at(fns, table, tb, t + th * hh, yt, p, m, g):
@@ -328,7 +342,15 @@ def guard_step(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh:
                 best, straight = th, False
             break
         k += 1
-    return best, straight
+    if best > 1.0:
+        return best, np.empty(0)
+    state = np.empty(n)
+    if straight:
+        for i in range(n):
+            state[i] = y0[i] + best / th_end * (ye[i] - y0[i])
+    else:
+        _dense(rc, best, state)
+    return best, state
 
 
 @njit
@@ -368,14 +390,14 @@ def sample_and_switch(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: flo
     (:func:`beyond_bound`), ``y`` moves to that crossing and the slot is :data:`GUARD`.
     Returns ``(slot or -1, new mode, end time, k)``."""
     n = y.shape[0]
-    theta_guard, straight = guard_step(fns, table, rc, t, hh, tb, p, m, y, y1, yt, g, g0,
-                                       t_out, k)
     theta_end, slot, new_mode = _next_event(fns, table, rc, t, hh, tb, p, m, y1, yt, g,
                                             True)
-    if theta_guard <= min(theta_end, 1.0):
-        theta_end, slot = theta_guard, GUARD
     if theta_end > 1.0:
         theta_end = 1.0
+    theta_guard, y_guard = guard_step(fns, table, rc, t, hh, theta_end, tb, p, m, y, y1, yt,
+                                      g, g0, t_out, k)
+    if theta_guard <= theta_end:
+        theta_end, slot = theta_guard, GUARD
     t_end = t + theta_end * hh
     while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
         if t_out[k] > t1 + 1e-13 * max(1.0, abs(t1)):
@@ -387,11 +409,8 @@ def sample_and_switch(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: flo
             Y_out[i, k] = yt[i]
         k += 1
     if slot == GUARD:  # the state where the bound is crossed
-        if straight:
-            for i in range(n):
-                y[i] += theta_end * (y1[i] - y[i])
-        else:
-            _dense(rc, theta_end, y)
+        for i in range(n):
+            y[i] = y_guard[i]
     elif slot >= 0:
         _dense(rc, theta_end, y)
         if new_mode == END or (table[slot, 0] == K_CORE and new_mode == AT_CORE):
@@ -589,23 +608,6 @@ def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
             if not ok:
                 status = NON_FINITE
                 break
-            for i in range(n):  # the step's cubic Hermite in DOPRI5's dense form
-                rc[0, i] = y[i]
-                rc[1, i] = y1[i] - y[i]
-                rc[2, i] = hs * k1[i] - rc[1, i]
-                rc[3, i] = rc[1, i] - hs * k2[i] - rc[2, i]
-                rc[4, i] = 0.0
-            theta_guard, straight = guard_step(fns, table, rc, t, hs, tb, p, m, y, y1, yt, g,
-                                               g0, t_out, k)
-            if theta_guard <= 1.0:  # stop where the first nip crosses its bound
-                if straight:
-                    for i in range(n):
-                        y[i] += theta_guard * (y1[i] - y[i])
-                else:
-                    _dense(rc, theta_guard, y)
-                t = t + theta_guard * hs
-                status = PENETRATED
-                break
             # core events (spec §2): first point of the interpolant on the new side
             _, slot, new_mode = _next_event(fns, table, np.empty((5, n)), t, hs, tb, p, m,
                                             y1, yt, g, False)
@@ -621,6 +623,20 @@ def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
                     else:
                         ta = th
                 theta = tb_
+            for i in range(n):  # the step's cubic Hermite in DOPRI5's dense form
+                rc[0, i] = y[i]
+                rc[1, i] = y1[i] - y[i]
+                rc[2, i] = hs * k1[i] - rc[1, i]
+                rc[3, i] = rc[1, i] - hs * k2[i] - rc[2, i]
+                rc[4, i] = 0.0
+            theta_guard, y_guard = guard_step(fns, table, rc, t, hs, theta, tb, p, m, y, y1,
+                                              yt, g, g0, t_out, k)
+            if theta_guard <= theta:  # stop where the first nip crosses its bound
+                for i in range(n):
+                    y[i] = y_guard[i]
+                t = t + theta_guard * hs
+                status = PENETRATED
+                break
             t_end = t + theta * hs
             while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
                 _hermite(y, k1, y1, k2, hs, min(theta, max(0.0, (t_out[k] - t) / hs)), yt)

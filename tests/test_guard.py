@@ -1,0 +1,153 @@
+"""No wrong answer with exit 0: the guard of every integrator's accepted step stops a run
+whose nip penetration reaches the smaller radius (one body's axis inside the other), at
+the crossing, naming the time, the nip and what to change.
+
+Oracle: the state at the reported time lies on the bound, ``δ = R + r − z = r`` (the
+roll's axis on the drum's surface; closed-form geometry of the single-drum scene, not the
+machine's generated functions), and the reported time is the exception's time. Without
+the guard both scenes end with exit 0: the first with the roll's axis inside the drum,
+the second at z = −2e11 m."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_corpus import PAPER
+
+import winder
+from winder.cli import main
+from winder.solve import integrators as integ
+from winder.solve.system import MachineSystem
+
+DRUM_RADIUS = 0.5  # [m], models/paper_winding.toml
+#: The RK4 run of the 1e12 N/m nip crosses the bound near 8.75 s (the roll is thrown off at
+#: 2 ms and comes back through the drum); 9 s is the shortest end that shows it.
+RK4_T_END = 9.0
+
+
+def _scene(folder: Path, name: str, old: str, new: str) -> Path:
+    text = PAPER.read_text()
+    assert text.count(old) == 1
+    p = folder / f"{name}.toml"
+    p.write_text(text.replace(old, new))
+    return p
+
+
+@pytest.fixture(scope="module")
+def stiff_nip(tmp_path_factory) -> Path:
+    """The paper scene with a 1e12 N/m nip (RK4's 1 ms step is unstable on it)."""
+    return _scene(tmp_path_factory.mktemp("stiff"), "stiff", "stiffness = 2e7 ",
+                  "stiffness = 1e12")
+
+
+@pytest.fixture(scope="module")
+def centred(tmp_path_factory) -> Path:
+    """The paper scene with ``com_offset = 0``."""
+    return _scene(tmp_path_factory.mktemp("centred"), "centred", "com_offset = 0.001 ",
+                  "com_offset = 0.0   ")
+
+
+def _on_the_bound(state: dict[str, float]) -> float:
+    """``δ − r`` [m] of the single-drum scene: 0 where the roll's axis is on the drum."""
+    return (DRUM_RADIUS + state["roll.radius"] - state["roll.z"]) - state["roll.radius"]
+
+
+def test_rk4_on_a_stiff_nip_stops_where_the_roll_enters_the_drum(stiff_nip, tmp_path,
+                                                                 capsys) -> None:
+    out = tmp_path / "out" / "r.csv"
+    status = main(["run", str(stiff_nip), "--out", str(out), "--method", "RK4",
+                   "--t-end", str(RK4_T_END)])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) <= 4, err
+    for name in ("nip 'nip'", "'RK4'", "0.001 s", "max_step (--max-step)", "atol"):
+        assert name in err, (name, err)
+    assert not out.parent.exists()  # nothing written
+    # the same run in Python: the reported time is where the bound is crossed
+    with pytest.raises(winder.SimulationError) as info:
+        winder.simulate(winder.load_scene(stiff_nip), method="RK4", t_end=RK4_T_END)
+    e = info.value
+    assert f"t = {e.time:.6g} s" in err
+    assert 1.0 < e.time < RK4_T_END
+    assert abs(_on_the_bound(e.state)) < 1e-9, e.state
+    assert abs(e.state["roll.z_dot"]) > 1e3  # the roll came back from its unstable launch
+
+
+@pytest.fixture(scope="module")
+def dropped(tmp_path_factory) -> Path:
+    """The paper scene with the roll released from rest at z = 20 m above the drum's axis."""
+    return _scene(tmp_path_factory.mktemp("dropped"), "dropped", "com_offset = 0.001 ",
+                  "com_offset = 0.001\ninitial_height = 20.0")
+
+
+@pytest.mark.parametrize("method", ["DOPRI5", "ROS2", "RK45", "LSODA", "Radau"])
+def test_a_step_through_the_drum_stops_at_the_free_fall_time(dropped, method) -> None:
+    """Every adaptive method (compiled and scipy's) steps the falling roll through the drum:
+    both ends of that step are clear of the nip, so no contact event is seen. The guard
+    (the step's straight path enters the drum) stops it where its interpolant reaches the
+    drum: in free fall, at ``t = sqrt(2 (z0 − R) / g)`` with ``ż = −g t`` (closed form)."""
+    with pytest.raises(winder.SimulationError) as info:
+        winder.simulate(winder.load_scene(dropped), method=method, t_end=3.0, rtol=1e-8,
+                        atol=1e-10)
+    e = info.value
+    t_fall = math.sqrt(2.0 * (20.0 - DRUM_RADIUS) / 9.81)
+    assert e.time == pytest.approx(t_fall, abs=1e-12)
+    assert e.state["roll.z_dot"] == pytest.approx(-9.81 * t_fall, abs=1e-9)
+    assert 0.0 <= _on_the_bound(e.state) < 1e-12, e.state
+    assert re.search(rf"at t = {e.time:.6g} s: nip 'nip' \('roll' on 'drum'\): penetration "
+                     r"0.075 m reached the smaller radius", str(e)), str(e)
+    assert "max_step" in str(e) and "atol" in str(e)
+
+
+def test_dopri5_with_no_error_control_stops_at_the_drum(centred) -> None:
+    """``atol = 1e300`` (refused by every entry point now, so through the kernel): DOPRI5
+    steps the roll's axis into the drum (0.425 m at 0.5 s without the guard); the guard
+    stops it where the axis reaches the drum's surface."""
+    system = MachineSystem(winder.load_scene(centred))
+    y = system.initial_state()
+    t_out = np.linspace(0.0, 0.5, 51)
+    Y = np.full((len(y), len(t_out)), np.nan)
+    stats = np.zeros(5, dtype=np.int64)
+    status, t, _, k = integ.dopri5(system.fns, system.table, 0.0, 0.5, y, system.params,
+                                   system.modes.copy(), 1e-6, 1e300, 0.0, math.inf, t_out,
+                                   Y, 0, 10**7, stats)
+    assert status == integ.PENETRATED
+    state = dict(zip(system.state_names, y, strict=True))
+    assert 0.0 <= _on_the_bound(state) < 1e-9, state
+    assert 0.0 < t < 0.5
+    assert t_out[k - 1] <= t < t_out[k]  # samples up to the crossing, none after it
+    err = system.penetration_error(t, y, method="DOPRI5", max_step=None, atol=1e300)
+    assert f"t = {t:.6g} s: nip 'nip'" in str(err)
+    assert "atol 1e+300" in str(err) and "a smaller atol" in str(err)
+    assert err.time == t
+
+
+def test_atol_1e300_is_refused(centred, tmp_path, capsys) -> None:
+    status = main(["run", str(centred), "--out", str(tmp_path / "r.npz"), "--t-end", "0.5",
+                   "--atol", "1e300"])
+    err = capsys.readouterr().err
+    assert status == 2 and "--atol" in err and "0.001" in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_stepper_takes_a_path_as_simulate_does() -> None:
+    by_path = winder.Stepper(PAPER)
+    by_text = winder.Stepper(str(PAPER))
+    by_scene = winder.Stepper(winder.load_scene(PAPER))
+    for sim in (by_path, by_text, by_scene):
+        for _ in range(5):
+            sim.step(0.01)
+    assert by_path.state == by_scene.state == by_text.state
+    assert by_path.outputs() == by_scene.outputs()
+    assert by_path.t == by_scene.t == pytest.approx(0.05, abs=1e-15)
+
+
+def test_stepper_path_errors_name_the_file(tmp_path) -> None:
+    with pytest.raises(winder.SceneError, match="no-such.toml"):
+        winder.Stepper(tmp_path / "no-such.toml")
+    with pytest.raises(winder.ArgumentTypeError, match="scene must be a winder.Scene"):
+        winder.Stepper(42)  # type: ignore[arg-type]
