@@ -151,3 +151,37 @@ def test_stepper_path_errors_name_the_file(tmp_path) -> None:
         winder.Stepper(tmp_path / "no-such.toml")
     with pytest.raises(winder.ArgumentTypeError, match="scene must be a winder.Scene"):
         winder.Stepper(42)  # type: ignore[arg-type]
+
+
+def test_run_with_plots_writes_all_or_nothing(tmp_path, monkeypatch, capsys) -> None:
+    """A scene given by its absolute path, ``--plots``, and an error at the second figure:
+    neither the result, nor a figure, nor a temporary is left (the figures are rendered
+    first and written with the result as one set)."""
+    from winder import _plots
+    from winder._files import OutputError
+
+    save, calls = _plots._save, []
+
+    def failing(fig, path):
+        calls.append(path)
+        if len(calls) == 2:
+            _plots.plt.close(fig)
+            raise OutputError(f"cannot write {path}: no space left on device")
+        return save(fig, path)
+
+    monkeypatch.setattr(_plots, "_save", failing)
+    scene = _scene(tmp_path, "short", "duration = 700.0 ", "duration = 0.3   ")
+    plots, out = tmp_path / "plots", tmp_path / "out" / "r.csv"
+    plots.mkdir()
+    status = main(["run", str(scene.resolve()), "--out", str(out), "--plots", str(plots)])
+    err = capsys.readouterr().err
+    assert status == 2 and "no space left" in err, err
+    assert len(calls) == 2
+    assert list(plots.iterdir()) == []
+    assert not out.parent.exists()
+    monkeypatch.setattr(_plots, "_save", save)  # and without the error: all of them
+    assert main(["run", str(scene.resolve()), "--out", str(out), "--plots", str(plots)]) == 0
+    names = sorted(p.name for p in plots.iterdir())
+    assert len(names) == 4 and all(n.startswith("paper_winding_fig") and n.endswith(".png")
+                                   for n in names), names
+    assert sorted(p.name for p in out.parent.iterdir()) == ["r.csv", "r.npz"]

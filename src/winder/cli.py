@@ -136,7 +136,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
         partial.save(*files)
         raise WinderError(f"{exc}\n  partial result up to t = {partial.t[-1]:g} s written "
                           f"to {', '.join(map(str, files))}") from None
-    result.save(*files)
+    figures: list[Path] = []
+    items: list[tuple[Path, Callable[[Path], object]]] = [
+        (f, result._writer(f)) for f in files]
+    if plots is not None:  # rendered first, then written with the result: all or nothing
+        from ._plots import collected, paper_figures
+
+        with collected() as pngs:
+            figures = paper_figures(result, plots, scene=scene)
+        items += [(p, lambda tmp, data=data: tmp.write_bytes(data)) for p, data in pngs]
+    from ._files import atomic_write_all
+
+    atomic_write_all(items)
     m = result.meta
     print(f"{scene.name}: {len(result.t)} samples to {out} ({m['method']}, rtol {m['rtol']:g}, "
           f"{m['rhs_evaluations']} RHS evaluations, {m['wall_time']:.2f} s integration)")
@@ -145,11 +156,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
               f"{m['static_scale']:.1e} N")
     if m.get("ended"):
         print(f"  {m['ended']}")
-    if plots is not None:
-        from ._plots import paper_figures
-
-        for p in paper_figures(result, plots, scene=scene):
-            print(f"  figure {p}")
+    for p in figures:
+        print(f"  figure {p}")
     return 0
 
 
