@@ -185,3 +185,29 @@ def test_run_with_plots_writes_all_or_nothing(tmp_path, monkeypatch, capsys) -> 
     assert len(names) == 4 and all(n.startswith("paper_winding_fig") and n.endswith(".png")
                                    for n in names), names
     assert sorted(p.name for p in out.parent.iterdir()) == ["r.csv", "r.npz"]
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM", "SIGHUP"])
+def test_signal_during_the_writability_probe_leaves_no_probe(sig, tmp_path,
+                                                            monkeypatch) -> None:
+    """The check of an output location writes and removes a probe file; a signal between
+    the two is acted on once the probe is gone (it was left as a ``.winder-*.tmp``)."""
+    import os
+    import signal
+    import tempfile
+
+    from winder import _files
+    from winder._interrupt import Interrupted, handling_signals
+
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, **kwargs):
+        made = real(*args, **kwargs)
+        os.kill(os.getpid(), getattr(signal, sig))
+        return made
+
+    monkeypatch.setattr(_files.tempfile, "mkstemp", mkstemp)
+    with pytest.raises(Interrupted) as info, handling_signals():
+        _files.check_output_file(tmp_path / "r.csv", "--out", suffixes=(".csv",))
+    assert info.value.name == sig
+    assert list(tmp_path.iterdir()) == []
