@@ -211,3 +211,15 @@ def test_signal_during_the_writability_probe_leaves_no_probe(sig, tmp_path,
         _files.check_output_file(tmp_path / "r.csv", "--out", suffixes=(".csv",))
     assert info.value.name == sig
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_stepper_stops_there_too(dropped) -> None:
+    """The Stepper (and the FMU on it) runs the same DOPRI5 kernel: the same stop, the
+    stepper left at the crossing."""
+    sim = winder.Stepper(dropped)
+    with pytest.raises(winder.SimulationError) as info:
+        sim.step(3.0)
+    t_fall = math.sqrt(2.0 * (20.0 - DRUM_RADIUS) / 9.81)
+    assert info.value.time == pytest.approx(t_fall, abs=1e-12)
+    assert sim.t == info.value.time
+    assert 0.0 <= _on_the_bound(sim.state) < 1e-12
