@@ -267,7 +267,6 @@ def _chord(fns: np.ndarray, table: np.ndarray, t: float, hh: float, y0: np.ndarr
     ``max(r_a, r_b)`` (from ``NIP.dx``, ``NIP.dz`` at both ends: a step that moves a body
     by about its radius) is the guard evaluated there."""
     best = 2.0
-    rl = np.empty((0, 0))
     for s in range(table.shape[0]):
         if table[s, 0] != K_CONTACT:
             continue
@@ -287,13 +286,13 @@ def _chord(fns: np.ndarray, table: np.ndarray, t: float, hh: float, y0: np.ndarr
         b2 = x0 * dx + z0 * dz
         disc = b2 * b2 - d2 * (x0 * x0 + z0 * z0 - bound * bound)
         th = 0.5 * (th + max(0.0, (-b2 - math.sqrt(max(disc, 0.0))) / d2))
-        if rl.shape[0] == 0:  # the straight path as a dense output
-            rl = np.zeros((5, y0.shape[0]))
+        for i in range(y0.shape[0]):
+            yt[i] = y0[i] + th * (y1[i] - y0[i])
+        if _switch_at(fns, table[s, 2], tb, t + th * hh, yt, p, m, g) > 0.0:
+            rl = np.zeros((5, y0.shape[0]))  # the straight path as a dense output
             for i in range(y0.shape[0]):
                 rl[0, i] = y0[i]
                 rl[1, i] = y1[i] - y0[i]
-        _dense(rl, th, yt)
-        if _switch_at(fns, table[s, 2], tb, t + th * hh, yt, p, m, g) > 0.0:
             best = min(best, _first_beyond(fns, table, rl, t, hh, th, tb, p, m, yt, g))
         switches(fns, tb, t + hh, y1, p, m, g)  # the probes overwrote g1
     return best
@@ -303,15 +302,15 @@ def _chord(fns: np.ndarray, table: np.ndarray, t: float, hh: float, y0: np.ndarr
 def guard_step(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh: float,
                th_end: float, tb: np.ndarray, p: np.ndarray, m: np.ndarray,
                y0: np.ndarray, y1: np.ndarray, yt: np.ndarray, g: np.ndarray,
-               g0: np.ndarray, t_out: np.ndarray, k: int) -> tuple[float, np.ndarray]:
+               g0: np.ndarray, t_out: np.ndarray, k: int, fresh: bool) -> float:
     """The guard of the kept part ``[0, θ_end]`` of an accepted step from ``(t, y0)`` to
     ``(t + hh, y1)`` with the dense output ``rc`` (cut at a mode switch at ``θ_end``; 1
-    for none), whose output samples start at ``t_out[k]`` (``g``, ``g0``: switching
-    function buffers): ``(θ, state)``, the first ``θ`` where a nip is beyond its
-    penetration bound (:func:`beyond_bound`) at the kept part's end, at a sample inside
-    it or on its straight path (a step that jumps through the other body: located on
-    ``rc`` where a scan of it finds the crossing, else on that path); ``θ = 2`` and an
-    empty state for none."""
+    for none), whose output samples start at ``t_out[k]``: the first ``θ`` where a nip is
+    beyond its penetration bound (:func:`beyond_bound`) at the kept part's end, at a
+    sample inside it or on its straight path (a step that jumps through the other body:
+    located on ``rc`` where a scan of it finds the crossing, else on that path), and
+    ``y0`` moved there; ``θ = 2`` for none. ``g0``, ``g``: switching-function buffers
+    (``g`` already holds them at ``y1`` where ``fresh``: no mode switch in the step)."""
     n = y0.shape[0]
     ye = y1
     if th_end < 1.0:
@@ -319,7 +318,8 @@ def guard_step(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh:
         _dense(rc, th_end, ye)
     best, straight = 2.0, False
     switches(fns, tb, t, y0, p, m, g0)
-    switches(fns, tb, t + th_end * hh, ye, p, m, g)
+    if not (fresh and th_end >= 1.0):
+        switches(fns, tb, t + th_end * hh, ye, p, m, g)
     if beyond_bound(table, g) >= 0:
         best = _first_beyond(fns, table, rc, t, hh, th_end, tb, p, m, yt, g)
         switches(fns, tb, t + th_end * hh, ye, p, m, g)
@@ -342,15 +342,13 @@ def guard_step(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh:
                 best, straight = th, False
             break
         k += 1
-    if best > 1.0:
-        return best, np.empty(0)
-    state = np.empty(n)
-    if straight:
-        for i in range(n):
-            state[i] = y0[i] + best / th_end * (ye[i] - y0[i])
-    else:
-        _dense(rc, best, state)
-    return best, state
+    if best <= 1.0:
+        if straight:
+            for i in range(n):
+                y0[i] += best / th_end * (ye[i] - y0[i])
+        else:
+            _dense(rc, best, y0)
+    return best
 
 
 @njit
@@ -394,8 +392,8 @@ def sample_and_switch(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: flo
                                             True)
     if theta_end > 1.0:
         theta_end = 1.0
-    theta_guard, y_guard = guard_step(fns, table, rc, t, hh, theta_end, tb, p, m, y, y1, yt,
-                                      g, g0, t_out, k)
+    theta_guard = guard_step(fns, table, rc, t, hh, theta_end, tb, p, m, y, y1, yt, g, g0,
+                             t_out, k, slot < 0)  # moves y to the crossing where it finds one
     if theta_guard <= theta_end:
         theta_end, slot = theta_guard, GUARD
     t_end = t + theta_end * hh
@@ -408,10 +406,7 @@ def sample_and_switch(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: flo
         for i in range(n):
             Y_out[i, k] = yt[i]
         k += 1
-    if slot == GUARD:  # the state where the bound is crossed
-        for i in range(n):
-            y[i] = y_guard[i]
-    elif slot >= 0:
+    if slot >= 0:
         _dense(rc, theta_end, y)
         if new_mode == END or (table[slot, 0] == K_CORE and new_mode == AT_CORE):
             y[table[slot, 3]] = p[table[slot, 4]]  # land exactly on the core
@@ -629,11 +624,9 @@ def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
                 rc[2, i] = hs * k1[i] - rc[1, i]
                 rc[3, i] = rc[1, i] - hs * k2[i] - rc[2, i]
                 rc[4, i] = 0.0
-            theta_guard, y_guard = guard_step(fns, table, rc, t, hs, theta, tb, p, m, y, y1,
-                                              yt, g, g0, t_out, k)
-            if theta_guard <= theta:  # stop where the first nip crosses its bound
-                for i in range(n):
-                    y[i] = y_guard[i]
+            theta_guard = guard_step(fns, table, rc, t, hs, theta, tb, p, m, y, y1, yt, g,
+                                     g0, t_out, k, slot < 0)
+            if theta_guard <= theta:  # stopped where the first nip crosses its bound
                 t = t + theta_guard * hs
                 status = PENETRATED
                 break
