@@ -273,9 +273,12 @@ def _option_cases() -> list[Case]:
             return ["modes", str(PAPER), "--points", "5", opt, value]
         return build
 
-    for opt in ("--t-end", "--rtol", "--atol"):
+    for opt in ("--t-end", "--rtol", "--atol", "--max-step"):
         for v in JUNK_NUMBERS:
             cases.append(Case("option", f"run {opt} {v!r}", run_opt(opt, v), names=(opt,)))
+    for v in ("1e300", "0.01", "1"):  # atol beyond 1e-3 [state units] means no error control
+        cases.append(Case("option", f"run --atol {v}", run_opt("--atol", v),
+                          names=("--atol", "0.001")))
     cases.append(Case("option", "run --rtol 2", run_opt("--rtol", "2"), names=("--rtol",)))
     cases.append(Case("option", "run --rtol 1", run_opt("--rtol", "1"), names=("--rtol",)))
     cases.append(Case("option", "run --method junk", run_opt("--method", "junk"),

@@ -40,7 +40,8 @@ def _as_float(text: str) -> float | None:
 OPTIONS = {
     "--t-end": ("run", lambda x: math.isfinite(x) and x > 0),
     "--rtol": ("run", lambda x: 0 < x <= 0.1),
-    "--atol": ("run", lambda x: math.isfinite(x) and x > 0),
+    "--atol": ("run", lambda x: 0 < x <= 1e-3),
+    "--max-step": ("run", lambda x: math.isfinite(x) and x > 0),
     "--max-evals": ("run", lambda x: 1 <= x <= 1e15 and x == int(x)),
     "--max-wall": ("run", lambda x: math.isfinite(x) and x > 0),
     "--every": ("view", lambda x: math.isfinite(x) and x > 0),

@@ -145,6 +145,7 @@ def test_not_toml_and_missing_file_or_directory(tmp_path) -> None:
     ("contact", "law", "y" * 100_000, r"law: 'yyy.*\(100000 characters\) is not one of"),
     ("solver", "max_rhs", 1000.5, r"\[solver\] max_rhs: 1000.5 is not a whole number"),
     ("solver", "rtol", 2.0, r"\[solver\] rtol: must be > 0 and <= 0.1, got 2.0"),
+    ("solver", "atol", 1e300, r"\[solver\] atol: must be > 0 and <= 0.001, got 1e\+300"),
 ])
 def test_out_of_range_names_key_and_bound(tmp_path, models_dir, table, key, value,
                                           pattern) -> None:

@@ -101,16 +101,18 @@ def test_signal_during_the_run(sig: int, tmp_path: Path) -> None:
     assert list((tmp_path / "tmp").iterdir()) == []
 
 
-def test_second_sigint_while_writing(tmp_path: Path) -> None:
+@pytest.mark.parametrize("sig", SIGNALS, ids=lambda s: signal.Signals(s).name)
+def test_second_signal_while_writing(sig: int, tmp_path: Path) -> None:
     out = tmp_path / "r.csv"
     proc = _spawn(tmp_path, "run", str(_big_scene(tmp_path)), "--out", str(out))
     _wait_for(lambda: _debris(tmp_path), proc)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     time.sleep(0.005)
     if proc.poll() is None:
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(sig)
     status, err = _finish(proc)
-    assert status == 130 and "SIGINT" in err and "Traceback" not in err, err
+    name = signal.Signals(sig).name
+    assert status == 128 + sig and name in err and "Traceback" not in err, err
     assert _debris(tmp_path) == [] and not out.exists() and not out.with_suffix(".npz").exists()
 
 
@@ -130,8 +132,7 @@ with handling_signals():
 """
 
 
-@pytest.mark.parametrize("second", [signal.SIGINT, signal.SIGTERM],
-                         ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("second", SIGNALS, ids=lambda s: signal.Signals(s).name)
 def test_second_signal_during_cleanup_says_so(second: int, tmp_path: Path) -> None:
     tmp = tmp_path / "partial.tmp"
     proc = subprocess.Popen([sys.executable, "-c", _SLOW_CLEANUP, str(tmp)],

@@ -19,9 +19,11 @@ BAD = [  # (keyword arguments, what the message must contain)
     ({"rtol": 0.0}, r"rtol = 0.0 .* > 0 and <= 0.1"),
     ({"rtol": -1e-6}, r"rtol = -1e-06 .* > 0 and <= 0.1"),
     ({"rtol": INF}, r"rtol = inf .* finite"),
-    ({"atol": -1.0}, r"atol = -1.0 .* finite and > 0"),
-    ({"atol": 0.0}, r"atol = 0.0 .* finite and > 0"),
+    ({"atol": -1.0}, r"atol = -1.0 .* finite, > 0 and <= 0.001"),
+    ({"atol": 0.0}, r"atol = 0.0 .* finite, > 0 and <= 0.001"),
     ({"atol": NAN}, r"atol = nan"),
+    ({"atol": 1e300}, r"atol = 1e\+300 is out of range; valid: finite, > 0 and <= 0.001"),
+    ({"atol": 0.0011}, r"atol = 0.0011 .* <= 0.001 \(an absolute tolerance"),
     ({"max_step": NAN}, r"max_step = nan .* finite and > 0"),
     ({"max_step": 0.0}, r"max_step = 0.0 .* finite and > 0"),
     ({"max_step": -1.0}, r"max_step = -1.0"),
@@ -106,8 +108,8 @@ def test_scene_of_another_type_is_named(scene) -> None:
 
 @pytest.mark.parametrize(("kwargs", "message"), [
     ({"rtol": 0.0}, r"rtol = 0.0 .* > 0 and <= 0.1"), ({"rtol": NAN}, "rtol = nan"),
-    ({"atol": -1.0}, "atol = -1.0"), ({"max_rhs": 0}, "max_rhs = 0"),
-    ({"max_wall": -1.0}, "max_wall = -1.0")])
+    ({"atol": -1.0}, "atol = -1.0"), ({"atol": 1e300}, r"atol = 1e\+300 .* <= 0.001"),
+    ({"max_rhs": 0}, "max_rhs = 0"), ({"max_wall": -1.0}, "max_wall = -1.0")])
 def test_stepper_arguments(paper_scene, kwargs, message) -> None:
     with pytest.raises(winder.ArgumentError, match=message):
         winder.Stepper(paper_scene, **kwargs)

@@ -10,11 +10,16 @@ from typing import Any
 
 from ._errors import ArgumentError, ArgumentTypeError
 
-__all__ = ["show", "range_text", "check_real", "number", "integer", "RTOL_MAX"]
+__all__ = ["show", "range_text", "check_real", "number", "integer", "RTOL_MAX", "ATOL_MAX"]
 
 #: The largest relative tolerance a scene, :func:`winder.simulate` or the CLI accepts [-]
 #: (beyond it the integrators' error control means nothing).
 RTOL_MAX = 0.1
+#: The largest absolute tolerance [state units: m, rad, m/s, rad/s, N] a scene,
+#: :func:`winder.simulate`, the :class:`~winder.Stepper` or the CLI accepts: 1 mm on a
+#: position whose nip penetration is µm, 1 mN on a friction state. Beyond it the error
+#: control no longer sees the contact (an atol of 1e300 lets a roll sink through its drum).
+ATOL_MAX = 1e-3
 
 
 def show(value: Any, limit: int = 60) -> str:

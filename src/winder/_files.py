@@ -110,12 +110,14 @@ def _existing_ancestor(arg: str, path: Path) -> tuple[Path, list[str]]:
 def _check_writable(arg: str, path: Path, directory: Path) -> None:
     """Create and remove a probe file in ``directory`` (permission bits do not tell the
     truth for root or on read-only mounts)."""
-    try:
-        fd, probe = tempfile.mkstemp(prefix=_TMP_PREFIX, suffix=_TMP_SUFFIX, dir=directory)
-    except OSError as exc:
-        raise _fail(arg, path, f"cannot write in {directory} ({exc.strerror})") from None
-    os.close(fd)
-    os.unlink(probe)
+    with deferred():  # a signal here would leave the probe behind: acted on after it
+        try:
+            fd, probe = tempfile.mkstemp(prefix=_TMP_PREFIX, suffix=_TMP_SUFFIX,
+                                         dir=directory)
+        except OSError as exc:
+            raise _fail(arg, path, f"cannot write in {directory} ({exc.strerror})") from None
+        os.close(fd)
+        os.unlink(probe)
 
 
 def check_output_file(path: str | os.PathLike[str], arg: str, *,

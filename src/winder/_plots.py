@@ -1,9 +1,16 @@
 """Figures from a result (matplotlib, PNG): the paper's figures for a single-drum scene,
-the machine figures for a scene of parts (drums, rolls, nips, free coordinates)."""
+the machine figures for a scene of parts (drums, rolls, nips, free coordinates).
+
+Each figure is written atomically; inside :func:`collected` the figures are rendered in
+memory instead and handed to the caller, who writes them together with its other files
+(all or nothing: ``winder run`` commits its result and its figures as one set)."""
 
 from __future__ import annotations
 
+import io
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import matplotlib
@@ -18,13 +25,34 @@ from ._scene import Scene  # noqa: E402
 from .parts import WebPart  # noqa: E402
 
 __all__ = ["paper_figures", "machine_figures", "campbell_figure", "normal_force_envelope",
-           "window_mean", "nip_colours", "NIP_COLOURS"]
+           "window_mean", "nip_colours", "NIP_COLOURS", "collected"]
+
+#: The figures rendered inside :func:`collected` (path, PNG bytes); None outside it.
+_COLLECTED: list[tuple[Path, bytes]] | None = None
+
+
+@contextmanager
+def collected() -> Iterator[list[tuple[Path, bytes]]]:
+    """Inside the block the figure functions render their PNGs into the list yielded,
+    ``(path, bytes)`` each, and write nothing: the caller writes them (with
+    :func:`winder._files.atomic_write_all`, together with its other files)."""
+    global _COLLECTED
+    previous, _COLLECTED = _COLLECTED, []
+    try:
+        yield _COLLECTED
+    finally:
+        _COLLECTED = previous
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
     try:
         fig.tight_layout()
-        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+        if _COLLECTED is not None:
+            png = io.BytesIO()
+            fig.savefig(png, dpi=110, format="png")
+            _COLLECTED.append((path, png.getvalue()))
+        else:
+            atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
     finally:
         plt.close(fig)
     return path

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ._args import RTOL_MAX, check_real, show
+from ._args import ATOL_MAX, RTOL_MAX, check_real, show
 from ._errors import ArgumentError, ArgumentTypeError, SceneError
 from .parts import (
     AXES,
@@ -188,7 +188,7 @@ class Friction(FrictionLaw):
 
 @dataclass(frozen=True)
 class Solver:
-    """``[solver]``: method (one of :data:`METHODS`), rtol (0, 0.1] [-], atol (0, 1]
+    """``[solver]``: method (one of :data:`METHODS`), rtol (0, 0.1] [-], atol (0, 1e-3]
     [state units], max_rhs (guard: an integer 1 … 1e12 of right-hand side evaluations),
     backend (one of :data:`BACKENDS`), max_wall (guard: wall-clock seconds, > 0) [s]."""
 
@@ -439,7 +439,7 @@ _NUMBERS: dict[tuple[str, str], tuple[float | None, str]] = {
     ("friction", "mu"): (10.0, "-"), ("friction", "slip_velocity"): (1e3, "m/s"),
     ("friction", "relaxation_length"): (1e3, "m"), ("friction", "min_speed"): (1e3, "m/s"),
     ("solver", "rtol"): (RTOL_MAX, "-"),
-    ("solver", "atol"): (1.0, "state units"),  # in each state's own unit
+    ("solver", "atol"): (ATOL_MAX, "state units"),  # in each state's own unit
     ("solver", "max_rhs"): (1e12, "-"), ("solver", "max_wall"): (None, "s"),
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,

@@ -13,7 +13,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ._args import RTOL_MAX, show
+from ._args import ATOL_MAX, RTOL_MAX, show
 from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError, state_text
 from ._result import Result
 from ._scene import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
@@ -57,11 +57,13 @@ def check_real(name: str, value: Any, ok: Callable[[float], bool], valid: str) -
 
 
 def check_tolerances(rtol: Any, atol: Any) -> tuple[float, float]:
-    """Validated ``(rtol, atol)``: rtol finite in ``(0, RTOL_MAX]``, atol finite and ``> 0``."""
+    """Validated ``(rtol, atol)``: rtol finite in ``(0, RTOL_MAX]``, atol finite in
+    ``(0, ATOL_MAX]``."""
     r = check_real("rtol", rtol, lambda v: math.isfinite(v) and 0.0 < v <= RTOL_MAX,
                    f"finite, > 0 and <= {RTOL_MAX:g} (a relative tolerance, e.g. 1e-6)")
-    a = check_real("atol", atol, lambda v: math.isfinite(v) and v > 0.0,
-                   "finite and > 0 (an absolute tolerance in state units, e.g. 1e-8)")
+    a = check_real("atol", atol, lambda v: math.isfinite(v) and 0.0 < v <= ATOL_MAX,
+                   f"finite, > 0 and <= {ATOL_MAX:g} (an absolute tolerance in state units "
+                   "[m, rad, N], e.g. 1e-8)")
     return r, a
 
 
@@ -287,6 +289,9 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
                 raise guards.error(f"step size underflow with method {meth!r} (the problem "
                                    "is too stiff or discontinuous for it): try "
                                    "method='Radau' or 'LSODA'", t, y)
+            if status == integ.PENETRATED:
+                raise system.penetration_error(t, y, method=meth, max_step=max_step,
+                                               atol=atol)
             if status == integ.EXHAUSTED:
                 system.ended(t, y)
                 return k
@@ -318,7 +323,8 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         with contact events), RK4 (fixed step ``max_step``, default 1 ms), ROS2 (compiled
         Rosenbrock on the exact Jacobian, for stiff scenes), or scipy's RK45, DOP853,
         Radau, BDF, LSODA, RK23; default ``[solver] method``.
-    rtol, atol: tolerances, rtol finite in (0, 0.1], atol finite > 0 (default ``[solver]``).
+    rtol, atol: tolerances, rtol finite in (0, 0.1], atol finite in (0, 1e-3] [state
+        units] (default ``[solver]``).
     progress: print a progress bar on stderr.
     output_step: sampling of the result [s], finite > 0 (default ``[scene] output_step``);
         at most :data:`MAX_SAMPLES` samples.

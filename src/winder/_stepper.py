@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import time
 from typing import Any
 
@@ -11,7 +12,7 @@ import numpy as np
 from ._errors import ArgumentError, SimulationError, state_text
 from ._result import Result
 from ._scene import Scene
-from ._simulate import budget_error, check_budgets, check_real, check_tolerances
+from ._simulate import _as_scene, budget_error, check_budgets, check_real, check_tolerances
 from .solve import integrators as integ
 from .solve.system import LEGACY_CHANNELS, MachineSystem
 
@@ -62,18 +63,21 @@ class Stepper:
 
     Parameters
     ----------
-    scene: the scene (a drum of drive kind ``torque`` for a torque input; its drive's
-        ``torque`` is the input until :meth:`set_input` changes it). Inputs:
-        :attr:`inputs` (``drum_torque`` for a single-drum scene, ``DRUM_torque`` per
+    scene: the scene, from :func:`winder.load_scene` or the path of a scene file (as
+        :func:`winder.simulate` takes it); a drum of drive kind ``torque`` for a torque
+        input (its drive's ``torque`` is the input until :meth:`set_input` changes it).
+        Inputs: :attr:`inputs` (``drum_torque`` for a single-drum scene, ``DRUM_torque`` per
         torque-driven drum of a machine from parts); outputs: :attr:`output_names`.
     rtol, atol: tolerances of the internal integrator (default ``1e-8``, ``1e-10``): rtol
-        finite in (0, 0.1], atol finite > 0.
+        finite in (0, 0.1], atol finite in (0, 1e-3] [state units].
     max_rhs, max_wall: budget of each :meth:`step`: evaluations and wall-clock seconds
         (default ``[solver] max_rhs`` and ``max_wall``).
     """
 
-    def __init__(self, scene: Scene, *, rtol: float = 1e-8, atol: float = 1e-10,
-                 max_rhs: int | None = None, max_wall: float | None = None) -> None:
+    def __init__(self, scene: Scene | str | os.PathLike, *, rtol: float = 1e-8,
+                 atol: float = 1e-10, max_rhs: int | None = None,
+                 max_wall: float | None = None) -> None:
+        scene = _as_scene(scene)
         self.rtol, self.atol = check_tolerances(rtol, atol)
         self.max_rhs, self.max_wall = check_budgets(
             scene.solver.max_rhs if max_rhs is None else max_rhs,
@@ -133,7 +137,8 @@ class Stepper:
         ArgumentError: a bad ``dt``.
         BudgetExceeded: the step reached its budget; the stepper stays at the time
             reached (``.time``) and may go on from there.
-        SimulationError: the integration failed.
+        SimulationError: the integration failed, or a nip's penetration reached its bound
+            (δ >= min(r_a, r_b); the stepper stays at that time).
         """
         if self.ended is not None:
             raise SimulationError(f"the run has ended: {self.ended}", time=self.t,
@@ -167,6 +172,11 @@ class Stepper:
                             else "the step size underflowed (too stiff or discontinuous)")
                     raise SimulationError(f"integration failed at t = {t:.6g} s: {what} "
                                           f"(state: {where})", time=t, state=self.state)
+                if status == integ.PENETRATED:  # a nip beyond its bound: stop there
+                    self.t, self._h = t, h
+                    self._outputs = None
+                    raise sy.penetration_error(t, self.y, method="DOPRI5", max_step=None,
+                                               atol=self.atol)
                 if status == integ.EXHAUSTED:  # the unwinding roll ran out of web
                     self.system.ended(t, self.y)
                     self.t, self._h = t, h

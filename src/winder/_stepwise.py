@@ -102,17 +102,104 @@ def _locate(event: _Event, sol: DenseOutput, ta: float, tb: float,
     return t_ev, sol(t_ev)
 
 
+class _Beyond(Exception):
+    """A nip crossed its penetration bound at ``(t, y)`` within an accepted step."""
+
+    def __init__(self, t: float, y: np.ndarray) -> None:
+        super().__init__(t)
+        self.t, self.y = t, y
+
+
+def _guard(system: MachineSystem, bounds: list[tuple[int, int, int]], solver: OdeSolver,
+           y_a: np.ndarray, t_b: float, y_b: np.ndarray, t_out: np.ndarray,
+           filled: int) -> None:
+    """The guard of every accepted step (as the compiled integrators',
+    :func:`~winder.solve.integrators.guard_step`), on its kept part from its start
+    ``y_a`` to ``(t_b, y_b)`` (the step's end or its first event): where a nip's
+    ``NIP.overlap`` is beyond its bound at that end, at an output sample inside it, or on
+    the straight path between (closest approach from ``NIP.dx``, ``NIP.dz``), raise
+    :class:`_Beyond` at the crossing. ``bounds``: the switching functions ``(overlap, dx,
+    dz)`` of each nip."""
+    if not bounds:
+        return
+    t_a = float(solver.t_old)
+    sol: Any = None
+
+    def over(t: float, y: np.ndarray, go: int) -> float:
+        return float(system.switches(t, y)[go])
+
+    def beyond(go: int, t_c: float, y_c: np.ndarray) -> _Beyond:
+        """At the crossing of ``go`` on the interpolant before ``t_c``, on its far side."""
+        t_x, y_x = _locate((lambda t, y: over(t, y, go), True), sol, t_a, t_c, y_c)
+        for _ in range(64):
+            if over(t_x, y_x, go) > 0.0 or t_x >= t_c:
+                break
+            t_x = min(t_c, float(np.nextafter(t_x, math.inf)))
+            y_x = y_c if t_x == t_c else sol(t_x)
+        return _Beyond(t_x, np.array(y_x, dtype=float))
+
+    points = [(float(ts), None) for ts in t_out[filled:np.searchsorted(t_out, t_b, "right")]]
+    for t_c, _ in [*points, (t_b, None)]:
+        if t_c == t_b:
+            y_c = y_b
+        else:
+            sol = sol or solver.dense_output()
+            y_c = sol(t_c)
+        g = system.switches(t_c, y_c)
+        crossed = [go for go, _, _ in bounds if not g[go] <= 0.0]
+        if not crossed:
+            continue
+        if not all(np.isfinite(g[go]) for go in crossed) or t_c <= t_a:
+            raise _Beyond(t_c, np.array(y_c, dtype=float))
+        sol = sol or solver.dense_output()
+        raise min((beyond(go, t_c, y_c) for go in crossed), key=lambda e: e.t)
+    g0, g1 = system.switches(t_a, y_a), system.switches(t_b, y_b)
+    h = t_b - t_a
+
+    def line(theta: float) -> np.ndarray:
+        return y_a + theta * (y_b - y_a)
+
+    for go, gx, gz in bounds:  # the straight path: a step that jumps through the body
+        x0, z0, x1, z1 = g0[gx], g0[gz], g1[gx], g1[gz]
+        dx, dz = x1 - x0, z1 - z0
+        d2 = dx * dx + dz * dz
+        if not d2 > 0.0:
+            continue
+        th = min(1.0, max(0.0, -(x0 * dx + z0 * dz) / d2))  # closest approach
+        bound = g1[go] + math.hypot(x1, z1)  # max(r_a, r_b)
+        if not math.hypot(x0 + th * dx, z0 + th * dz) < bound:
+            continue
+        b2 = x0 * dx + z0 * dz  # probe between entering that circle and the closest approach
+        disc = b2 * b2 - d2 * (x0 * x0 + z0 * z0 - bound * bound)
+        th = 0.5 * (th + max(0.0, (-b2 - math.sqrt(max(disc, 0.0))) / d2))
+        if not over(t_a + th * h, line(th), go) > 0.0:
+            continue
+        sol = sol or solver.dense_output()
+        for q in np.linspace(0.0, 1.0, 65)[1:]:  # where the interpolant passes beyond
+            y_q = sol(t_a + q * h)
+            if over(t_a + q * h, y_q, go) > 0.0:
+                raise beyond(go, t_a + q * h, y_q)
+        th = brentq(lambda q, go=go: over(t_a + q * h, line(q), go), 0.0, th,
+                    xtol=4 * np.finfo(float).eps)
+        while not over(t_a + th * h, line(th), go) > 0.0:  # on the far side of the root
+            th = np.nextafter(th, 2.0)
+        raise _Beyond(t_a + th * h, line(th))
+
+
 def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
              y0: np.ndarray, t_stop: float, events: list[_Event], t_out: np.ndarray,
-             Ys: np.ndarray, filled: int, guards: _Guards, meth: str
+             Ys: np.ndarray, filled: int, guards: _Guards, meth: str,
+             system: MachineSystem, bounds: list[tuple[int, int, int]]
              ) -> tuple[float, np.ndarray, int, int]:
     """Integrate from ``t0`` until ``t_stop`` or the first event; samples into ``Ys``.
     Returns ``(t, y, filled, event index or -1)``. A spent budget raises :class:`_Stop`
-    carrying the last accepted ``(t, y, step)``."""
+    carrying the last accepted ``(t, y, step)``; a nip beyond its penetration bound
+    (switching functions ``bounds``) raises :class:`_Beyond`."""
     while filled < len(t_out) and t_out[filled] <= t0:
         Ys[:, filled] = y0
         filled += 1
     solver = None
+    y_a = np.array(y0, dtype=float)  # the start of the step
     try:
         solver = make(t0, y0, t_stop)
         while True:
@@ -130,6 +217,8 @@ def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
                     t_ev, y_ev = _locate(events[i], sol, t_a, t_b, y_b)
                     if hit < 0 or t_ev < t_lim:
                         hit, t_lim, y_lim = i, t_ev, y_ev
+            _guard(system, bounds, solver, y_a, t_lim, y_lim, t_out, filled)
+            y_a = np.array(y_b, dtype=float)
             while filled < len(t_out) and t_out[filled] <= t_lim:
                 if t_out[filled] == t_b:
                     Ys[:, filled] = y_b
@@ -189,6 +278,7 @@ def run_stepwise(system: MachineSystem, meth: str, y0: np.ndarray, t_s: float,
     cores = [s for s in range(len(table)) if table[s, 0] == integ.K_CORE]
     contacts = [s for s in range(len(table)) if table[s, 0] == integ.K_CONTACT]
     ends = [s for s in range(len(table)) if table[s, 0] == integ.K_END]
+    bounds = [(int(table[s, 2]), int(table[s, 3]), int(table[s, 4])) for s in contacts]
     contact_events = events and system.scene.effects.contact and meth != "RK4"
     filled, n_events, t0, y = 0, 0, t_s, np.array(y0, dtype=float)
     g = system.switches(t0, y)
@@ -217,8 +307,12 @@ def run_stepwise(system: MachineSystem, meth: str, y0: np.ndarray, t_s: float,
                 for s in contacts:  # the event leaves the current side
                     evs.append((switch(table[s, 1]), not touching[s]))
                     slots.append(s)
-            t1, y, filled, hit = _segment(make, t0, y, t_stop, evs, t_out, Ys, filled,
-                                          guards, meth)
+            try:
+                t1, y, filled, hit = _segment(make, t0, y, t_stop, evs, t_out, Ys, filled,
+                                              guards, meth, system, bounds)
+            except _Beyond as stop:
+                raise system.penetration_error(stop.t, stop.y, method=meth,
+                                               max_step=max_step, atol=atol) from None
             if hit >= 0:
                 n_events += 1
                 s = slots[hit]

@@ -27,7 +27,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from ._args import RTOL_MAX
+from ._args import ATOL_MAX, RTOL_MAX
 from ._errors import WinderError
 from ._interrupt import Interrupted, handling_signals
 
@@ -65,6 +65,7 @@ def _number(lo: float, hi: float = math.inf, *, lo_open: bool = True,
 
 _POSITIVE = _number(0.0)
 _RTOL = _number(0.0, RTOL_MAX)
+_ATOL = _number(0.0, ATOL_MAX)
 _PLAYBACK = _number(0.0, 3600.0)
 _POINTS = _number(2, 100_000, lo_open=False, integer=True)
 _EVALS = _number(1, 1e15, lo_open=False, integer=True)
@@ -128,7 +129,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     progress = sys.stderr.isatty() if args.progress is None else args.progress
     try:
         result = simulate(scene, t_end=args.t_end, method=args.method, rtol=args.rtol,
-                          atol=args.atol, progress=progress, backend=args.backend,
+                          atol=args.atol, max_step=args.max_step, progress=progress,
+                          backend=args.backend,
                           max_rhs=args.max_evals, max_wall=args.max_wall)
     except EquilibriumError as exc:  # machines.md §7: no initial balance, a scene error
         raise WinderError(f"{args.scene}: {exc}") from None
@@ -144,7 +146,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
         partial.save(*files)
         raise WinderError(f"{exc}\n  partial result up to t = {partial.t[-1]:g} s written "
                           f"to {', '.join(map(str, files))}") from None
-    result.save(*files)
+    figures: list[Path] = []
+    items: list[tuple[Path, Callable[[Path], object]]] = [
+        (f, result._writer(f)) for f in files]
+    if plots is not None:  # rendered first, then written with the result: all or nothing
+        from ._plots import collected, paper_figures
+
+        with collected() as pngs:
+            figures = paper_figures(result, plots, scene=scene)
+        items += [(p, lambda tmp, data=data: tmp.write_bytes(data)) for p, data in pngs]
+    from ._files import atomic_write_all
+
+    atomic_write_all(items)
     m = result.meta
     print(f"{scene.name}: {len(result.t)} samples to {out} ({m['method']}, rtol {m['rtol']:g}, "
           f"{m['rhs_evaluations']} RHS evaluations, {m['wall_time']:.2f} s integration)")
@@ -152,11 +165,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         print("  " + _balance_text(m["static_residual"], m["static_scale"]))
     if m.get("ended"):
         print(f"  {m['ended']}")
-    if plots is not None:
-        from ._plots import paper_figures
-
-        for p in paper_figures(result, plots, scene=scene):
-            print(f"  figure {p}")
+    for p in figures:
+        print(f"  figure {p}")
     return 0
 
 
@@ -440,7 +450,10 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--backend", help=f"right-hand side: {' or '.join(BACKENDS)} (default: "
                      "the scene's [solver] backend, else compiled)")
     run.add_argument("--rtol", type=_RTOL, help=f"relative tolerance (0 < rtol <= {RTOL_MAX:g})")
-    run.add_argument("--atol", type=_POSITIVE, help="absolute tolerance (> 0)")
+    run.add_argument("--atol", type=_ATOL,
+                     help=f"absolute tolerance [state units] (0 < atol <= {ATOL_MAX:g})")
+    run.add_argument("--max-step", type=_POSITIVE, metavar="SECONDS",
+                     help="largest step [s] (the step of RK4, default 1e-3)")
     run.add_argument("--max-evals", type=_EVALS, metavar="N",
                      help="budget of right-hand side evaluations (default: [solver] max_rhs)")
     run.add_argument("--max-wall", type=_POSITIVE, metavar="SECONDS",

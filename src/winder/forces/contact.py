@@ -9,6 +9,13 @@ negative, zero for ``δ ≤ 0``: linear ``k δ + c δ̇`` or Hunt–Crossley
 Each nip has a locked contact mode (``AUTO`` the clamped law, ``FREE`` no force,
 ``IN_CONTACT`` the unclamped law, smoothly extended to ``δ < 0``) and a switching function
 ``min(δ, F_unclamped/k)`` [m], > 0 exactly where the clamped law gives ``F_n > 0``.
+
+Each nip also has the guard function ``NIP.overlap = δ − min(r_a, r_b)`` [m]: > 0 where
+the penetration reaches the smaller radius, i.e. the axis of one body lies inside the
+other (the integrators stop the run there: no nip carries its load so, and the state no
+longer describes a contact; see :func:`winder.solve.integrators.beyond_bound`), and the
+centre of ``b`` relative to ``a``, ``NIP.dx`` and ``NIP.dz`` [m], for a step that jumps
+through the other body between its ends.
 """
 
 from __future__ import annotations
@@ -80,7 +87,8 @@ class Contact(ForceElement):
                 machine.parameter(f"{nip.name}.{key}", getattr(c, key))
             machine.parameter(f"{nip.name}.mu", f.mu)
             machine.parameter(f"{nip.name}.slip_velocity", f.slip_velocity)
-            machine.mode(f"{nip.name}.contact", (f"{nip.name}.contact",))
+            machine.mode(f"{nip.name}.contact", tuple(
+                f"{nip.name}.{g}" for g in ("contact", "overlap", "dx", "dz")))
 
     def apply(self, ev: Evaluation) -> None:
         M = ev.M
@@ -93,6 +101,10 @@ class Contact(ForceElement):
 
             fu = unclamped_force(M, law, par, ns.delta, ns.delta_dot)
             ev.switches[f"{nip.name}.contact"] = M.fmin(ns.delta, fu / par("stiffness"))
+            a, b = ev.bodies[nip.a.name], ev.bodies[nip.b.name]
+            ev.switches[f"{nip.name}.overlap"] = ns.delta - M.fmin(a.r, b.r)
+            ev.switches[f"{nip.name}.dx"] = b.cx - a.cx
+            ev.switches[f"{nip.name}.dz"] = b.cz - a.cz
             fn = normal_force(M, ev.mode(f"{nip.name}.contact"), ns.delta, fu)
             ns.normal_force = fn
             ns.steady_friction = par("mu") * fn * M.tanh(ns.v_s / par("slip_velocity"))

@@ -12,7 +12,9 @@ core lands exactly on ``r_c``.
 
 The machine's functions are called through their addresses (:mod:`winder.core.ccall`):
 ``fns = [rhs, jac, out, sw]``. Mode slots are described by ``table`` rows ``(kind, g1,
-g2, state, param)``: kind :data:`K_CONTACT` (``g1`` its switching function),
+g2, state, param)``: kind :data:`K_CONTACT` (``g1`` its switching function, ``g2``
+its guard ``NIP.overlap``, then the guard's ``NIP.dx`` and ``NIP.dz`` in place of state
+and param),
 :data:`K_CORE` (``g1`` = ``r_c − r``, ``g2`` = speed, ``state`` the radius, ``param``
 ``r_c``) or :data:`K_END` (an unwinding roll: ``g1`` = ``r_c − r``; where it crosses
 zero the roll has run out of web, the radius lands on ``r_c`` and the integration stops
@@ -21,7 +23,18 @@ with :data:`EXHAUSTED`).
 Both functions integrate ``y`` in place, write samples at output times into a caller's
 array and keep counters in ``stats = [nfev, accepted, rejected, events, stiff steps]``.
 Status codes: :data:`DONE`, :data:`PAUSED` (the evaluation budget of this call is spent;
-call again to resume), :data:`STEP_UNDERFLOW`, :data:`NON_FINITE`, :data:`EXHAUSTED`.
+call again to resume), :data:`STEP_UNDERFLOW`, :data:`NON_FINITE`, :data:`EXHAUSTED`,
+:data:`PENETRATED`.
+
+The guard of every accepted step (:func:`guard_step`: DOPRI5 and ROS2 in
+:func:`sample_and_switch`, RK4 after its non-finite check): where a nip's guard function
+``NIP.overlap = δ − min(r_a, r_b)`` (the contact row's ``g2``) is positive or not a number
+at the step's end or at an output sample inside it, or where the straight path of the
+step (from its start to its end) takes it there (a step that jumps through the other
+body), the first crossing of the bound is located, ``y`` moves there and the integration
+stops with :data:`PENETRATED`: one body's axis inside the other means the integrator lost
+the contact (a step or tolerance far too coarse for the nip), and every later number
+would be wrong.
 """
 
 from __future__ import annotations
@@ -36,13 +49,16 @@ from ..core.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
 
 __all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "switch_buffer", "first_step",
            "sample_and_switch", "DONE", "PAUSED",
-           "STEP_UNDERFLOW", "NON_FINITE", "EXHAUSTED", "CHUNK", "TIME_RESOLUTION",
+           "STEP_UNDERFLOW", "NON_FINITE", "EXHAUSTED", "PENETRATED", "CHUNK",
+           "TIME_RESOLUTION", "beyond_bound", "guard_step",
            "K_CONTACT", "K_CORE", "K_END"]
 
-DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE, EXHAUSTED = 0, 1, 2, 3, 4
+DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE, EXHAUSTED, PENETRATED = 0, 1, 2, 3, 4, 5
 K_CONTACT, K_CORE, K_END = 0, 1, 2
 #: The mode a :data:`K_END` slot switches to: the run ends (an unwinding roll at its core).
 END = 9
+#: The slot :func:`sample_and_switch` returns where a nip crossed its penetration bound.
+GUARD = -2
 F_RHS, F_JAC, F_OUT, F_SW = 0, 1, 2, 3
 #: Shortest step [s] relative to ``max(1 s, |t|)``; below it the time is not resolved.
 TIME_RESOLUTION = 1e-14
@@ -196,9 +212,154 @@ def _next_event(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh
 
 
 @njit
+def beyond_bound(table: np.ndarray, g: np.ndarray) -> int:
+    """The first contact slot whose guard function (``g2`` of its row, ``NIP.overlap``
+    [m] in the switching functions ``g`` of one state) is beyond its bound: positive, or
+    not a number. -1 for none."""
+    for s in range(table.shape[0]):
+        if table[s, 0] == K_CONTACT and not g[table[s, 2]] <= 0.0:
+            return s
+    return -1
+
+
+@njit
+def _beyond_at(fns: np.ndarray, table: np.ndarray, tb: np.ndarray, t: float,
+               y: np.ndarray, p: np.ndarray, m: np.ndarray, g: np.ndarray) -> bool:
+    """Whether a nip is beyond its penetration bound at ``(t, y)`` (:func:`beyond_bound`)."""
+    switches(fns, tb, t, y, p, m, g)
+    return beyond_bound(table, g) >= 0
+
+
+@njit
+def _first_beyond(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh: float,
+                  th_hi: float, tb: np.ndarray, p: np.ndarray, m: np.ndarray,
+                  yt: np.ndarray, g: np.ndarray) -> float:
+    """Where the nips beyond their penetration bound at ``θ_hi`` of a step (dense output
+    ``rc``, length ``hh``) cross it: the first ``θ`` in ``(0, θ_hi]`` with the guard
+    function > 0, by bisection to ~1e-18 of the step (``θ_hi`` for a non-finite one)."""
+    best = th_hi
+    for s in range(table.shape[0]):
+        if table[s, 0] != K_CONTACT:
+            continue
+        gi = table[s, 2]
+        _dense(rc, th_hi, yt)
+        if not _switch_at(fns, gi, tb, t + th_hi * hh, yt, p, m, g) > 0.0:
+            continue
+        ta, tb_ = 0.0, th_hi
+        for _ in range(60):
+            th = 0.5 * (ta + tb_)
+            _dense(rc, th, yt)
+            if _switch_at(fns, gi, tb, t + th * hh, yt, p, m, g) > 0.0:
+                tb_ = th
+            else:
+                ta = th
+        best = min(best, tb_)
+    return best
+
+
+@njit
+def _chord(fns: np.ndarray, table: np.ndarray, t: float, hh: float, y0: np.ndarray,
+           y1: np.ndarray, g0: np.ndarray, tb: np.ndarray, p: np.ndarray, m: np.ndarray,
+           yt: np.ndarray, g: np.ndarray) -> float:
+    """``θ`` where the straight path of a step from ``y0`` to ``y1`` (switching functions
+    ``g0``, ``g`` there; ``g`` is also the probes' buffer) first takes a nip beyond its
+    penetration bound, 2 for none. Only where the centres come closer on that path than
+    ``max(r_a, r_b)`` (from ``NIP.dx``, ``NIP.dz`` at both ends: a step that moves a body
+    by about its radius) is the guard evaluated there."""
+    best = 2.0
+    for s in range(table.shape[0]):
+        if table[s, 0] != K_CONTACT:
+            continue
+        x0, z0 = g0[table[s, 3]], g0[table[s, 4]]
+        x1, z1 = g[table[s, 3]], g[table[s, 4]]
+        dx, dz = x1 - x0, z1 - z0
+        d2 = dx * dx + dz * dz
+        bound = g[table[s, 2]] + math.sqrt(x1 * x1 + z1 * z1)  # max(r_a, r_b) at the end
+        if not d2 > 0.0:
+            continue
+        th = min(1.0, max(0.0, -(x0 * dx + z0 * dz) / d2))  # closest approach
+        cx, cz = x0 + th * dx, z0 + th * dz
+        if not cx * cx + cz * cz < bound * bound:
+            continue
+        # probe halfway between entering the bound's circle and the closest approach
+        # (which may be the other centre itself, where the nip has no normal)
+        b2 = x0 * dx + z0 * dz
+        disc = b2 * b2 - d2 * (x0 * x0 + z0 * z0 - bound * bound)
+        th = 0.5 * (th + max(0.0, (-b2 - math.sqrt(max(disc, 0.0))) / d2))
+        for i in range(y0.shape[0]):
+            yt[i] = y0[i] + th * (y1[i] - y0[i])
+        if _switch_at(fns, table[s, 2], tb, t + th * hh, yt, p, m, g) > 0.0:
+            rl = np.zeros((5, y0.shape[0]))  # the straight path as a dense output
+            for i in range(y0.shape[0]):
+                rl[0, i] = y0[i]
+                rl[1, i] = y1[i] - y0[i]
+            best = min(best, _first_beyond(fns, table, rl, t, hh, th, tb, p, m, yt, g))
+        switches(fns, tb, t + hh, y1, p, m, g)  # the probes overwrote g1
+    return best
+
+
+@njit
+def guard_step(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float, hh: float,
+               th_end: float, tb: np.ndarray, p: np.ndarray, m: np.ndarray,
+               y0: np.ndarray, y1: np.ndarray, yt: np.ndarray, g: np.ndarray,
+               g0: np.ndarray, t_out: np.ndarray, k: int, fresh: bool) -> float:
+    """The guard of the kept part ``[0, θ_end]`` of an accepted step from ``(t, y0)`` to
+    ``(t + hh, y1)`` with the dense output ``rc`` (cut at a mode switch at ``θ_end``; 1
+    for none), whose output samples start at ``t_out[k]``: the first ``θ`` where a nip is
+    beyond its penetration bound (:func:`beyond_bound`) at the kept part's end, at a
+    sample inside it or on its straight path (a step that jumps through the other body:
+    located on ``rc`` where a scan of it finds the crossing, else on that path), and
+    ``y0`` moved there; ``θ = 2`` for none. ``g0``, ``g``: switching-function buffers
+    (``g`` already holds them at ``y1`` where ``fresh``: no mode switch in the step)."""
+    n = y0.shape[0]
+    ye = y1
+    if th_end < 1.0:
+        ye = np.empty(n)
+        _dense(rc, th_end, ye)
+    best, straight = 2.0, False
+    switches(fns, tb, t, y0, p, m, g0)
+    if not (fresh and th_end >= 1.0):
+        switches(fns, tb, t + th_end * hh, ye, p, m, g)
+    if beyond_bound(table, g) >= 0:
+        best = _first_beyond(fns, table, rc, t, hh, th_end, tb, p, m, yt, g)
+        switches(fns, tb, t + th_end * hh, ye, p, m, g)
+    th = _chord(fns, table, t, th_end * hh, y0, ye, g0, tb, p, m, yt, g)
+    if th * th_end < best:  # where the dense output passes beyond, if it does
+        best, straight = th * th_end, True
+        for j in range(1, 65):
+            tj = th_end * j / 64.0
+            _dense(rc, tj, yt)
+            if _beyond_at(fns, table, tb, t + tj * hh, yt, p, m, g):
+                best = _first_beyond(fns, table, rc, t, hh, tj, tb, p, m, yt, g)
+                straight = False
+                break
+    while k < t_out.shape[0] and t_out[k] <= t + min(best, th_end) * hh:
+        th = max(0.0, (t_out[k] - t) / hh)
+        _dense(rc, th, yt)
+        if _beyond_at(fns, table, tb, t + th * hh, yt, p, m, g):
+            th = _first_beyond(fns, table, rc, t, hh, th, tb, p, m, yt, g)
+            if th < best:
+                best, straight = th, False
+            break
+        k += 1
+    if best <= 1.0:
+        if straight:
+            for i in range(n):
+                y0[i] += best / th_end * (ye[i] - y0[i])
+        else:
+            _dense(rc, best, y0)
+    return best
+
+
+@njit
 def switch_buffer(table: np.ndarray) -> np.ndarray:
     """A buffer for every switching function the mode ``table`` refers to."""
-    return np.empty(max(1, int(table[:, 1:3].max()) + 1 if table.shape[0] else 1))
+    size = 1
+    for s in range(table.shape[0]):
+        last = 5 if table[s, 0] == K_CONTACT else 3
+        for c in range(1, last):
+            size = max(size, int(table[s, c]) + 1)
+    return np.empty(size)
 
 
 @njit
@@ -218,20 +379,28 @@ def first_step(y: np.ndarray, f: np.ndarray, rtol: float, atol: float) -> float:
 def sample_and_switch(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: float,
                       hh: float, t1: float, tb: np.ndarray, p: np.ndarray, m: np.ndarray,
                       y: np.ndarray, y1: np.ndarray, yt: np.ndarray, g: np.ndarray,
-                      t_out: np.ndarray, Y_out: np.ndarray,
+                      g0: np.ndarray, t_out: np.ndarray, Y_out: np.ndarray,
                       k: int) -> tuple[int, float, float, int]:
     """After an accepted step from ``(t, y)`` to ``y1`` with the dense output ``rc``: the
     first mode switch inside it (:func:`_next_event`), the output samples up to it (or to
     the step's end), and, at a switch, ``y`` moved to the crossing, landed exactly on the
-    core where a roll reaches it. Returns ``(slot or -1, new mode, end time, k)``."""
+    core where a roll reaches it. Where a nip crosses its penetration bound first
+    (:func:`beyond_bound`), ``y`` moves to that crossing and the slot is :data:`GUARD`.
+    Returns ``(slot or -1, new mode, end time, k)``."""
     n = y.shape[0]
     theta_end, slot, new_mode = _next_event(fns, table, rc, t, hh, tb, p, m, y1, yt, g,
                                             True)
     if theta_end > 1.0:
         theta_end = 1.0
+    theta_guard = guard_step(fns, table, rc, t, hh, theta_end, tb, p, m, y, y1, yt, g, g0,
+                             t_out, k, slot < 0)  # moves y to the crossing where it finds one
+    if theta_guard <= theta_end:
+        theta_end, slot = theta_guard, GUARD
     t_end = t + theta_end * hh
     while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
         if t_out[k] > t1 + 1e-13 * max(1.0, abs(t1)):
+            break
+        if slot == GUARD and t_out[k] >= t_end:
             break
         _dense(rc, min(theta_end, max(0.0, (t_out[k] - t) / hh)), yt)
         for i in range(n):
@@ -259,7 +428,7 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
     yt, y1 = np.empty(n), np.empty(n)
     rc = np.empty((5, n))
     tb = np.empty(1)
-    g = switch_buffer(table)
+    g, g0 = switch_buffer(table), switch_buffer(table)
     t = t0
     modes_of(fns, table, tb, t, y, p, m, g, False)
     evaluate(fns, F_RHS, tb, t, y, p, m, k1)
@@ -341,8 +510,12 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
             rc[4, i] = hh * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i]
                              + D7 * k7[i])
         slot, new_mode, t_end, k = sample_and_switch(fns, table, rc, t, hh, t1, tb, p, m, y,
-                                                     y1, yt, g, t_out, Y_out, k)
+                                                     y1, yt, g, g0, t_out, Y_out, k)
         stats[1] += 1
+        if slot == GUARD:  # a nip beyond its penetration bound: stop at the crossing
+            t = t_end
+            status = PENETRATED
+            break
         if slot >= 0:  # event: restart at the crossing in the new mode
             t = t_end
             if new_mode == END:
@@ -389,8 +562,9 @@ def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
     n = y.shape[0]
     k1, k2, k3, k4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     yt, y1 = np.empty(n), np.empty(n)
+    rc = np.empty((5, n))
     tb = np.empty(1)
-    g = switch_buffer(table)
+    g, g0 = switch_buffer(table), switch_buffer(table)
     modes_of(fns, table, tb, t0, y, p, m, g, True)
     evaluate(fns, F_RHS, tb, t0, y, p, m, k1)
     nfev = 1
@@ -444,6 +618,18 @@ def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
                     else:
                         ta = th
                 theta = tb_
+            for i in range(n):  # the step's cubic Hermite in DOPRI5's dense form
+                rc[0, i] = y[i]
+                rc[1, i] = y1[i] - y[i]
+                rc[2, i] = hs * k1[i] - rc[1, i]
+                rc[3, i] = rc[1, i] - hs * k2[i] - rc[2, i]
+                rc[4, i] = 0.0
+            theta_guard = guard_step(fns, table, rc, t, hs, theta, tb, p, m, y, y1, yt, g,
+                                     g0, t_out, k, slot < 0)
+            if theta_guard <= theta:  # stopped where the first nip crosses its bound
+                t = t + theta_guard * hs
+                status = PENETRATED
+                break
             t_end = t + theta * hs
             while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
                 _hermite(y, k1, y1, k2, hs, min(theta, max(0.0, (t_out[k] - t) / hs)), yt)

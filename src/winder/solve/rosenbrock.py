@@ -22,8 +22,10 @@ from .integrators import (
     EXHAUSTED,
     F_JAC,
     F_RHS,
+    GUARD,
     NON_FINITE,
     PAUSED,
+    PENETRATED,
     STEP_UNDERFLOW,
     TIME_RESOLUTION,
     evaluate,
@@ -101,7 +103,7 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
     piv = np.empty(n, dtype=np.int64)
     rc = np.zeros((5, n))
     tb = np.empty(1)
-    g = switch_buffer(table)
+    g, g0 = switch_buffer(table), switch_buffer(table)
     t = t0
     modes_of(fns, table, tb, t, y, p, m, g, False)
     evaluate(fns, F_RHS, tb, t, y, p, m, f0)
@@ -181,9 +183,13 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
             rc[1, i] = hh * k2[i]
             rc[2, i] = hh * (k1[i] - k2[i]) / (1.0 - 2.0 * D)
         slot, new_mode, t_end, k = sample_and_switch(fns, table, rc, t, hh, t1, tb, p, m, y,
-                                                     y1, yt, g, t_out, Y_out, k)
+                                                     y1, yt, g, g0, t_out, Y_out, k)
         stats[1] += 1
         fresh = False
+        if slot == GUARD:  # a nip beyond its penetration bound: stop at the crossing
+            t = t_end
+            status = PENETRATED
+            break
         if slot >= 0:
             t = t_end
             if new_mode == END:

@@ -100,7 +100,9 @@ class MachineSystem:
         rows = []
         for name in m.mode_names:
             if name.endswith(".contact"):
-                rows.append((integ.K_CONTACT, m.switch_names.index(name), 0, 0, 0))
+                nip = name[:-len(".contact")]
+                rows.append((integ.K_CONTACT, *(m.switch_names.index(f"{nip}.{g}") for g in
+                                                ("contact", "overlap", "dx", "dz"))))
             elif name.endswith(".end"):
                 roll = name[:-len(".end")]
                 rows.append((integ.K_END, m.switch_names.index(f"{roll}.exhausted"), 0,
@@ -250,6 +252,48 @@ class MachineSystem:
             f"(active effects: {effects}); the state was " + state_text(state)
             + ". Try a stiff method (method='Radau' or 'BDF') or a tighter rtol.",
             time=t, state=state)
+
+    def beyond_bound(self, t: float, y: np.ndarray) -> list[tuple[str, float, float]]:
+        """The nips whose penetration is beyond its bound at ``(t, y)``: ``(nip, δ [m],
+        min(r_a, r_b) [m])`` each, from the guard functions ``NIP.overlap`` (> 0, or not
+        a number) of the generated switching functions."""
+        g = self.switches(t, y)
+        m, out = self.machine, []
+        for nip in m.nips:
+            name = f"{nip.name}.overlap"
+            if name not in m.switch_names:  # contact off: no nip force, no bound
+                continue
+            over = float(g[m.switch_names.index(name)])
+            if not over <= 0.0:
+                radii = [float(y[m.index(f"{b.name}.radius")]) if b.kind == "roll"
+                         else float(b.part.radius) for b in (nip.a, nip.b)]
+                out.append((nip.name, over + min(radii), min(radii)))
+        return out
+
+    def penetration_error(self, t: float, y: np.ndarray, *, method: str,
+                          max_step: float | None, atol: float) -> SimulationError:
+        """The error for a run stopped where a nip's penetration reached its bound
+        (``δ >= min(r_a, r_b)``: one body's axis inside the other): the time, the nip, and
+        what to change (the method, ``max_step``, ``atol``)."""
+        state = dict(zip(self.state_names, map(float, y), strict=True))
+        bad = self.beyond_bound(t, y)
+        nips = "; ".join(f"nip {name!r} ({self.machine.nip[name].b.name!r} on "
+                         f"{self.machine.nip[name].a.name!r}): penetration {delta:.6g} m "
+                         f"reached the smaller radius, {bound:.6g} m" for name, delta, bound in bad)
+        if method == "RK4":
+            how = f"method 'RK4' with its fixed step {max_step or 1e-3:g} s"
+            fix = ("method 'DOPRI5' (error control), or 'ROS2' for a stiff nip; or a smaller "
+                   "max_step (--max-step)")
+        else:
+            how = (f"method {method!r} with atol {atol:g}"
+                   + ("" if max_step is None else f" and max_step {max_step:g} s"))
+            fix = ("method 'ROS2' or 'Radau' (stiff nips); a smaller atol (the shipped "
+                   "scenes use 1e-8); or a max_step (--max-step) below the nip's period")
+        return SimulationError(
+            f"the run stopped at t = {t:.6g} s: {nips or 'a nip crossed its bound'} (one "
+            f"body's axis inside the other): {how} lost the contact, and nothing after "
+            f"this time would be right. Change the method, max_step or atol: try {fix}. "
+            "The state was " + state_text(state) + ".", time=t, state=state)
 
     # ---- outputs ----------------------------------------------------------------------------
     def channels(self, t: np.ndarray, Y: np.ndarray) -> dict[str, np.ndarray]:
