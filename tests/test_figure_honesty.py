@@ -110,3 +110,23 @@ def test_fig4_of_a_run_shows_the_whole_torque(tmp_path, monkeypatch):
     clipped = np.mean((torque < zlo) | (torque > zhi))
     assert 0.0 < clipped < 1.0  # the zoom leaves the ramp and the impacts out, and says so
     assert f"{clipped:.2%} of samples lie outside" in ztitle
+
+
+def test_fig8_weight_line_uses_the_scene_gravity(monkeypatch, tmp_path: Path) -> None:
+    """Fig. 8's weight line is ``m g`` with the scene's own ``g`` (here 3.7 m/s², as on
+    Mars), not a fixed 9.81: the drawn values equal the mass channel times that g."""
+    scene = winder.load_scene(MODELS / "paper_winding.toml").replace(scene={"gravity": 3.7})
+    res = winder.simulate(scene, t_end=0.5)
+    lines: dict[str, list] = {}
+    save = _plots._save
+
+    def capture(fig, path: Path) -> Path:
+        lines[Path(path).name] = [(ln.get_label(), ln.get_ydata()) for ln in fig.axes[0].lines]
+        return save(fig, path)
+
+    monkeypatch.setattr(_plots, "_save", capture)
+    _plots.paper_figures(res, tmp_path, scene=scene, closeup=res)
+    weight = [y for label, y in lines["paper_winding_fig8_normal_force.png"]
+              if label.startswith("weight")]
+    assert len(weight) == 1
+    np.testing.assert_allclose(weight[0], res["mass"] * 3.7 / 1e3, rtol=1e-15)

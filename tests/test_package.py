@@ -64,3 +64,33 @@ def test_no_writable_numba_cache_falls_back_to_memory(tmp_path: Path, models_dir
     ref = winder.simulate(winder.load_scene(scene), t_end=20.0, output_step=5.0)
     np.testing.assert_array_equal(out["roll_speed"], ref["roll_speed"])
     np.testing.assert_array_equal(out["radius"], ref["radius"])
+
+
+def test_every_exception_of_the_package_is_a_winder_error() -> None:
+    """Every public exception class the package defines is in the :class:`winder.WinderError`
+    tree, and it raises no bare ``RuntimeError``/``Exception`` (an AST scan of src/ and
+    viewer/: a new ``class FooError(ValueError)`` or ``raise RuntimeError(...)`` fails
+    here)."""
+    import ast
+    import importlib
+
+    root = Path(__file__).resolve().parents[1]
+    bare = {"RuntimeError", "Exception"}
+    outside = []
+    for path in [*(root / "src" / "winder").rglob("*.py"), *(root / "viewer").glob("*.py")]:
+        tree = ast.parse(path.read_text(), str(path))
+        rel = path.relative_to(root)
+        parts = rel.with_suffix("").parts
+        module = ".".join(("winder", "viewer", *parts[1:]) if parts[0] == "viewer"
+                          else parts[1:])
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Raise) and isinstance(node.exc, ast.Call) and \
+                    isinstance(node.exc.func, ast.Name) and node.exc.func.id in bare:
+                outside.append(f"{rel}:{node.lineno} raises {node.exc.func.id}")
+            if isinstance(node, ast.ClassDef) and node.name.endswith("Error") and \
+                    not node.name.startswith("_"):
+                cls = getattr(importlib.import_module(module.removesuffix(".__init__")),
+                              node.name, None)
+                if isinstance(cls, type) and not issubclass(cls, winder.WinderError):
+                    outside.append(f"{rel}:{node.lineno} class {node.name}")
+    assert not outside, outside

@@ -150,11 +150,14 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
 
     fig, ax = plt.subplots(2, 1, figsize=(9, 7))
     ax[0].plot(t, result["normal_force"] / 1e3, lw=0.4)
-    ax[0].plot(t, result["mass"] * 9.81 / 1e3, color="k", lw=0.8, label="weight m g")
+    if scene is not None:  # the weight under the scene's own gravity (none when it is off)
+        g = scene.scene.gravity if scene.effects.gravity else 0.0
+        ax[0].plot(t, result["mass"] * g / 1e3, color="k", lw=0.8,
+                   label=f"weight m g (g = {g:g} m/s²)")
+        ax[0].legend()
     ax[0].set_ylabel("normal force F_n [kN]")
     ax[0].set_xlabel("t [s]")
     ax[0].set_title(f"{name}: nip normal force (Fig. 8)")
-    ax[0].legend()
     t_lift = _first_liftoff(result)
     if closeup is None and t_lift is not None and scene is not None:
         from ._simulate import simulate

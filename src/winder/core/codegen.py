@@ -28,9 +28,11 @@ from typing import Any
 
 import numpy as np
 
+from .._errors import WinderError
 from .machine import Machine
 
-__all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "FUNCTIONS", "stats"]
+__all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
+           "stats"]
 
 #: The generated functions, in the order of :attr:`Generated.addresses`.
 FUNCTIONS = ("rhs", "jac", "out", "sw")
@@ -39,8 +41,12 @@ CFLAGS = ("-O3", "-shared", "-fPIC")
 stats = {"compiled": 0, "cached": 0}
 
 
-class CompilerMissing(RuntimeError):
+class CompilerMissing(WinderError, RuntimeError):
     """No C compiler: the generated path is unavailable (the numeric path remains)."""
+
+
+class CompileError(WinderError, RuntimeError):
+    """The C compiler failed on the generated model: the message holds its output."""
 
 
 def cache_dir() -> Path:
@@ -187,7 +193,7 @@ def generate(machine: Machine, *, directory: Path | None = None,
             proc = subprocess.run([cc, *CFLAGS, str(src), "-o", str(tmp_lib), "-lm"],
                                   capture_output=True, text=True)
             if proc.returncode != 0:
-                raise RuntimeError(f"compiling the generated model failed ({cc}):\n"
+                raise CompileError(f"compiling the generated model failed ({cc}):\n"
                                    + proc.stderr[-2000:])
             os.replace(tmp_lib, lib)
         stats["compiled"] += 1

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._errors import WinderError
 from ..forces.contact import rest_penetration
 from .backends import NumericBackend
 from .machine import AUTO, CORE_AUTO, FREE, IN_CONTACT, Body, Machine, Nip
@@ -34,7 +35,7 @@ __all__ = ["static_state", "resting_state", "Resting", "Equilibrium", "Equilibri
 RESIDUAL_LIMIT = 1e-6
 
 
-class EquilibriumError(ValueError):
+class EquilibriumError(WinderError, ValueError):
     """No static balance for a body: names the body and the residual."""
 
 
