@@ -412,15 +412,16 @@ class _Linearisation:
                                 f"residual {value:.3g}{unit}{saturated}); valid: a "
                                 "lower web speed or a smaller radius")
         sw = sys_.switches(self.t, y)
+        names = self.machine.switch_names
         for n in self.machine.nips:
-            g = sw[self.machine.switch_names.index(f"{n.name}.contact")]
-            ra, rb = self._radius_of(y, n.a.name), self._radius_of(y, n.b.name)
-            delta = ra + rb - self._distance(y, n)
+            g = sw[names.index(f"{n.name}.contact")]
+            over = sw[names.index(f"{n.name}.overlap")]  # δ − min(r_a, r_b), as the guard
             if not g > 0.0:
                 raise ArgumentError(f"{where}: at radius = {r:g} m nip {n.name!r} opens at "
                                     "the operating point (no normal force): no bounce mode "
                                     "about a lasting contact there")
-            if delta >= min(ra, rb):
+            if not over < 0.0:
+                delta = over + min(self._radius_of(y, n.a.name), self._radius_of(y, n.b.name))
                 raise ArgumentError(f"{where}: at radius = {r:g} m the load compresses nip "
                                     f"{n.name!r} by {delta:.4g} m, more than a radius (one "
                                     "axis would lie inside the other body); valid: a smaller "
@@ -445,13 +446,6 @@ class _Linearisation:
                 out.append(f"; nip {n.name!r} slips at v_s = {vs:.3g} m/s, its friction "
                            f"saturated at mu F_n = {n.part.friction.mu * fn:.4g} N")
         return "".join(out)
-
-    def _distance(self, y: np.ndarray, n) -> float:  # noqa: ANN001
-        def c(b):  # noqa: ANN001, ANN202
-            x = y[self.machine.index(f"{b.name}.x")] if "x" in b.free else b.centre[0]
-            z = y[self.machine.index(f"{b.name}.z")] if "z" in b.free else b.centre[1]
-            return np.array([x, z])
-        return float(np.linalg.norm(c(n.b) - c(n.a)))
 
     # ---- the modes ----------------------------------------------------------------------
     def modes(self, y: np.ndarray) -> list[Mode]:
