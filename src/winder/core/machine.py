@@ -408,10 +408,8 @@ class Evaluation:
         self.fext_extra: dict[str, list[Any]] = {}  # local-frame spatial forces by body
         #: actuator torques about the bodies' axes [N·m], operation sense (drives)
         self.drive_torques: dict[str, Any] = {}
-        #: dT/dt of each web's span [N/s] by web name (web_tension sets it); ``span_rate``
-        #: that of the first span
+        #: dT/dt of each web's span [N/s] by web name (web_tension sets it)
         self.span_rates: dict[str, Any] = {}
-        self.span_rate: Any = 0.0
         self.gravity: Any = 0.0  # [m/s²], set by the gravity effect
 
     # access by name
