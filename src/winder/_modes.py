@@ -138,7 +138,7 @@ def _web_speed(where: str, scene: Scene, web_speed: float | None, lo_open: bool)
         drum = _entry_drum(scene)
         v = drum.drive.web_speed
         if lo_open and not v > 0.0:
-            key = "[drum.drive]" if scene.legacy else f"[[drum]] {drum.name!r} drive"
+            key = _where_drum(scene, drum.name)
             raise ArgumentError(f"{where}: web_speed is not given and the scene's {key} "
                                 f"web_speed is {v!r} ({scene.source}); valid: a web speed "
                                 "> 0 m/s")
@@ -487,9 +487,14 @@ def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: b
     return _Linearisation(scene, _web_speed(where, scene, web_speed, lo_open=lo_open))
 
 
-def _radius(where: str, lin: _Linearisation, radius: float) -> float:
-    key = "[roll] core_radius" if lin.scene.legacy else \
+def _core_key(lin: _Linearisation) -> str:
+    """The scene key of the wound roll's core radius, the smallest radius of a map."""
+    return "[roll] core_radius" if lin.scene.legacy else \
         f"[[roll]] {lin.roll.name!r} core_radius"
+
+
+def _radius(where: str, lin: _Linearisation, radius: float) -> float:
+    key = _core_key(lin)
     return number(where, "radius", radius, lo=lin.rc, unit="m",
                   valid=f"a finite radius >= {key} = {lin.rc:g} m")
 
@@ -670,7 +675,7 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
     """``(r_min, r_max)`` [m] of a map: the arguments (``names`` in messages) or the
     roll's initial radius and its radius at the end of the scene's run."""
     roll, rc = lin.roll.part, lin.rc
-    key = "[roll] core_radius" if scene.legacy else f"[[roll]] {lin.roll.name!r} core_radius"
+    key = _core_key(lin)
     hi = _MAX[("roll", "initial_radius")]
     if radius_min is None:
         lo = roll.initial_radius
@@ -728,8 +733,7 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     bad = ~(np.isfinite(radii) & (radii >= rc))
     if bad.any():
         i = int(np.argmax(bad))
-        key = "[roll] core_radius" if scene.legacy else \
-            f"[[roll]] {lin.roll.name!r} core_radius"
+        key = _core_key(lin)
         raise ArgumentError(f"{where}: radii[{i}] = {float(radii[i])!r} is out of range; "
                             f"valid: finite radii >= {key} = {rc:g} m")
     nt = len(lin.coords)
