@@ -800,10 +800,11 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
 
 # ---- scenes of parts -------------------------------------------------------------------
 
-def _elements(source: str, data: Mapping[str, Any], array: str
+def _elements(source: str, data: Mapping[str, Any], array: str, *, named: bool = True
               ) -> list[tuple[str, dict[str, Any]]]:
     """``(label, raw table)`` of each element of ``[[array]]``; the label names it in
-    messages (``drum 'front'``, or ``drum #2`` while its name is not valid)."""
+    messages (``drum 'front'``, or ``drum #2`` while its name is not valid, or absent
+    where ``named`` is false: the name is optional)."""
     raw = data.get(array, [])
     if not isinstance(raw, list):
         raise SceneError(f"{source}: [{array}] must be an array of tables ([[{array}]], one "
@@ -816,6 +817,9 @@ def _elements(source: str, data: Mapping[str, Any], array: str
             raise SceneError(f"{source}: [{label}] must be a table of keys, got "
                              f"{show(element)} ({type(element).__name__})")
         if "name" not in element:
+            if not named:
+                out.append((label, element))
+                continue
             raise _fail(source, label, "name", "missing required key")
         name = _check_part_name(source, label, element["name"])
         out.append((f"{array} {name!r}", element))
@@ -888,15 +892,7 @@ def _parse_webs(source: str, data: Mapping[str, Any]) -> list[tuple[str, WebPart
             raise SceneError(f"{source}: [[web]]: an empty array of webs; give one [[web]] "
                              "table per wound roll, each with entry_nip, or leave web out "
                              "(a scene without wound rolls)")
-        elements = []
-        for i, raw in enumerate(web_raw):
-            label = f"web #{i + 1}"
-            if not isinstance(raw, dict):
-                raise SceneError(f"{source}: [{label}] must be a table of keys, got "
-                                 f"{show(raw)} ({type(raw).__name__})")
-            if "name" in raw:
-                label = f"web {_check_part_name(source, label, raw['name'])!r}"
-            elements.append((label, raw))
+        elements = _elements(source, data, "web", named=False)
     else:
         elements = [("web", web_raw)]
     webs = []
