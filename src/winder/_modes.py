@@ -215,9 +215,7 @@ class _Linearisation:
 
     # ---- the operating point ------------------------------------------------------------
     def _radius_of(self, y: np.ndarray, name: str) -> float:
-        b = self.machine.body[name]
-        return float(y[self.machine.index(f"{name}.radius")]) if b.kind == "roll" \
-            else float(b.part.radius)
+        return self.machine.radius(y, self.machine.body[name])
 
     def _speed_radius(self, y: np.ndarray) -> np.ndarray:
         """Radius [m] of each body whose speed is an unknown."""

@@ -298,6 +298,12 @@ class Machine:
             raise KeyError(f"no state {name!r}; states: {', '.join(self.state_names)}") \
                 from None
 
+    def radius(self, y: Any, body: Body) -> float:
+        """Radius [m] of ``body`` in state ``y``: a roll's is a state, a drum's or a
+        rider's its part's."""
+        return float(y[self.index(f"{body.name}.radius")]) if body.kind == "roll" \
+            else float(body.part.radius)
+
     def param_index(self, name: str) -> int:
         """Position of parameter ``name`` in the parameter vector."""
         try:
