@@ -1,7 +1,7 @@
 """Scenes of growing size for the speed benchmarks, written as TOML text (machines spec §8).
 
 ``machine_toml(units, riders)``: ``units`` single-drum winding units side by side (a drum,
-a wound roll free in ``z`` on it and their nip; the web enters the first unit's roll), and
+a wound roll free in ``z`` on it and their nip; a ``[[web]]`` enters each unit's roll), and
 ``riders`` rider rolls on the first roll (each with its own nip), spread over its top.
 """
 
@@ -79,7 +79,8 @@ def machine_toml(units: int, riders: int = 0) -> str:
     for j in range(riders):  # spread over the top of roll0 (|x| < 0.25 m)
         x = 0.0 if riders == 1 else -0.2 + 0.4 * j / (riders - 1)
         parts.append(_RIDER.format(j=j, x=x))
-    parts.append('\n[web]\nentry_nip = "nip0"\ntension = 200.0\n')
+    for i in range(units):  # every wound roll is fed by its own web
+        parts.append(f'\n[[web]]\nentry_nip = "nip{i}"\ntension = 200.0\n')
     return "".join(parts)
 
 

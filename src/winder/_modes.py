@@ -138,7 +138,7 @@ def _web_speed(where: str, scene: Scene, web_speed: float | None, lo_open: bool)
         drum = _entry_drum(scene)
         v = drum.drive.web_speed
         if lo_open and not v > 0.0:
-            key = "[drum.drive]" if scene.legacy else f"[[drum]] {drum.name!r} drive"
+            key = _where_drum(scene, drum.name)
             raise ArgumentError(f"{where}: web_speed is not given and the scene's {key} "
                                 f"web_speed is {v!r} ({scene.source}); valid: a web speed "
                                 "> 0 m/s")
@@ -215,9 +215,7 @@ class _Linearisation:
 
     # ---- the operating point ------------------------------------------------------------
     def _radius_of(self, y: np.ndarray, name: str) -> float:
-        b = self.machine.body[name]
-        return float(y[self.machine.index(f"{name}.radius")]) if b.kind == "roll" \
-            else float(b.part.radius)
+        return self.machine.radius(y, self.machine.body[name])
 
     def _speed_radius(self, y: np.ndarray) -> np.ndarray:
         """Radius [m] of each body whose speed is an unknown."""
@@ -412,15 +410,16 @@ class _Linearisation:
                                 f"residual {value:.3g}{unit}{saturated}); valid: a "
                                 "lower web speed or a smaller radius")
         sw = sys_.switches(self.t, y)
+        names = self.machine.switch_names
         for n in self.machine.nips:
-            g = sw[self.machine.switch_names.index(f"{n.name}.contact")]
-            ra, rb = self._radius_of(y, n.a.name), self._radius_of(y, n.b.name)
-            delta = ra + rb - self._distance(y, n)
+            g = sw[names.index(f"{n.name}.contact")]
+            over = sw[names.index(f"{n.name}.overlap")]  # δ − min(r_a, r_b), as the guard
             if not g > 0.0:
                 raise ArgumentError(f"{where}: at radius = {r:g} m nip {n.name!r} opens at "
                                     "the operating point (no normal force): no bounce mode "
                                     "about a lasting contact there")
-            if delta >= min(ra, rb):
+            if not over < 0.0:
+                delta = over + min(self._radius_of(y, n.a.name), self._radius_of(y, n.b.name))
                 raise ArgumentError(f"{where}: at radius = {r:g} m the load compresses nip "
                                     f"{n.name!r} by {delta:.4g} m, more than a radius (one "
                                     "axis would lie inside the other body); valid: a smaller "
@@ -445,13 +444,6 @@ class _Linearisation:
                 out.append(f"; nip {n.name!r} slips at v_s = {vs:.3g} m/s, its friction "
                            f"saturated at mu F_n = {n.part.friction.mu * fn:.4g} N")
         return "".join(out)
-
-    def _distance(self, y: np.ndarray, n) -> float:  # noqa: ANN001
-        def c(b):  # noqa: ANN001, ANN202
-            x = y[self.machine.index(f"{b.name}.x")] if "x" in b.free else b.centre[0]
-            z = y[self.machine.index(f"{b.name}.z")] if "z" in b.free else b.centre[1]
-            return np.array([x, z])
-        return float(np.linalg.norm(c(n.b) - c(n.a)))
 
     # ---- the modes ----------------------------------------------------------------------
     def modes(self, y: np.ndarray) -> list[Mode]:
@@ -493,9 +485,14 @@ def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: b
     return _Linearisation(scene, _web_speed(where, scene, web_speed, lo_open=lo_open))
 
 
-def _radius(where: str, lin: _Linearisation, radius: float) -> float:
-    key = "[roll] core_radius" if lin.scene.legacy else \
+def _core_key(lin: _Linearisation) -> str:
+    """The scene key of the wound roll's core radius, the smallest radius of a map."""
+    return "[roll] core_radius" if lin.scene.legacy else \
         f"[[roll]] {lin.roll.name!r} core_radius"
+
+
+def _radius(where: str, lin: _Linearisation, radius: float) -> float:
+    key = _core_key(lin)
     return number(where, "radius", radius, lo=lin.rc, unit="m",
                   valid=f"a finite radius >= {key} = {lin.rc:g} m")
 
@@ -676,7 +673,7 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
     """``(r_min, r_max)`` [m] of a map: the arguments (``names`` in messages) or the
     roll's initial radius and its radius at the end of the scene's run."""
     roll, rc = lin.roll.part, lin.rc
-    key = "[roll] core_radius" if scene.legacy else f"[[roll]] {lin.roll.name!r} core_radius"
+    key = _core_key(lin)
     hi = _MAX[("roll", "initial_radius")]
     if radius_min is None:
         lo = roll.initial_radius
@@ -734,8 +731,7 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     bad = ~(np.isfinite(radii) & (radii >= rc))
     if bad.any():
         i = int(np.argmax(bad))
-        key = "[roll] core_radius" if scene.legacy else \
-            f"[[roll]] {lin.roll.name!r} core_radius"
+        key = _core_key(lin)
         raise ArgumentError(f"{where}: radii[{i}] = {float(radii[i])!r} is out of range; "
                             f"valid: finite radii >= {key} = {rc:g} m")
     nt = len(lin.coords)

@@ -434,12 +434,12 @@ _NUMBERS: dict[tuple[str, str], tuple[float | None, str]] = {
     ("roll", "initial_radius"): (10.0, "m"), ("roll", "initial_speed"): (1e5, "rad/s"),
     ("roll", "com_offset"): (10.0, "m"), ("roll", "initial_height"): (1e3, "m"),
     ("paper", "density"): (1e5, "kg/m³"), ("paper", "caliper"): (0.1, "m"),
-    ("contact", "stiffness"): (1e18, "N/m (N/m^p)"), ("contact", "damping"): (1e12, "N·s/m"),
+    ("contact", "stiffness"): (1e18, "N/m"), ("contact", "damping"): (1e12, "N·s/m"),
     ("contact", "exponent"): (3.0, "-"), ("contact", "hc_damping"): (1e4, "s/m"),
     ("friction", "mu"): (10.0, "-"), ("friction", "slip_velocity"): (1e3, "m/s"),
     ("friction", "relaxation_length"): (1e3, "m"), ("friction", "min_speed"): (1e3, "m/s"),
     ("solver", "rtol"): (RTOL_MAX, "-"),
-    ("solver", "atol"): (ATOL_MAX, "state units"),  # in each state's own unit
+    ("solver", "atol"): (ATOL_MAX, ""),  # in each state's own unit: none in common
     ("solver", "max_rhs"): (1e12, "-"), ("solver", "max_wall"): (None, "s"),
 }
 _CHOICES = {("drum.drive", "kind"): DRIVE_KINDS, ("contact", "law"): CONTACT_LAWS,
@@ -527,8 +527,9 @@ def key_unit(path: str, data: Mapping[str, Any] | None = None) -> str:
     ``nip.front.contact.stiffness``: ``"N/m"``), ``"-"`` for a dimensionless number and
     ``""`` for a key without a unit (a word, a flag) or an unknown path. ``data`` (the
     scene's nested tables, :meth:`Scene.to_dict`) tells an array of tables (whose next
-    segment is an element's name) from a table; without it, the first segment is an array
-    when the path does not fit the single-drum tables."""
+    segment is an element's name) from a table, and a Hunt–Crossley nip's stiffness
+    (``N/m^p``) from a linear one's; without it, the first segment is an array when the
+    path does not fit the single-drum tables."""
     parts = path.split(".")
     if len(parts) < 2:
         return ""
@@ -539,7 +540,19 @@ def key_unit(path: str, data: Mapping[str, Any] | None = None) -> str:
         array = head in _ARRAYS and ".".join([head, *rest[:-1]]) not in _SPEC
     if array:
         head, rest = head + "[]", rest[1:]  # skip the element's name
-    return _UNITS.get((".".join([head, *rest[:-1]]), rest[-1]), "") if rest else ""
+    if not rest:
+        return ""
+    unit = _UNITS.get((".".join([head, *rest[:-1]]), rest[-1]), "")
+    if unit == "N/m" and rest[-1] == "stiffness" and data is not None:
+        from ._sweep_grid import get_path  # its law's: k δ^p of a Hunt–Crossley nip
+
+        try:
+            law = get_path(data, path[:-len("stiffness")] + "law")
+        except (KeyError, ArgumentError):
+            law = "linear"
+        if law == "hunt_crossley":
+            return "N/m^p"
+    return unit
 
 
 def _check_name(source: str, value: str) -> str:
@@ -787,10 +800,11 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
 
 # ---- scenes of parts -------------------------------------------------------------------
 
-def _elements(source: str, data: Mapping[str, Any], array: str
+def _elements(source: str, data: Mapping[str, Any], array: str, *, named: bool = True
               ) -> list[tuple[str, dict[str, Any]]]:
     """``(label, raw table)`` of each element of ``[[array]]``; the label names it in
-    messages (``drum 'front'``, or ``drum #2`` while its name is not valid)."""
+    messages (``drum 'front'``, or ``drum #2`` while its name is not valid, or absent
+    where ``named`` is false: the name is optional)."""
     raw = data.get(array, [])
     if not isinstance(raw, list):
         raise SceneError(f"{source}: [{array}] must be an array of tables ([[{array}]], one "
@@ -803,6 +817,9 @@ def _elements(source: str, data: Mapping[str, Any], array: str
             raise SceneError(f"{source}: [{label}] must be a table of keys, got "
                              f"{show(element)} ({type(element).__name__})")
         if "name" not in element:
+            if not named:
+                out.append((label, element))
+                continue
             raise _fail(source, label, "name", "missing required key")
         name = _check_part_name(source, label, element["name"])
         out.append((f"{array} {name!r}", element))
@@ -875,15 +892,7 @@ def _parse_webs(source: str, data: Mapping[str, Any]) -> list[tuple[str, WebPart
             raise SceneError(f"{source}: [[web]]: an empty array of webs; give one [[web]] "
                              "table per wound roll, each with entry_nip, or leave web out "
                              "(a scene without wound rolls)")
-        elements = []
-        for i, raw in enumerate(web_raw):
-            label = f"web #{i + 1}"
-            if not isinstance(raw, dict):
-                raise SceneError(f"{source}: [{label}] must be a table of keys, got "
-                                 f"{show(raw)} ({type(raw).__name__})")
-            if "name" in raw:
-                label = f"web {_check_part_name(source, label, raw['name'])!r}"
-            elements.append((label, raw))
+        elements = _elements(source, data, "web", named=False)
     else:
         elements = [("web", web_raw)]
     webs = []
@@ -1232,7 +1241,9 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
 
 #: (table of _SPEC/_PART_SPEC, key) -> (unit, meaning, default text or None: the
 #: dataclass default, or "required"). The unit of a numeric key is None here: it is
-#: declared once, in :data:`_NUMBERS`, and :func:`key_doc` reads it from there.
+#: declared once, in :data:`_NUMBERS`, and :func:`key_doc` reads it from there; only
+#: where the reference says more than one axis label can (a stiffness whose unit
+#: follows the law, atol in each state's unit) is it written here.
 _KEY_DOC: dict[tuple[str, str], tuple[str | None, str, str | None]] = {
     ("scene", "name"): ("-", "the scene's name, in titles, messages and the result",
                         "the file name without .toml"),
@@ -1288,7 +1299,7 @@ _KEY_DOC: dict[tuple[str, str], tuple[str | None, str, str | None]] = {
                            "revolution", None),
     ("contact", "law"): ("-", "linear: F_n = max(0, k δ + c δ̇); hunt_crossley: F_n = "
                          "max(0, k δ^p (1 + α δ̇))", None),
-    ("contact", "stiffness"): (None, "stiffness k of the nip", None),
+    ("contact", "stiffness"): ("N/m (N/m^p)", "stiffness k of the nip", None),
     ("contact", "damping"): (None, "damping c of the linear law", None),
     ("contact", "exponent"): (None, "exponent p of the Hunt–Crossley law", None),
     ("contact", "hc_damping"): (None, "damping α of the Hunt–Crossley law", None),
@@ -1302,7 +1313,7 @@ _KEY_DOC: dict[tuple[str, str], tuple[str | None, str, str | None]] = {
                                 "finite at standstill)", None),
     ("solver", "method"): ("-", "integrator; auto is DOPRI5", None),
     ("solver", "rtol"): (None, "relative tolerance", None),
-    ("solver", "atol"): (None, "absolute tolerance", None),
+    ("solver", "atol"): ("state units", "absolute tolerance", None),
     ("solver", "max_rhs"): (None, "budget: most right-hand side evaluations of a run (a "
                             "whole number)", None),
     ("solver", "backend"): ("-", "compiled: the generated code; pinocchio: the numeric "

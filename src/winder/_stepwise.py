@@ -111,19 +111,21 @@ class _Beyond(Exception):
 
 
 def _guard(system: MachineSystem, bounds: list[tuple[int, int, int]], solver: OdeSolver,
-           y_a: np.ndarray, t_b: float, y_b: np.ndarray, t_out: np.ndarray,
-           filled: int) -> None:
+           sol: DenseOutput | None, y_a: np.ndarray, g_a: np.ndarray | None, t_b: float,
+           y_b: np.ndarray, t_s: np.ndarray, y_s: np.ndarray) -> np.ndarray | None:
     """The guard of every accepted step (as the compiled integrators',
     :func:`~winder.solve.integrators.guard_step`), on its kept part from its start
     ``y_a`` to ``(t_b, y_b)`` (the step's end or its first event): where a nip's
-    ``NIP.overlap`` is beyond its bound at that end, at an output sample inside it, or on
+    ``NIP.overlap`` is beyond its bound at that end, at an output sample inside it (times
+    ``t_s``, states the columns of ``y_s``), or on
     the straight path between (closest approach from ``NIP.dx``, ``NIP.dz``), raise
     :class:`_Beyond` at the crossing. ``bounds``: the switching functions ``(overlap, dx,
-    dz)`` of each nip."""
+    dz)`` of each nip; ``g_a``: all of them at the start (None: evaluated here); ``sol``:
+    the step's dense output, if made already. Returns them at ``(t_b, y_b)``, the next
+    step's ``g_a``."""
     if not bounds:
-        return
+        return None
     t_a = float(solver.t_old)
-    sol: Any = None
 
     def over(t: float, y: np.ndarray, go: int) -> float:
         return float(system.switches(t, y)[go])
@@ -138,13 +140,7 @@ def _guard(system: MachineSystem, bounds: list[tuple[int, int, int]], solver: Od
             y_x = y_c if t_x == t_c else sol(t_x)
         return _Beyond(t_x, np.array(y_x, dtype=float))
 
-    points = [(float(ts), None) for ts in t_out[filled:np.searchsorted(t_out, t_b, "right")]]
-    for t_c, _ in [*points, (t_b, None)]:
-        if t_c == t_b:
-            y_c = y_b
-        else:
-            sol = sol or solver.dense_output()
-            y_c = sol(t_c)
+    for t_c, y_c in [*zip(map(float, t_s), y_s.T, strict=True), (t_b, y_b)]:
         g = system.switches(t_c, y_c)
         crossed = [go for go, _, _ in bounds if not g[go] <= 0.0]
         if not crossed:
@@ -153,20 +149,23 @@ def _guard(system: MachineSystem, bounds: list[tuple[int, int, int]], solver: Od
             raise _Beyond(t_c, np.array(y_c, dtype=float))
         sol = sol or solver.dense_output()
         raise min((beyond(go, t_c, y_c) for go in crossed), key=lambda e: e.t)
-    g0, g1 = system.switches(t_a, y_a), system.switches(t_b, y_b)
+    g1 = g  # at (t_b, y_b), the loop's last point
+    # as floats: the arithmetic below, once per nip and step, is IEEE either way
+    f0 = (system.switches(t_a, y_a) if g_a is None else g_a).tolist()
+    f1 = g1.tolist()
     h = t_b - t_a
 
     def line(theta: float) -> np.ndarray:
         return y_a + theta * (y_b - y_a)
 
     for go, gx, gz in bounds:  # the straight path: a step that jumps through the body
-        x0, z0, x1, z1 = g0[gx], g0[gz], g1[gx], g1[gz]
+        x0, z0, x1, z1 = f0[gx], f0[gz], f1[gx], f1[gz]
         dx, dz = x1 - x0, z1 - z0
         d2 = dx * dx + dz * dz
         if not d2 > 0.0:
             continue
         th = min(1.0, max(0.0, -(x0 * dx + z0 * dz) / d2))  # closest approach
-        bound = g1[go] + math.hypot(x1, z1)  # max(r_a, r_b)
+        bound = f1[go] + math.hypot(x1, z1)  # max(r_a, r_b)
         if not math.hypot(x0 + th * dx, z0 + th * dz) < bound:
             continue
         b2 = x0 * dx + z0 * dz  # probe between entering that circle and the closest approach
@@ -184,6 +183,7 @@ def _guard(system: MachineSystem, bounds: list[tuple[int, int, int]], solver: Od
         while not over(t_a + th * h, line(th), go) > 0.0:  # on the far side of the root
             th = np.nextafter(th, 2.0)
         raise _Beyond(t_a + th * h, line(th))
+    return g1
 
 
 def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
@@ -200,6 +200,7 @@ def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
         filled += 1
     solver = None
     y_a = np.array(y0, dtype=float)  # the start of the step
+    g_a = None  # the switching functions there, once known
     try:
         solver = make(t0, y0, t_stop)
         while True:
@@ -217,8 +218,7 @@ def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
                     t_ev, y_ev = _locate(events[i], sol, t_a, t_b, y_b)
                     if hit < 0 or t_ev < t_lim:
                         hit, t_lim, y_lim = i, t_ev, y_ev
-            _guard(system, bounds, solver, y_a, t_lim, y_lim, t_out, filled)
-            y_a = np.array(y_b, dtype=float)
+            start = filled
             while filled < len(t_out) and t_out[filled] <= t_lim:
                 if t_out[filled] == t_b:
                     Ys[:, filled] = y_b
@@ -226,6 +226,9 @@ def _segment(make: Callable[[float, np.ndarray, float], OdeSolver], t0: float,
                     sol = sol or solver.dense_output()
                     Ys[:, filled] = sol(t_out[filled])
                 filled += 1
+            g_a = _guard(system, bounds, solver, sol, y_a, g_a, t_lim, y_lim,
+                         t_out[start:filled], Ys[:, start:filled])
+            y_a = np.array(y_b, dtype=float)
             if hit >= 0:
                 return t_lim, np.array(y_lim, dtype=float), filled, hit
             if solver.status == "finished":

@@ -298,6 +298,12 @@ class Machine:
             raise KeyError(f"no state {name!r}; states: {', '.join(self.state_names)}") \
                 from None
 
+    def radius(self, y: Any, body: Body) -> float:
+        """Radius [m] of ``body`` in state ``y``: a roll's is a state, a drum's or a
+        rider's its part's."""
+        return float(y[self.index(f"{body.name}.radius")]) if body.kind == "roll" \
+            else float(body.part.radius)
+
     def param_index(self, name: str) -> int:
         """Position of parameter ``name`` in the parameter vector."""
         try:
@@ -408,10 +414,8 @@ class Evaluation:
         self.fext_extra: dict[str, list[Any]] = {}  # local-frame spatial forces by body
         #: actuator torques about the bodies' axes [N·m], operation sense (drives)
         self.drive_torques: dict[str, Any] = {}
-        #: dT/dt of each web's span [N/s] by web name (web_tension sets it); ``span_rate``
-        #: that of the first span
+        #: dT/dt of each web's span [N/s] by web name (web_tension sets it)
         self.span_rates: dict[str, Any] = {}
-        self.span_rate: Any = 0.0
         self.gravity: Any = 0.0  # [m/s²], set by the gravity effect
 
     # access by name

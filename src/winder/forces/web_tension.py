@@ -70,8 +70,6 @@ class WebTension(ForceElement):
             v1, v2 = u.r * u.speed, ns.u_a
             rate = (ev.p(f"{k}span.EA") * (v2 - v1) + v1 * ev.p(f"{k}span.T_in")
                     - v2 * state) / ev.p(f"{k}span.length")
-            if not ev.span_rates:
-                ev.span_rate = rate
             ev.span_rates[w.name] = rate
             ev.set_rate(f"{k}span.tension", rate)
             ev.set_channel(f"{w.span_channel}span_tension", state)

@@ -265,8 +265,7 @@ class MachineSystem:
                 continue
             over = float(g[m.switch_names.index(name)])
             if not over <= 0.0:
-                radii = [float(y[m.index(f"{b.name}.radius")]) if b.kind == "roll"
-                         else float(b.part.radius) for b in (nip.a, nip.b)]
+                radii = [m.radius(y, b) for b in (nip.a, nip.b)]
                 out.append((nip.name, over + min(radii), min(radii)))
         return out
 
