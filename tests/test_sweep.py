@@ -470,6 +470,13 @@ def test_units_come_from_the_key_declarations() -> None:
                        ("contact.law", ""), ("drum.front.name", ""), ("no.such.key", ""),
                        ("drum", "")):
         assert key_unit(path) == unit, path
+    # a Hunt–Crossley nip's stiffness is N/m^p (F = k δ^p), a linear one's N/m
+    assert key_unit("contact.stiffness", {"contact": {"law": "hunt_crossley"}}) == "N/m^p"
+    assert key_unit("contact.stiffness", {"contact": {"law": "linear"}}) == "N/m"
+    nips = {"nip": [{"name": "rear", "contact": {"law": "hunt_crossley"}},
+                    {"name": "front", "contact": {"law": "linear"}}]}
+    assert key_unit("nip.rear.contact.stiffness", nips) == "N/m^p"
+    assert key_unit("nip.front.contact.stiffness", nips) == "N/m"
     # a part named like a sub-table: the scene's tables decide
     assert key_unit("drum.drive.radius", {"drum": [{"name": "drive"}]}) == "m"
     assert key_unit("drum.drive.web_speed", {"drum": {"drive": {}}}) == "m/s"
