@@ -1140,7 +1140,7 @@ def _check_rest_on_nip(scene: Scene) -> None:
     if not scene.effects.contact or scene.roll.initial_height is not None:
         return
     from ._mass_law import PaperRollLaw
-    from .forces.contact import static_penetration
+    from .forces.contact import rest_penetration
 
     roll = scene.roll
     r = roll.initial_radius
@@ -1148,12 +1148,9 @@ def _check_rest_on_nip(scene: Scene) -> None:
                           scene.paper.density).mass(r) \
         * (scene.scene.gravity if scene.effects.gravity else 0.0)
     r_dot = scene.paper.caliper / (2 * math.pi) * roll.initial_speed
-    try:
-        delta = static_penetration(scene.contact, weight, r_dot)
-    except ValueError:
-        delta = math.inf
+    c = scene.contact
+    delta = rest_penetration(c.law, lambda k: getattr(c, k), weight, r_dot)
     if not delta < r:
-        c = scene.contact
         raise _fail(scene.source, "contact", "stiffness",
                     f"{c.stiffness!r} ({c.law}) is too soft for the roll's weight "
                     f"{weight:.4g} N: at rest the nip would be compressed by {delta:.3g} m, "

@@ -28,7 +28,7 @@ from ._base import ForceElement
 if TYPE_CHECKING:
     from ..core.machine import Evaluation, Machine, NipState
 
-__all__ = ["Contact", "unclamped_force", "normal_force", "push", "static_penetration",
+__all__ = ["Contact", "unclamped_force", "normal_force", "push",
            "rest_penetration"]
 
 
@@ -38,29 +38,6 @@ def unclamped_force(M: Any, law: str, par: Any, delta: Any, delta_dot: Any) -> A
         return par("stiffness") * delta + par("damping") * delta_dot
     return par("stiffness") * delta * M.power_abs(delta, par("exponent") - 1.0) \
         * (1.0 + par("hc_damping") * delta_dot)
-
-
-def static_penetration(law: Any, load: float, delta_dot: float = 0.0) -> float:
-    """``δ`` [m] at which the nip ``law`` (a ``[contact]`` table: ``law``, ``stiffness``,
-    …) carries ``load`` [N] at rate ``delta_dot`` [m/s]; 0 for ``load <= 0``. Raises
-    ValueError where no penetration up to 1 km carries it."""
-    from ..core.mathns import NUMERIC
-
-    if load <= 0.0:
-        return 0.0
-
-    def force(delta: float) -> float:
-        return max(0.0, unclamped_force(NUMERIC, law.law, lambda k: getattr(law, k), delta,
-                                        delta_dot))
-
-    hi = 1e-9
-    while force(hi) < load:
-        hi *= 2.0
-        if hi > 1e3:
-            raise ValueError(f"no penetration carries a load of {load} N")
-    from scipy.optimize import brentq  # here: scipy costs start-up time elsewhere
-
-    return brentq(lambda d: force(d) - load, 0.0, hi, xtol=1e-300, rtol=8.9e-16)
 
 
 def normal_force(M: Any, mode: Any, delta: Any, f_unclamped: Any) -> Any:
