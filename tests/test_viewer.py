@@ -429,7 +429,9 @@ def test_readout_follows_the_animation_in_chromium(tmp_path: Path, two_drum,
     shown = html_lib.unescape(re.search(r'<pre id="winder-readout">(.*?)</pre>', dom,
                                         re.S).group(1))
     assert shown in texts
-    assert texts.index(shown) > 5, shown  # it moved on from the first frame
+    # it moved on from the first frame: how far depends on when Chromium starts the
+    # animation clock (frames 5 to 82 of 101 seen after the same virtual 4 s)
+    assert texts.index(shown) > 0, shown
 
 
 # ---- the winder line: the parent roll and the web span between it and the winder ---------
