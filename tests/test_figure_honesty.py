@@ -87,6 +87,9 @@ def test_a_nip_has_one_colour_in_run_figures_and_resonance_map(tmp_path, monkeyp
         assert {"two_drum_winder_nip_forces.png", "two_drum_winder_slip.png",
                 "modes.png"} <= figures, (n, figures)
         assert {c for _, c in hits} == {want[n]}, (n, hits)
+    # the map's bounce modes are drawn in colours no nip has (its lower panel shows nips)
+    modes = {colour for _, label, colour in seen["modes.png"] if label.startswith("bounce mode")}
+    assert len(modes) == 3 and not modes & set(want.values()), (modes, want)
 
 
 def test_fig4_of_a_run_shows_the_whole_torque(tmp_path, monkeypatch):

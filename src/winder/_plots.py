@@ -211,6 +211,11 @@ def _torque_panels(full: plt.Axes, zoom: plt.Axes, t: np.ndarray, torque: np.nda
 NIP_COLOURS = ("C0", "C1", "C2", "C4", "C5", "C6", "C8", "C9")
 
 
+#: Colours of the bounce modes of a resonance map, none of them a nip's (the map's lower
+#: panel draws the nips in :data:`NIP_COLOURS`).
+MODE_COLOURS = ("#6a3d9a", "#b15928", "#e7298a", "#1b9e77", "#808000", "#17becf")
+
+
 def nip_colours(scene: Scene) -> dict[str, str]:
     """Colour of each nip of ``scene`` by name (the single-drum nip is ``"nip"``)."""
     return {n.name: NIP_COLOURS[i % len(NIP_COLOURS)] for i, n in enumerate(scene.nips)}
@@ -454,10 +459,11 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     one = len(mm.coordinates) == 1
     for i, c in enumerate(mm.coordinates):
         f = mm.frequencies[c]
-        ax.plot(r, np.where(f > 0, f, np.nan), f"C{i}", lw=2,
+        colour = MODE_COLOURS[i % len(MODE_COLOURS)]
+        ax.plot(r, np.where(f > 0, f, np.nan), color=colour, lw=2,
                 label="bounce mode (damped)" if one else f"bounce mode {c} (damped)")
         if np.any(f == 0):  # overdamped (real eigenvalue): a bar along the bottom
-            ax.plot(r, np.where(f == 0, 0.02 + 0.025 * i, np.nan), f"C{i}", lw=4,
+            ax.plot(r, np.where(f == 0, 0.02 + 0.025 * i, np.nan), color=colour, lw=4,
                     solid_capstyle="butt", transform=ax.get_xaxis_transform(),
                     label=("bounce mode" if one else c) + " overdamped here (real "
                     "eigenvalue: no oscillation)")
