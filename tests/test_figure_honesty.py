@@ -133,3 +133,26 @@ def test_fig8_weight_line_uses_the_scene_gravity(monkeypatch, tmp_path: Path) ->
               if label.startswith("weight")]
     assert len(weight) == 1
     np.testing.assert_allclose(weight[0], res["mass"] * 3.7 / 1e3, rtol=1e-15)
+
+
+def test_resonance_map_axis_is_the_maps_radii(tmp_path, monkeypatch):
+    """With a map over 0.1–0.3 m and a simulated envelope over 0.05–0.8 m (the scene's whole
+    run, as with ``winder modes --radius-max``), both panels show the map's radii (2 %
+    margin), not the envelope's."""
+    scene = winder.load_scene(MODELS / "paper_winding.toml")
+    mm = winder.mode_map(scene, np.linspace(0.1, 0.3, 3))
+    t = np.linspace(0.0, 100.0, 10_001)
+    res = winder.Result({"t": t, "radius": np.linspace(0.05, 0.8, t.size),
+                         "normal_force": np.full(t.size, 1e3)})
+    limits: dict[str, list] = {}
+    save = _plots._save
+
+    def capture(fig, path: Path) -> Path:
+        limits[Path(path).name] = [a.get_xlim() for a in fig.axes]
+        return save(fig, path)
+
+    monkeypatch.setattr(_plots, "_save", capture)
+    _plots.campbell_figure(mm, tmp_path / "map.png", result=res)
+    for lo, hi in limits["map.png"]:
+        assert lo == pytest.approx(0.1 - 0.004, abs=1e-12)
+        assert hi == pytest.approx(0.3 + 0.004, abs=1e-12)

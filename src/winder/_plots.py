@@ -517,5 +517,8 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
         b.set_ylabel("normal force envelope [kN]")
         b.grid(alpha=0.3)
         b.set_title("simulated nip normal force (min-max over 0.5 s)", fontsize=10)
+    if len(r) > 1:  # the map's radii (--radius-min/max), the envelope too where it is longer
+        span = float(r.max() - r.min())
+        ax.set_xlim(float(r.min()) - 0.02 * span, float(r.max()) + 0.02 * span)
     axes[-1, 0].set_xlabel("roll radius r [m]")
     return _save(fig, Path(path))
