@@ -14,13 +14,13 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test,fmu,peers]'
 	touch $(STAMP)
 
-# The pin_casadi generator (Pinocchio's C++ headers on casadi::SX, winder/core/_pin_casadi.cpp):
+# The pin_casadi generator (Pinocchio's C++ headers on casadi::SX, winder/model/_pin_casadi.cpp):
 # built under ~/.cache/winder/pin-casadi/<pin, casadi, eigen versions>/ (shared by every clone
 # and venv; $(VENV)/winder-pin-casadi where the home cache is not writable) when missing
 # (about 160 s of g++ and 4 GB, once per version); a no-op otherwise; a warning only where
 # g++ is missing.
 pin-casadi: $(STAMP)
-	$(PY) -m winder.core.pin_casadi
+	$(PY) -m winder.model.pin_casadi
 
 venv: $(STAMP) pin-casadi
 
@@ -71,9 +71,9 @@ bench: $(STAMP)
 peers: $(STAMP)
 	$(PY) benchmarks/peers/study.py
 
-# docs/scene-reference.md from the scene schema (src/winder/_scene.py); a test fails when stale.
+# docs/scene-reference.md from the scene schema (src/winder/scene/load.py); a test fails when stale.
 scene-reference: $(STAMP)
-	$(PY) -m winder.scene_reference --out docs/scene-reference.md
+	$(PY) -m winder.scene.reference --out docs/scene-reference.md
 
 # The README's quoted numbers of the two-drum winder and the winder line, from the demo's
 # results in $(OUT)/ (run where missing): a table to paste.

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 import winder
-from winder._modes import operating_point
+from winder.analysis.modes import operating_point
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 

@@ -16,7 +16,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from winder._files import atomic_write
+from winder.io.files import atomic_write
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "models" / "paper_winding.toml"

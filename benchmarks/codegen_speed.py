@@ -2,7 +2,7 @@
 
 Cold: each measurement runs in a fresh Python process with an empty ``WINDER_CACHE_DIR``
 (and, on route cpp, an empty model cache of the pin_casadi generator, which is itself
-built and only linked in): ``winder.core.codegen.generate(machine, route=..., directory=...)``
+built and only linked in): ``winder.model.codegen.generate(machine, route=..., directory=...)``
 split into the SX graph build (Pinocchio's ABA/RNEA on symbols, the force elements, the
 Jacobian, ``casadi.Function``), C generation (``CodeGenerator.generate``) and gcc. Cached:
 a second fresh process loading the same directory (``from_cache``), and the whole
@@ -38,8 +38,8 @@ def child(scene_path: str, route: str, directory: str) -> dict[str, Any]:
     import casadi as ca
 
     import winder
-    from winder.core import codegen
-    from winder.core.machine import Machine
+    from winder.model import codegen
+    from winder.model.machine import Machine
 
     t_all = time.perf_counter()
     scene = winder.load_scene(scene_path)
@@ -100,7 +100,7 @@ def run_child(scene_path: Path, route: str, directory: Path, pin_dir: Path) -> d
 
 def fresh_pin_dir(tmp: Path) -> Path:
     """A pin_casadi folder with the built generator linked in and an empty model cache."""
-    from winder.core import pin_casadi
+    from winder.model import pin_casadi
 
     binary = pin_casadi.generator_path(build=False)
     base = tmp / "pin"
@@ -112,7 +112,7 @@ def fresh_pin_dir(tmp: Path) -> Path:
 
 
 def main(quick: bool = False) -> dict[str, Any]:
-    from winder.core.backends import default_route
+    from winder.model.backends import default_route
 
     repeats = 1 if quick else 2
     routes = ["py"] + (["cpp"] if default_route() == "cpp" else [])
@@ -147,7 +147,7 @@ def main(quick: bool = False) -> dict[str, Any]:
 
 
 def write_docs(out: dict[str, Any]) -> None:
-    from winder._files import atomic_write
+    from winder.io.files import atomic_write
 
     la, lb = out["load_before"], out["load_after"]
     lines = ["# Code generation and compile times", "",
@@ -157,7 +157,7 @@ def write_docs(out: dict[str, Any]) -> None:
              "empty pin_casadi model cache on route cpp): `generate()` = SX graph build (the "
              "machine's dynamics on `casadi.SX`: Pinocchio's ABA/RNEA, force elements, exact "
              "Jacobian, `casadi.Function` with CSE) + C generation + gcc (`-O3 -shared -fPIC`, "
-             "`winder.core.codegen.CFLAGS`). *Cached*: loading the compiled library "
+             "`winder.model.codegen.CFLAGS`). *Cached*: loading the compiled library "
              "(`from_cache`), and the whole `MachineSystem(scene)` from the cache (pin model, "
              "load, static balance).", "",
              f"Route cpp needs the pin_casadi generator, built once: {out['generator_build']} "

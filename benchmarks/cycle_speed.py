@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 import winder
-from winder._files import atomic_write
+from winder.io.files import atomic_write
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"

@@ -13,14 +13,14 @@ import time
 from pathlib import Path
 
 import winder
-from winder._files import atomic_write
-from winder._fmu import build_fmu
+from winder.fmu.build import build_fmu
+from winder.io.files import atomic_write
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def fmu_run(fmu_file: Path, t_end: float, step: float) -> float:
-    from winder._fmpy_host import loaded_fmu, start_fmu
+    from winder.fmu.host import loaded_fmu, start_fmu
 
     with loaded_fmu(fmu_file, instance_name="rt") as (fmu, refs, _):
         start_fmu(fmu, refs, logging=False)

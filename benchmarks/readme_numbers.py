@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 import winder
-from winder._plots import normal_force_envelope, window_mean
+from winder.plots.figures import normal_force_envelope, window_mean
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"

@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 import winder
-from winder._files import atomic_write
+from winder.io.files import atomic_write
 from winder.solve import integrators as integ
 from winder.solve.system import MachineSystem
 

@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 import winder
-from winder._files import atomic_write
-from winder._sweep import run_one, run_settings
+from winder.analysis.sweep import run_one, run_settings
+from winder.io.files import atomic_write
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -34,7 +34,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 import winder
-from winder._files import atomic_write
+from winder.io.files import atomic_write
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"

@@ -39,7 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     import fmpy
     from fmpy.fmi2 import FMU2Slave
 
-    from winder._fmu import build_fmu
+    from winder.fmu.build import build_fmu
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=700.0, help="end time [s]")

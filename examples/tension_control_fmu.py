@@ -62,7 +62,7 @@ class TensionLaw:
 
     def inertia(self, r: float) -> float:
         """``J(r)`` [kg·m²] of the parent roll (the paper-roll law)."""
-        from winder._mass_law import paper_roll_mass
+        from winder.model.mass_law import paper_roll_mass
 
         return float(paper_roll_mass(r, self.rc, self.mc, self.Jc, self.k)[1])
 
@@ -96,7 +96,7 @@ def run(fmu_file: Path, law: TensionLaw, t_end: float, dt: float
         ) -> tuple[dict[str, np.ndarray], str | None]:
     """The closed loop until ``t_end`` [s] or the parent's run-out: the log by name
     (``tau``, ``e`` and the outputs :data:`READS`), and why it stopped early (None)."""
-    from winder._fmpy_host import loaded_fmu, start_fmu
+    from winder.fmu.host import loaded_fmu, start_fmu
 
     rows: list[list[float]] = []
     ended = None
@@ -157,7 +157,7 @@ def plot(log: dict[str, np.ndarray], T_set: float, path: Path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     import winder
-    from winder._fmu import build_fmu
+    from winder.fmu.build import build_fmu
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=60.0,

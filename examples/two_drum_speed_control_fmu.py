@@ -58,8 +58,8 @@ def torque_driven_scene(out: Path) -> tuple[Any, float, float]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from winder._fmpy_host import loaded_fmu, start_fmu
-    from winder._fmu import build_fmu
+    from winder.fmu.build import build_fmu
+    from winder.fmu.host import loaded_fmu, start_fmu
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=20.0, help="end time [s]")

@@ -16,7 +16,7 @@ from pathlib import Path
 import fmpy
 import numpy as np
 
-from winder._fmpy_host import loaded_fmu, start_fmu
+from winder.fmu.host import loaded_fmu, start_fmu
 
 
 def rss_mb() -> float:
@@ -207,7 +207,7 @@ def case_bad_input(path: str) -> dict:
 
 
 def case_cycles_instantiate(path: str, n: int = 220) -> dict:
-    from winder._fmu_slave import WinderSlave
+    from winder.fmu.slave import WinderSlave
 
     mem, radius = [], []
     with loaded_fmu(path, instance_name="host") as (fmu, refs, _):

@@ -1,5 +1,5 @@
 """Scene builders for the machine tests: plain parts objects (``SimpleNamespace``) with the
-attributes :class:`winder.core.machine.Machine` reads, until the parts loader lands.
+attributes :class:`winder.model.machine.Machine` reads, until the parts loader lands.
 
 Every builder returns a fresh object (nothing is shared between parts, so overriding one
 nip's law does not touch another) and takes keyword overrides. :func:`override` sets any

@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 import winder
-from winder._modes import _Linearisation, mode_map
+from winder.analysis.modes import _Linearisation, mode_map
 from winder.cli import main
-from winder.core.equilibrium import EquilibriumError, resting_state
+from winder.solve.equilibrium import EquilibriumError, resting_state
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 HC = {"law": "hunt_crossley", "stiffness": 1e9, "exponent": 1.5, "hc_damping": 0.3}
@@ -244,8 +244,8 @@ def test_two_drum_modes_break_off_where_overdamped(tmp_path) -> None:
     eigenpair carries a quarter of its kinetic energy in ``set.x``, while at web speed 0
     (the friction state relaxes at ``v_min/σ``, too slowly to damp) ``set.x`` oscillates.
     ``winder modes`` prints the ranges and the chart marks them."""
-    from winder._linearise import jacobian
-    from winder._modes import modes_at
+    from winder.analysis.linearise import jacobian
+    from winder.analysis.modes import modes_at
 
     path = MODELS / "two_drum_winder.toml"
     scene = winder.load_scene(path)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import winder
-from winder._simulate import budget_error
+from winder.solve.simulate import budget_error
 
 PATHS = [("DOPRI5", "compiled"), ("RK4", "compiled"), ("LSODA", "compiled"),
          ("RK45", "compiled"), ("LSODA", "pinocchio"), ("RK4", "pinocchio")]

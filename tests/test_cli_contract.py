@@ -16,8 +16,8 @@ from hypothesis import strategies as st
 
 import winder
 from winder import cli
-from winder._files import STEM_MAX, check_output_dir, check_output_file, safe_stem
 from winder.cli import main
+from winder.io.files import STEM_MAX, check_output_dir, check_output_file, safe_stem
 
 CASES = [*corpus(), *new_option_cases()]
 
@@ -139,7 +139,7 @@ def test_safe_stem_never_leaves_the_directory(text: str) -> None:
 
 @pytest.mark.parametrize("name", ["../x", "/abs/path", "a\0b", "n" * 400, "..", ""])
 def test_plot_files_stay_in_their_directory(name: str, tmp_path: Path) -> None:
-    from winder._plots import paper_figures
+    from winder.plots.figures import paper_figures
 
     res = winder.Result({k: np.asarray(v) for k, v in good_result_arrays().items()} | {
         "normal_force": np.zeros(50), "friction_force": np.zeros(50),
@@ -188,7 +188,7 @@ def _budget_stub(monkeypatch, partial: winder.Result | None) -> dict:
         raise winder.BudgetExceeded(
             "wall-clock budget of 0.5 s (max_wall) reached at t = 0.25 s, step 1e-3 s",
             time=0.25, state={"z": 0.5}, step=1e-3, partial=partial)
-    monkeypatch.setattr("winder._simulate.simulate", simulate)
+    monkeypatch.setattr("winder.solve.simulate.simulate", simulate)
     return seen
 
 

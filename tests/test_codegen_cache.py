@@ -1,4 +1,4 @@
-"""The cache of generated machines (:mod:`winder.core.codegen`): one compile per
+"""The cache of generated machines (:mod:`winder.model.codegen`): one compile per
 structure, parameter values at run time, distinct keys for distinct structures, safe
 concurrent builds, no leftovers. Every test uses its own cache directory."""
 
@@ -16,9 +16,9 @@ import machines as mc
 import numpy as np
 import pytest
 
-from winder.core import codegen
-from winder.core.backends import NumericBackend
-from winder.core.machine import AUTO, CORE_AUTO, Machine
+from winder.model import codegen
+from winder.model.backends import NumericBackend
+from winder.model.machine import AUTO, CORE_AUTO, Machine
 
 pytest.importorskip("casadi")
 
@@ -131,8 +131,8 @@ _WORKER = textwrap.dedent("""
     sys.path.insert(0, {tests!r})
     import numpy as np
     import machines as mc
-    from winder.core import codegen
-    from winder.core.machine import Machine
+    from winder.model import codegen
+    from winder.model.machine import Machine
     go = Path({go!r})
     m = Machine(mc.two_drum())
     while not go.exists():  # start both builds at once

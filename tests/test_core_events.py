@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import winder
-from winder.core.machine import AT_CORE, WINDING
+from winder.model.machine import AT_CORE, WINDING
 from winder.solve import integrators as integ
 from winder.solve.system import MachineSystem
 

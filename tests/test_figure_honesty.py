@@ -12,7 +12,7 @@ import pytest
 from conftest import MODELS
 
 import winder
-from winder import _plots
+import winder.plots.figures as _plots
 from winder.cli import main
 
 
@@ -69,7 +69,7 @@ def test_a_nip_has_one_colour_in_run_figures_and_resonance_map(tmp_path, monkeyp
     seen = _colours(monkeypatch)
     _plots.machine_figures(short, tmp_path, scene=scene)
     # the resonance map of the command line, its envelope from the same short run
-    import winder._simulate as sim
+    import winder.solve.simulate as sim
 
     monkeypatch.setattr(sim, "simulate", lambda *a, **k: short)
     assert main(["modes", str(MODELS / "two_drum_winder.toml"), "--points", "3",

@@ -41,8 +41,8 @@ def test_fmpy_validate_reports_no_problems(fmu_path) -> None:
 def test_interface(fmu_path, paper_scene) -> None:
     """The model description lists exactly the Stepper's inputs and outputs (plus the
     profile reference) and the FMU parameters, with start values from the scene."""
-    from winder._fmu import FMU_PARAMETERS
-    from winder._stepper import INPUTS, OUTPUTS
+    from winder.fmu.build import FMU_PARAMETERS
+    from winder.solve.stepper import INPUTS, OUTPUTS
 
     md = fmpy.read_model_description(str(fmu_path))
     by = {v.name: v for v in md.modelVariables}
@@ -204,7 +204,7 @@ def test_parts_fmu_validates(which, request) -> None:
 def test_parts_interface(which, request) -> None:
     """Inputs: the Stepper's (one ``DRUM_torque`` per torque-driven drum); outputs: the
     Stepper's outputs but those inputs; parameters by part name with the scene's values."""
-    from winder._fmu import fmu_parameters, parameter_value
+    from winder.fmu.build import fmu_parameters, parameter_value
 
     path = request.getfixturevalue(f"{which}_fmu")
     scene = request.getfixturevalue(f"{which}_scene")
@@ -239,7 +239,7 @@ def test_parts_interface(which, request) -> None:
 
 def test_parts_scene_with_parameters(torque_scene) -> None:
     """FMU parameter values land on the named part (the other parts keep theirs)."""
-    from winder._fmu import FmuError, scene_with_parameters
+    from winder.fmu.build import FmuError, scene_with_parameters
 
     sc = scene_with_parameters(torque_scene, {"rear_nip_mu": 0.2, "set_com_offset": 1e-3,
                                               "front_web_speed": 3.0, "web_tension": 5.0})
@@ -277,7 +277,7 @@ def test_parts_fmu_drums_follow_their_own_torque(torque_scene, tmp_path) -> None
     J Ω̇ = τ, Ω(t) = τ t / J from rest (measured error 1e-17 absolute: DOPRI5 is exact on
     a linear ramp). Gravity, web tension and rider load off too, so that the set and the
     rider, resting on nothing, have a static balance to start from."""
-    from winder._fmu import build_fmu
+    from winder.fmu.build import build_fmu
 
     scene = torque_scene.replace(effects={"contact": False, "slip_relaxation": False,
                                           "gravity": False, "web_tension": False,
@@ -353,7 +353,7 @@ def test_line_interface(which, line_fmus, models_dir) -> None:
     """Inputs: the unwind's set-point (tension control) or its torque (kind torque), and
     no drum torque (the drums follow their profile); outputs: every channel but the
     inputs, and ``t``; parameters: the span's instead of ``web_tension``."""
-    from winder._fmu import fmu_parameters, parameter_value
+    from winder.fmu.build import fmu_parameters, parameter_value
 
     scene = winder.load_scene(models_dir / LINES[which])
     sim = winder.Stepper(scene)
@@ -384,7 +384,7 @@ def test_line_interface(which, line_fmus, models_dir) -> None:
 
 def test_line_scene_with_span_parameters(models_dir) -> None:
     """FMU parameter values of the span and the controller land in the scene."""
-    from winder._fmu import scene_with_parameters
+    from winder.fmu.build import scene_with_parameters
 
     scene = winder.load_scene(models_dir / "winder_line_small.toml")
     sc = scene_with_parameters(scene, {"span_EA": 2e6, "span_length": 2.5,
@@ -418,7 +418,7 @@ def test_line_fmu_stops_where_the_parent_runs_out(tmp_path, models_dir) -> None:
     2.6863 s, 2.4e-3 later). The FMU's step stops there:
     status discard, the reason in the log, the outputs at the run-out time (the Stepper's,
     the parent at its core), and every later step fails too; the host process survives."""
-    from winder._fmu import build_fmu
+    from winder.fmu.build import build_fmu
 
     scene = winder.load_scene(models_dir / "winder_line_fmu.toml")
     scene = scene.replace(roll={"parent": {"initial_radius": 0.4002}})
@@ -447,7 +447,7 @@ def test_tension_control_example_equals_the_model_controller(tmp_path, models_di
     scene (measured 1.1e-5 of T* and of the peak torque: the 2 ms zero-order hold and
     the sampled ∫e against the continuous law). The tension stays within 1.8 N of
     T* = 1000 N from the start (measured 1.80 N at 0.2 s, 0.013 N after 1 s)."""
-    from winder._mass_law import paper_roll_mass
+    from winder.model.mass_law import paper_roll_mass
 
     example = Path(__file__).resolve().parents[1] / "examples" / "tension_control_fmu.py"
     proc = subprocess.run([sys.executable, str(example), "--t-end", "5", "--out",

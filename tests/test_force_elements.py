@@ -289,9 +289,9 @@ def test_two_drum_static_balance_and_initial_rates(tmp_path, variant) -> None:
 
 def test_route_py_equals_pinocchio(tmp_path) -> None:
     """The generated code of route "py" (Pinocchio's ABA and RNEA written over the model,
-    winder.core.spatial) against ``pin.aba``/``pin.rnea`` on numbers: rates and channels
+    winder.model.spatial) against ``pin.aba``/``pin.rnea`` on numbers: rates and channels
     of the two-drum winder on random states."""
-    from winder.core.codegen import generate
+    from winder.model.codegen import generate
 
     scene = _scene(tmp_path, "plain")
     system = MachineSystem(scene, backend="pinocchio")

@@ -21,8 +21,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from winder.core.backends import NumericBackend
-from winder.core.machine import AT_CORE, AUTO, CORE_AUTO, FREE, IN_CONTACT, WINDING, Machine
+from winder.model.backends import NumericBackend
+from winder.model.machine import AT_CORE, AUTO, CORE_AUTO, FREE, IN_CONTACT, WINDING, Machine
 
 casadi = pytest.importorskip("casadi")
 
@@ -35,7 +35,7 @@ def _private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
 
 
 def _generate(machine: Machine) -> Any:
-    from winder.core.codegen import generate
+    from winder.model.codegen import generate
 
     return generate(machine)
 
@@ -188,7 +188,7 @@ def test_route_py_equals_pinocchio(seed: int) -> None:
     ``forwardKinematics`` with random ``q, v, τ``, inertias, ``fext`` and gravity."""
     import casadi as ca
 
-    from winder.core.spatial import SpatialFunctions
+    from winder.model.spatial import SpatialFunctions
 
     rng = np.random.default_rng(seed)
     pin.seed(seed)
@@ -265,7 +265,7 @@ def test_symmetric_valley_static_balance() -> None:
     """Two drums at x = ∓0.525, the set free in x and z with a rider on top, no web
     tension, no imbalance: the set sits at x = 0, each drum nip carries
     ``(m g + F_rider)/(2 cos α)`` and the rider nip ``m_rider g + L q(r)``."""
-    from winder.core.equilibrium import static_state
+    from winder.solve.equilibrium import static_state
 
     sc = mc.two_drum(imbalance=False, values={"web.tension": 0.0})
     m = Machine(sc)

@@ -175,8 +175,8 @@ def test_run_with_plots_writes_all_or_nothing(tmp_path, monkeypatch, capsys) -> 
     """A scene given by its absolute path, ``--plots``, and an error at the second figure:
     neither the result, nor a figure, nor a temporary is left (the figures are rendered
     first and written with the result as one set)."""
-    from winder import _plots
-    from winder._files import OutputError
+    import winder.plots.figures as _plots
+    from winder.io.files import OutputError
 
     save, calls = _plots._save, []
 
@@ -214,8 +214,8 @@ def test_signal_during_the_writability_probe_leaves_no_probe(sig, tmp_path,
     import signal
     import tempfile
 
-    from winder import _files
-    from winder._interrupt import Interrupted, handling_signals
+    import winder.io.files as _files
+    from winder.io.interrupt import Interrupted, handling_signals
 
     real = tempfile.mkstemp
 

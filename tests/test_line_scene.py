@@ -17,8 +17,7 @@ import pytest
 import tomli_w
 
 import winder
-from winder._scene import EFFECT_NAMES
-from winder._sweep_grid import build_grid
+from winder.analysis.sweep_grid import build_grid
 from winder.parts import (
     RollPart,
     SpanPart,
@@ -27,6 +26,7 @@ from winder.parts import (
     UnwindTorqueDrive,
     WebPart,
 )
+from winder.scene.load import EFFECT_NAMES
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 LINE = MODELS / "winder_line.toml"

@@ -16,9 +16,9 @@ import pytest
 from scipy.optimize import brentq
 
 import winder
-from winder._linearise import jacobian
-from winder._modes import mode_map, modes_at, operating_point
-from winder.core.machine import paper_roll_mass
+from winder.analysis.linearise import jacobian
+from winder.analysis.modes import mode_map, modes_at, operating_point
+from winder.model.machine import paper_roll_mass
 from winder.solve.system import MachineSystem
 
 # central-difference steps by the kind of state (its name's ending)
@@ -280,7 +280,7 @@ def test_simulated_vibration_peaks_at_predicted_critical_radius(paper_scene) -> 
     crit = mode_map(scene, np.linspace(0.075, 0.4, 120)).critical_radii(1)
     assert len(crit) == 1
     res = winder.simulate(scene, t_end=200.0, output_step=2e-3)
-    from winder._plots import normal_force_envelope
+    from winder.plots.figures import normal_force_envelope
 
     r, lo, hi, amp = normal_force_envelope(res, window=0.5)
     assert np.all(lo > 0)  # stays in contact: the linear picture applies

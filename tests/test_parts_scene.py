@@ -15,8 +15,7 @@ import pytest
 import tomli_w
 
 import winder
-from winder._scene import EFFECT_NAMES, Contact, Effects, Friction
-from winder._sweep_grid import build_grid
+from winder.analysis.sweep_grid import build_grid
 from winder.parts import (
     ContactLaw,
     DrumPart,
@@ -28,6 +27,7 @@ from winder.parts import (
     TorqueDrive,
     WebPart,
 )
+from winder.scene.load import EFFECT_NAMES, Contact, Effects, Friction
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 TWO_DRUM = MODELS / "two_drum_winder.toml"

@@ -1,4 +1,4 @@
-"""winder.core.pin_casadi: Pinocchio's own ABA/RNEA/kinematics on casadi SX.
+"""winder.model.pin_casadi: Pinocchio's own ABA/RNEA/kinematics on casadi SX.
 
 Oracle: the numeric ``pin.aba``/``pin.rnea``/``pin.forwardKinematics`` of the same model with
 ``model.inertias`` set from the same dynamic parameters and ``model.gravity`` from the same g.
@@ -15,8 +15,8 @@ import pinocchio as pin
 import pytest
 
 from winder import ArgumentTypeError
-from winder.core import pin_casadi
-from winder.core.pin_casadi import PinCasadiError, functions, generator_path
+from winder.model import pin_casadi
+from winder.model.pin_casadi import PinCasadiError, functions, generator_path
 
 # Measured worst relative errors over the draws below: aba 4e-16, rnea 0, vel 0 (rnea and the
 # kinematics run the same operations in the same order); over 2000 draws aba reaches 1.5e-14.

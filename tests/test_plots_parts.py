@@ -11,8 +11,8 @@ import pytest
 from conftest import MODELS
 
 import winder
-from winder import _plots
-from winder._sweep_summary import (
+import winder.plots.figures as _plots
+from winder.analysis.sweep_summary import (
     BAND_COLUMNS,
     SCALAR_COLUMNS,
     default_band_edges,
@@ -21,7 +21,7 @@ from winder._sweep_summary import (
     summarise,
 )
 from winder.cli import main
-from winder.core.equilibrium import EquilibriumError
+from winder.solve.equilibrium import EquilibriumError
 
 TWO_DRUM = MODELS / "two_drum_winder.toml"
 NIPS = ("front_nip", "rear_nip", "rider_nip")

@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import winder
-from winder._scene import _CHOICES, _MAX, _SPEC
+from winder.scene.load import _CHOICES, _MAX, _SPEC
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 #: The shipped scenes in the single-drum format (the keys below are its tables).
@@ -88,7 +88,7 @@ def outcome(path: Path, data: dict, keys: list[str]) -> str:
     except Exception as exc:  # noqa: BLE001 - the contract forbids any other error
         return f"bad: {type(exc).__name__} while loading: {str(exc)[:200]}"
     try:
-        from winder.core.equilibrium import static_state
+        from winder.solve.equilibrium import static_state
 
         machine = winder.Machine(scene)
         y0 = static_state(machine).state

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 import winder
-from winder import _scene as sc
-from winder.scene_reference import (
+import winder.scene.load as sc
+from winder.scene.reference import (
     CHANNEL_DOC,
     LEGACY_CHANNEL_DOC,
     _num,

@@ -118,7 +118,7 @@ def test_second_signal_while_writing(sig: int, tmp_path: Path) -> None:
 
 _SLOW_CLEANUP = """
 import sys, time, pathlib
-from winder._interrupt import Interrupted, handling_signals, on_abort
+from winder.io.interrupt import Interrupted, handling_signals, on_abort
 tmp = pathlib.Path(sys.argv[1])
 with handling_signals():
     tmp.write_text("temporary")

@@ -13,10 +13,9 @@ import numpy as np
 import pytest
 
 import winder
-from winder import _progress
-from winder._scene import key_unit
-from winder._sweep import run_id, run_one, run_settings
-from winder._sweep_grid import (
+import winder.io.progress as _progress
+from winder.analysis.sweep import run_id, run_one, run_settings
+from winder.analysis.sweep_grid import (
     build_grid,
     get_path,
     parse_spec,
@@ -25,10 +24,11 @@ from winder._sweep_grid import (
     set_path,
     split_keys,
 )
-from winder._sweep_plot import axis_label
-from winder._sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS, default_band_edges
-from winder._sweep_table import SweepTable
+from winder.analysis.sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS, default_band_edges
+from winder.analysis.sweep_table import SweepTable
 from winder.cli import main
+from winder.plots.sweep import axis_label
+from winder.scene.load import key_unit
 
 # Short runs of the paper scene (web speed reached after 6-12 s, 30 s each, ~0.1 s of
 # integration): bouncing at the higher speeds and the larger imbalance, none at 12 m/s
@@ -142,7 +142,7 @@ def test_specs_ranges_and_lists() -> None:
 
 def test_bad_specs_rejected_before_anything_is_submitted(base, tmp_path, monkeypatch,
                                                          models_dir, capsys) -> None:
-    import winder._sweep as sw
+    import winder.analysis.sweep as sw
 
     def no_cluster(*args, **kwargs):
         raise AssertionError("a cluster was contacted")
@@ -258,7 +258,7 @@ def test_cluster_sweep_equals_serial_runs(cluster, base, reference, tmp_path) ->
     assert back.keys == ("drum.drive.web_speed", "roll.com_offset")
     assert list(back.frame["drum.drive.web_speed"]) == [12.0] * 2 + [16.0] * 2 + \
         [20.0] * 2 + [24.0] * 2
-    h = winder._sweep_grid.scene_hash(base.replace(drum={"drive": {"web_speed": 24.0}},
+    h = winder.analysis.sweep_grid.scene_hash(base.replace(drum={"drive": {"web_speed": 24.0}},
                                                    roll={"com_offset": 1e-3}).to_dict())
     assert back.frame["scene_hash"].iloc[7] == h
     # trajectories on request: the stored result is the full run of that grid point
@@ -454,7 +454,7 @@ def test_tied_keys_in_the_grid(two_drum) -> None:
 def test_units_come_from_the_key_declarations() -> None:
     """Every numeric key of both scene formats has a unit; paths of both formats map to
     the same unit; words and unknown paths have none."""
-    from winder import _scene
+    import winder.scene.load as _scene
 
     for specs in (_scene._SPEC, _scene._PART_SPEC):
         for table, keys in specs.items():
@@ -492,7 +492,7 @@ def test_tied_sweep_runs_are_the_hand_edited_scenes(cluster, two_drum, tmp_path,
     scene edited by hand to the same values (run in this process); the Python API with a
     tuple of keys names the same runs; the map labels the tied axis with both keys and its
     unit."""
-    from winder import _sweep_plot
+    import winder.plots.sweep as _sweep_plot
 
     _, lc = cluster
     fast = (MODELS / "two_drum_winder.toml").read_text().replace(

@@ -344,7 +344,7 @@ def _synthetic_two_drum(scene: winder.Scene) -> winder.Result:
     """The set grows 0.1 → 0.3 → 0.5 m between the drums, the rider on top of it."""
     from winder.viewer._motion import drawn_channels, nip_channels
 
-    from winder.core.machine import Machine
+    from winder.model.machine import Machine
 
     t = np.array([0.0, 1.0, 2.0])
     r = np.array([0.1, 0.3, 0.5])
@@ -446,7 +446,7 @@ def _synthetic_line(scene: winder.Scene) -> winder.Result:
     0.1 → 0.5 m between the drums; the span's tension varies."""
     from winder.viewer._motion import drawn_channels, nip_channels
 
-    from winder.core.machine import Machine
+    from winder.model.machine import Machine
 
     t = np.linspace(0.0, 4.0, 5)
     r = np.linspace(0.1, 0.5, 5)

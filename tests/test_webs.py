@@ -25,9 +25,9 @@ import tomli_w
 from cli_corpus import Case, run_case
 
 import winder
-from winder._scene import scene_from_dict
-from winder._sweep_grid import build_grid
+from winder.analysis.sweep_grid import build_grid
 from winder.cli import main
+from winder.scene.load import scene_from_dict
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 V = 5.0  # [m/s] the web speed of every station, from t = 0

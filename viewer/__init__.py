@@ -1,8 +1,8 @@
 """winder.viewer: meshcat scene graph of any machine of parts, animation of results with
 an on-screen readout, standalone HTML, snapshots."""
 
-from ._animation import AnimationPlan, animate, plan_animation
-from ._export import (
+from winder.viewer._animation import AnimationPlan, animate, plan_animation
+from winder.viewer._export import (
     export_html,
     find_chromium,
     screenshot,
@@ -10,9 +10,9 @@ from ._export import (
     snapshot_names,
     snapshots,
 )
-from ._motion import BodyMotion, Motion, check_drawable, motion, web_path
-from ._readout import readout_text
-from ._scene_graph import COLOURS, COM_MARKER_GAIN, WinderGraph
+from winder.viewer._motion import BodyMotion, Motion, check_drawable, motion, web_path
+from winder.viewer._readout import readout_text
+from winder.viewer._scene_graph import COLOURS, COM_MARKER_GAIN, WinderGraph
 
 __all__ = ["AnimationPlan", "BodyMotion", "COLOURS", "COM_MARKER_GAIN", "Motion",
            "WinderGraph", "animate", "check_drawable", "export_html", "find_chromium",

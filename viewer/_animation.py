@@ -16,14 +16,13 @@ from dataclasses import dataclass
 import meshcat
 import numpy as np
 from meshcat.animation import Animation
+from winder.viewer._motion import Motion, body_channels, check_drawable, motion, scene_of
+from winder.viewer._readout import readout_text
+from winder.viewer._scene_graph import WinderGraph, apply_poses
 
 from winder._errors import WinderError
-from winder._result import Result
-from winder._scene import Scene
-
-from ._motion import Motion, body_channels, check_drawable, motion, scene_of
-from ._readout import readout_text
-from ._scene_graph import WinderGraph, apply_poses
+from winder.io.result import Result
+from winder.scene.load import Scene
 
 __all__ = ["AnimationPlan", "check_drawable", "plan_animation", "animate",
            "animation_motion"]
@@ -60,7 +59,7 @@ def plan_animation(result: Result, *, playback: float = 30.0, fps: int = 30,
     if scene is None:
         speeds = ["roll_speed", "drum_speed"]
     else:
-        from winder.core.machine import Machine
+        from winder.model.machine import Machine
 
         speeds = [body_channels(scene, b)["speed"] for b in Machine(scene).bodies]
     w_max = max(max(float(np.max(np.abs(result[c]))) for c in speeds if c in result), 1e-9)

@@ -1,7 +1,7 @@
 """Standalone HTML export and PNG snapshots rendered by headless Chromium.
 
 Every child process (the meshcat server, Chromium) is stopped when the call ends, on an
-error, and when a command is stopped by a signal (:mod:`winder._interrupt`)."""
+error, and when a command is stopped by a signal (:mod:`winder.io.interrupt`)."""
 
 from __future__ import annotations
 
@@ -17,16 +17,15 @@ from pathlib import Path
 
 import meshcat
 import numpy as np
+from winder.viewer._animation import animate, plan_animation
+from winder.viewer._motion import check_drawable, motion
+from winder.viewer._readout import readout_text, with_readout
+from winder.viewer._scene_graph import WinderGraph
 
 from winder._errors import ArgumentError, WinderError
-from winder._files import atomic_write, scratch_dir
-from winder._interrupt import deferred, on_abort
-from winder._result import Result
-
-from ._animation import animate, plan_animation
-from ._motion import check_drawable, motion
-from ._readout import readout_text, with_readout
-from ._scene_graph import WinderGraph
+from winder.io.files import atomic_write, scratch_dir
+from winder.io.interrupt import deferred, on_abort
+from winder.io.result import Result
 
 __all__ = ["export_html", "snapshot_html", "find_chromium", "screenshot", "snapshots",
            "snapshot_names", "served", "MAX_SNAPSHOTS", "NAME_RESOLUTION"]

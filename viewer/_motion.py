@@ -20,10 +20,10 @@ from types import SimpleNamespace
 import numpy as np
 
 from winder._errors import WinderError
-from winder._result import Result
-from winder._scene import Scene
-from winder.core.machine import Body, Machine, Web
 from winder.forces.web_tension import exit_point
+from winder.io.result import Result
+from winder.model.machine import Body, Machine, Web
+from winder.scene.load import Scene
 
 __all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
            "check_drawable", "scene_of", "motion", "WebMotion", "web_path", "span_web_path",
@@ -52,7 +52,7 @@ def scene_of(result: Result, scene: Scene | None = None) -> Scene | None:
         return scene
     stored = result.meta.get("scene_dict")
     if isinstance(stored, dict):
-        from winder._scene import scene_from_dict
+        from winder.scene.load import scene_from_dict
 
         return scene_from_dict(stored)
     return None

@@ -13,7 +13,7 @@ import html
 import json
 from types import SimpleNamespace
 
-from ._motion import Motion
+from winder.viewer._motion import Motion
 
 __all__ = ["readout_text", "with_readout", "READOUT_ID"]
 

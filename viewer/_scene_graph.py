@@ -4,7 +4,7 @@ nip as a strip of segments (on a winder line from the unwinding roll), a floor a
 side frames of the fixed stands (drums, unwinding rolls).
 
 Placements of the bodies come from the Pinocchio model of the machine
-(:class:`winder.core.machine.Machine`: per body prismatic ``x``/``z`` where free, then a
+(:class:`winder.model.machine.Machine`: per body prismatic ``x``/``z`` where free, then a
 revolute joint about ``+y``), posed by forward kinematics, never from re-derived formulas.
 A paper roll grows by scaling its ``paper`` node (meshcat scales via the ``scale``
 property; set_transform's scale is dropped by animations in meshcat 0.3.2); so does each
@@ -21,11 +21,10 @@ import meshcat
 import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
+from winder.viewer._motion import WEB_ARC_POINTS, Motion
 
-from winder._scene import Scene
-from winder.core.machine import Machine
-
-from ._motion import WEB_ARC_POINTS, Motion
+from winder.model.machine import Machine
+from winder.scene.load import Scene
 
 __all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN", "WEB_THICKNESS", "FOV", "Pose",
            "apply_poses"]

@@ -5,7 +5,7 @@ Public API (everything else is private and may change):
 
 from typing import TYPE_CHECKING, Any
 
-from ._errors import (
+from winder._errors import (
     ArgumentError,
     ArgumentTypeError,
     BudgetExceeded,
@@ -18,39 +18,40 @@ from ._errors import (
 # The rest is imported on first use (PEP 562): a command pays only for what it runs
 # (``winder run`` never imports the FMU, the linearisation or scipy's optimisers).
 _LAZY = {
-    "build_fmu": "._fmu",
-    "jacobian": "._linearise",
-    "FunctionMassLaw": "._mass_law", "MassLaw": "._mass_law", "MassProperties": "._mass_law",
-    "PaperRollLaw": "._mass_law",
-    "Mode": "._modes", "ModeMap": "._modes", "mode_map": "._modes", "modes_at": "._modes",
-    "Result": "._result", "load_result": "._result", "ResultFileError": "._result",
-    "OutputError": "._files",
-    "Scene": "._scene", "load_scene": "._scene", "scene_from_dict": "._scene",
-    "DEFAULT_METHOD": "._simulate", "simulate": "._simulate",
-    "Stepper": "._stepper",
-    "CHANNELS": ".solve.system", "EXTRA_CHANNELS": ".solve.system",
-    "MachineSystem": ".solve.system", "Machine": ".core.machine",
-    "VariableMassModel": "._variable_mass",
-    "FORCES": ".forces", "ForceElement": ".forces",
-    "sweep": "._sweep", "SweepTable": "._sweep_table",  # Dask, pandas, pyarrow
+    **dict.fromkeys(("build_fmu",), ".fmu.build"),
+    **dict.fromkeys(("jacobian",), ".analysis.linearise"),
+    **dict.fromkeys(("FunctionMassLaw", "MassLaw", "MassProperties", "PaperRollLaw"),
+                    ".model.mass_law"),
+    **dict.fromkeys(("Mode", "ModeMap", "mode_map", "modes_at"), ".analysis.modes"),
+    **dict.fromkeys(("Result", "load_result", "ResultFileError"), ".io.result"),
+    **dict.fromkeys(("OutputError",), ".io.files"),
+    **dict.fromkeys(("Scene", "load_scene", "scene_from_dict"), ".scene.load"),
+    **dict.fromkeys(("DEFAULT_METHOD", "simulate"), ".solve.simulate"),
+    **dict.fromkeys(("Stepper",), ".solve.stepper"),
+    **dict.fromkeys(("CHANNELS", "EXTRA_CHANNELS", "MachineSystem"), ".solve.system"),
+    **dict.fromkeys(("Machine",), ".model.machine"),
+    **dict.fromkeys(("VariableMassModel",), ".model.variable_body"),
+    **dict.fromkeys(("FORCES", "ForceElement"), ".forces"),
+    **dict.fromkeys(("sweep",), ".analysis.sweep"),
+    **dict.fromkeys(("SweepTable",), ".analysis.sweep_table"),  # Dask, pandas, pyarrow
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
-    from ._files import OutputError
-    from ._fmu import build_fmu
-    from ._linearise import jacobian
-    from ._mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
-    from ._modes import Mode, ModeMap, mode_map, modes_at
-    from ._result import Result, ResultFileError, load_result
-    from ._scene import Scene, load_scene, scene_from_dict
-    from ._simulate import DEFAULT_METHOD, simulate
-    from ._stepper import Stepper
-    from ._sweep import sweep
-    from ._sweep_table import SweepTable
-    from ._variable_mass import VariableMassModel
-    from .core.machine import Machine
-    from .forces import FORCES, ForceElement
-    from .solve.system import CHANNELS, EXTRA_CHANNELS, MachineSystem
+    from winder.analysis.linearise import jacobian
+    from winder.analysis.modes import Mode, ModeMap, mode_map, modes_at
+    from winder.analysis.sweep import sweep
+    from winder.analysis.sweep_table import SweepTable
+    from winder.fmu.build import build_fmu
+    from winder.forces import FORCES, ForceElement
+    from winder.io.files import OutputError
+    from winder.io.result import Result, ResultFileError, load_result
+    from winder.model.machine import Machine
+    from winder.model.mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
+    from winder.model.variable_body import VariableMassModel
+    from winder.scene.load import Scene, load_scene, scene_from_dict
+    from winder.solve.simulate import DEFAULT_METHOD, simulate
+    from winder.solve.stepper import Stepper
+    from winder.solve.system import CHANNELS, EXTRA_CHANNELS, MachineSystem
 
 
 def __getattr__(name: str) -> Any:

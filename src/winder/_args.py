@@ -8,7 +8,7 @@ import math
 import numbers
 from typing import Any
 
-from ._errors import ArgumentError, ArgumentTypeError
+from winder._errors import ArgumentError, ArgumentTypeError
 
 __all__ = ["show", "range_text", "check_real", "number", "integer", "RTOL_MAX", "ATOL_MAX"]
 

@@ -27,9 +27,9 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from ._args import ATOL_MAX, RTOL_MAX
-from ._errors import WinderError
-from ._interrupt import Interrupted, handling_signals
+from winder._args import ATOL_MAX, RTOL_MAX
+from winder._errors import WinderError
+from winder.io.interrupt import Interrupted, handling_signals
 
 __all__ = ["main"]
 
@@ -112,7 +112,7 @@ def _balance_text(residual: float, scale: float) -> str:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from ._files import check_output_dir, check_output_file
+    from winder.io.files import check_output_dir, check_output_file
 
     out = check_output_file(args.out, "--out", suffixes=(".csv", ".npz"))
     files = _result_files(out)
@@ -120,10 +120,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
         check_output_file(twin, "--out (its .npz twin)", suffixes=(".npz",))
     plots = check_output_dir(args.plots, "--plots") if args.plots is not None else None
 
-    from ._errors import BudgetExceeded
-    from ._scene import load_scene
-    from ._simulate import simulate
-    from .core.equilibrium import EquilibriumError
+    from winder._errors import BudgetExceeded
+    from winder.scene.load import load_scene
+    from winder.solve.equilibrium import EquilibriumError
+    from winder.solve.simulate import simulate
 
     scene = load_scene(args.scene)
     progress = sys.stderr.isatty() if args.progress is None else args.progress
@@ -150,12 +150,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
     items: list[tuple[Path, Callable[[Path], object]]] = [
         (f, result._writer(f)) for f in files]
     if plots is not None:  # rendered first, then written with the result: all or nothing
-        from ._plots import collected, paper_figures
+        from winder.plots.figures import collected, paper_figures
 
         with collected() as pngs:
             figures = paper_figures(result, plots, scene=scene)
         items += [(p, lambda tmp, data=data: tmp.write_bytes(data)) for p, data in pngs]
-    from ._files import atomic_write_all
+    from winder.io.files import atomic_write_all
 
     atomic_write_all(items)
     m = result.meta
@@ -173,10 +173,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
 def _load_for_view(path: str, check_span: Callable[[float], None]):
     """The scene and result to view; ``check_span(t_end)`` runs before a scene is simulated
     (and before a result file is used)."""
-    from ._files import _check_text
-    from ._result import load_result
-    from ._scene import load_scene, scene_from_dict
-    from ._simulate import simulate
+    from winder.io.files import _check_text
+    from winder.io.result import load_result
+    from winder.scene.load import load_scene, scene_from_dict
+    from winder.solve.simulate import simulate
 
     p = _check_text("source", path)
     if p.suffix.lower() == ".toml":
@@ -203,7 +203,7 @@ def _load_for_view(path: str, check_span: Callable[[float], None]):
 
 
 def _cmd_view(args: argparse.Namespace) -> int:
-    from ._files import check_output_dir, check_output_file
+    from winder.io.files import check_output_dir, check_output_file
 
     html = check_output_file(args.html, "--html", suffixes=(".html", ".htm")) \
         if args.html is not None else None
@@ -261,7 +261,7 @@ def _check_fmu(path: Path) -> str:
         import fmpy
     except ImportError:
         return "not run-checked: FMPy is not installed (pip install 'winder[fmu]')"
-    from ._fmpy_host import loaded_fmu, start_fmu
+    from winder.fmu.host import loaded_fmu, start_fmu
 
     with loaded_fmu(path, instance_name="check") as (fmu, refs, _):
         try:
@@ -283,10 +283,10 @@ def _check_fmu(path: Path) -> str:
 
 
 def _cmd_fmu(args: argparse.Namespace) -> int:
-    from ._files import check_output_file
+    from winder.io.files import check_output_file
 
     out = check_output_file(args.out, "-o/--out", suffixes=(".fmu",))
-    from ._fmu import build_fmu
+    from winder.fmu.build import build_fmu
 
     out = build_fmu(args.scene, out)
     print(f"FMI 2.0 co-simulation FMU written to {out}")
@@ -298,16 +298,16 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
 
 
 def _cmd_modes(args: argparse.Namespace) -> int:
-    from ._files import check_output_file
+    from winder.io.files import check_output_file
 
     csv = check_output_file(args.csv, "--csv", suffixes=(".csv",)) \
         if args.csv is not None else None
     plot = check_output_file(args.plot, "--plot", suffixes=(".png",)) \
         if args.plot is not None else None
 
-    from ._files import atomic_write, csv_writer
-    from ._modes import mode_map
-    from ._scene import load_scene
+    from winder.analysis.modes import mode_map
+    from winder.io.files import atomic_write, csv_writer
+    from winder.scene.load import load_scene
 
     scene = load_scene(args.scene)
     mm = mode_map(scene, web_speed=args.web_speed, n=args.points, radius_min=args.radius_min,
@@ -331,8 +331,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         atomic_write(csv, csv_writer(mm.as_columns(), fmt="%.10g"))
         print(f"  table written to {csv}")
     if plot is not None:
-        from ._plots import campbell_figure, nip_colours
-        from ._simulate import simulate
+        from winder.plots.figures import campbell_figure, nip_colours
+        from winder.solve.simulate import simulate
 
         result = None
         if args.simulate:
@@ -380,10 +380,10 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     stderr and recorded in the table), 2 when every run failed (listed; the table is kept,
     no map is drawn), 1 when runs are missing (workers died), 128 + N on signal N (130
     Ctrl-C; finished runs are kept: re-run to resume)."""
-    from ._files import check_output_dir, check_output_file
-    from ._scene import load_scene
-    from ._sweep import sweep
-    from ._sweep_grid import parse_vary
+    from winder.analysis.sweep import sweep
+    from winder.analysis.sweep_grid import parse_vary
+    from winder.io.files import check_output_dir, check_output_file
+    from winder.scene.load import load_scene
 
     check_output_dir(args.out, "--out")  # every output location, before anything runs
     if args.plot not in (None, True):
@@ -391,7 +391,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     vary = parse_vary(args.vary)
     if args.plot:
-        from ._sweep_plot import map_layout
+        from winder.plots.sweep import map_layout
 
         map_layout(vary)  # a map that cannot be drawn stops the sweep before it runs
     try:
@@ -417,7 +417,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.plot and all_failed:
         print("  no runnability map: no run ended normally", file=sys.stderr)
     elif args.plot:
-        from ._sweep_plot import runnability_map
+        from winder.plots.sweep import runnability_map
 
         png = Path(args.out) / "runnability_map.png" if args.plot is True else args.plot
         print(f"  runnability map written to "
@@ -433,7 +433,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _build_parser() -> argparse.ArgumentParser:
-    from ._scene import BACKENDS, METHODS  # the scene's [solver] choices: one list
+    from winder.scene.load import BACKENDS, METHODS  # the scene's [solver] choices: one list
 
     parser = _Parser(prog="winder", description="Paper winder simulation.",
                      epilog="Exit status: 0 done; 2 bad input or failed run (a message names "

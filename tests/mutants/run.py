@@ -14,15 +14,15 @@ Anything but ``killed`` fails the run. Before the mutants, every test the mutant
 must pass on the unmutated copy (this also fills each worker's caches).
 
 Caches: the generated C of a machine is cached under ``$WINDER_CACHE_DIR``, keyed by a hash
-of the source of ``winder/core``, ``winder/forces`` and ``winder/_mass_law.py``; numba
+of the source of ``winder/model``, ``winder/forces`` and ``winder/model/mass_law.py``; numba
 caches its kernels under ``$NUMBA_CACHE_DIR``, keyed by each module's path and time stamp.
 Every mutant gets its own fresh directory for both (deleted afterwards), so no mutant runs
 code generated or compiled from another source: a mutant of those sources starts with an
 empty generated cache, a mutant of a module with numba kernels an empty numba cache; the
 others start from a copy of the worker's unmutated caches (which cannot depend on the
-edit). The Pinocchio/CasADi generator of ``core/pin_casadi.py`` (built once
+edit). The Pinocchio/CasADi generator of ``model/pin_casadi.py`` (built once
 under the virtual environment, ``winder-pin-casadi``) is shared: it is Pinocchio's
-algorithms, not winder's physics (``core/_pin_casadi.cpp`` is not mutated: a changed
+algorithms, not winder's physics (``model/_pin_casadi.cpp`` is not mutated: a changed
 source rebuilds it, ~160 s of g++ per mutant).
 Never the project's own caches.
 
@@ -50,7 +50,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 CATALOGUE = Path(__file__).with_name("catalogue.toml")
 #: Sources the generated code is keyed by (a mutant there must not see the clean cache).
-GENERATED = ("src/winder/core/", "src/winder/forces/", "src/winder/_mass_law.py")
+GENERATED = ("src/winder/model/", "src/winder/forces/", "src/winder/model/mass_law.py")
 KINDS = {"drop": lambda x: "0.0", "double": lambda x: f"2.0 * ({x})",
          "flip": lambda x: f"-({x})"}
 TIMEOUT = 300.0  # [s] per mutant

@@ -1,15 +1,15 @@
 """Force elements: one module per effect of ``[effects]`` (see :class:`ForceElement`)."""
 
-from ._base import ForceElement
-from .contact import Contact
-from .gravity import Gravity
-from .imbalance import Imbalance
-from .rider_load import RiderLoad
-from .slip_relaxation import SlipRelaxation
-from .tension_control import TensionControl
-from .variable_mass import VariableMass
-from .web_momentum import WebMomentum
-from .web_tension import WebTension
+from winder.forces._base import ForceElement
+from winder.forces.contact import Contact
+from winder.forces.gravity import Gravity
+from winder.forces.imbalance import Imbalance
+from winder.forces.rider_load import RiderLoad
+from winder.forces.slip_relaxation import SlipRelaxation
+from winder.forces.tension_control import TensionControl
+from winder.forces.variable_mass import VariableMass
+from winder.forces.web_momentum import WebMomentum
+from winder.forces.web_tension import WebTension
 
 __all__ = ["ForceElement", "FORCES", "DRIVES"]
 

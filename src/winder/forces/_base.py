@@ -1,7 +1,7 @@
 """The force-element interface: what an effect adds to the machine's dynamics.
 
 Every effect of ``[effects]`` is one :class:`ForceElement` in its own module, written over
-a math namespace (:mod:`winder.core.mathns`) so that the same code builds the generated C
+a math namespace (:mod:`winder.model.mathns`) so that the same code builds the generated C
 and runs on the numeric Pinocchio path.
 """
 
@@ -11,7 +11,7 @@ from abc import ABC
 from typing import TYPE_CHECKING, Any, ClassVar
 
 if TYPE_CHECKING:
-    from ..core.machine import Evaluation, Machine
+    from winder.model.machine import Evaluation, Machine
 
 __all__ = ["ForceElement"]
 
@@ -25,11 +25,11 @@ class ForceElement(ABC):
     1. Subclass :class:`ForceElement` in its own module under ``winder/forces/``; set
        ``name`` (the ``[effects]`` key) and ``order`` (lower runs first; an effect that
        reads what another wrote runs after it).
-    2. In :meth:`declare`, register with the :class:`~winder.core.machine.Machine` what it
+    2. In :meth:`declare`, register with the :class:`~winder.model.machine.Machine` what it
        needs: run-time parameters (``machine.parameter(name, value)``, values from the
        scene's parts), states (``machine.state(name, initial)``), result channels
        (``machine.channel(name)``).
-    3. In :meth:`apply`, read the :class:`~winder.core.machine.Evaluation` (``ev.M`` is
+    3. In :meth:`apply`, read the :class:`~winder.model.machine.Evaluation` (``ev.M`` is
        the math namespace; ``ev.p(name)`` a parameter, ``ev.x(name)`` a state,
        ``ev.bodies``/``ev.nips`` the kinematics), add forces with ``ev.add_force``, write
        state derivatives with ``ev.set_rate`` and channels with ``ev.set_channel``. Branch

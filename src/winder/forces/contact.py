@@ -22,11 +22,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ..core.machine import FREE, IN_CONTACT
-from ._base import ForceElement
+from winder.forces._base import ForceElement
+from winder.model.machine import FREE, IN_CONTACT
 
 if TYPE_CHECKING:
-    from ..core.machine import Evaluation, Machine, NipState
+    from winder.model.machine import Evaluation, Machine, NipState
 
 __all__ = ["Contact", "unclamped_force", "normal_force", "push",
            "rest_penetration"]

@@ -6,11 +6,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ._base import ForceElement
-from .contact import push
+from winder.forces._base import ForceElement
+from winder.forces.contact import push
 
 if TYPE_CHECKING:
-    from ..core.machine import Evaluation, Machine
+    from winder.model.machine import Evaluation, Machine
 
 __all__ = ["SlipRelaxation"]
 

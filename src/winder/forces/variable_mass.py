@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ._base import ForceElement
+from winder.forces._base import ForceElement
 
 if TYPE_CHECKING:
-    from ..core.machine import Evaluation
+    from winder.model.machine import Evaluation
 
 __all__ = ["VariableMass", "inertia_times"]
 

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ._base import ForceElement
-from .web_tension import exit_point
+from winder.forces._base import ForceElement
+from winder.forces.web_tension import exit_point
 
 if TYPE_CHECKING:
-    from ..core.machine import Evaluation, Machine
+    from winder.model.machine import Evaluation, Machine
 
 __all__ = ["WebMomentum"]
 

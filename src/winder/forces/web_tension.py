@@ -13,10 +13,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ._base import ForceElement
+from winder.forces._base import ForceElement
 
 if TYPE_CHECKING:
-    from ..core.machine import Evaluation, Machine, Web
+    from winder.model.machine import Evaluation, Machine, Web
 
 __all__ = ["WebTension", "exit_point"]
 

@@ -3,10 +3,10 @@ nips and the web with its span, as frozen dataclasses (one module per part). A s
 is read into them by :func:`winder.load_scene` (:class:`~winder.Scene` fields ``drums``,
 ``rolls``, ``riders``, ``nips``, ``web``)."""
 
-from .drum import DrumPart, SpeedProfileDrive, TorqueDrive
-from .nip import CONTACT_LAWS, ContactLaw, FrictionLaw, NipPart
-from .rider import RiderPart
-from .roll import (
+from winder.parts.drum import DrumPart, SpeedProfileDrive, TorqueDrive
+from winder.parts.nip import CONTACT_LAWS, ContactLaw, FrictionLaw, NipPart
+from winder.parts.rider import RiderPart
+from winder.parts.roll import (
     AXES,
     ROLL_KINDS,
     UNWIND_DRIVE_KINDS,
@@ -14,7 +14,7 @@ from .roll import (
     TensionControl,
     UnwindTorqueDrive,
 )
-from .web import SpanPart, WebPart
+from winder.parts.web import SpanPart, WebPart
 
 __all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "RollPart", "ROLL_KINDS", "AXES",
            "UnwindTorqueDrive", "TensionControl", "UNWIND_DRIVE_KINDS", "RiderPart",

@@ -10,7 +10,7 @@ and the integration restarts in the new mode. The discontinuity of a damped norm
 at touch-down and the kink at lift-off never fall inside a step. A roll unwinding to its
 core lands exactly on ``r_c``.
 
-The machine's functions are called through their addresses (:mod:`winder.core.ccall`):
+The machine's functions are called through their addresses (:mod:`winder.model.ccall`):
 ``fns = [rhs, jac, out, sw]``. Mode slots are described by ``table`` rows ``(kind, g1,
 g2, state, param)``: kind :data:`K_CONTACT` (``g1`` its switching function, ``g2``
 its guard ``NIP.overlap``, then the guard's ``NIP.dx`` and ``NIP.dz`` in place of state
@@ -43,9 +43,9 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from ..core.ccall import call
-from ..core.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
+from winder.model.ccall import call
+from winder.model.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
+from winder.solve._jit import njit
 
 __all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "switch_buffer", "first_step",
            "sample_and_switch", "DONE", "PAUSED",

@@ -15,8 +15,8 @@ import math
 
 import numpy as np
 
-from .._jit import njit
-from .integrators import (
+from winder.solve._jit import njit
+from winder.solve.integrators import (
     DONE,
     END,
     EXHAUSTED,

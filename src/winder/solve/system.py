@@ -1,8 +1,8 @@
 """A scene's machine as one ODE system: generated code (or Pinocchio on numbers), its
 parameters, locked modes, initial state and result channels.
 
-``MachineSystem(scene)`` builds the :class:`~winder.core.machine.Machine`, compiles its
-generated functions (cached; see :mod:`winder.core.codegen`) and serves the integrators:
+``MachineSystem(scene)`` builds the :class:`~winder.model.machine.Machine`, compiles its
+generated functions (cached; see :mod:`winder.model.codegen`) and serves the integrators:
 ``rhs``/``jac`` for scipy's methods, the function addresses ``fns``, the mode ``table``
 and the parameter vector ``params`` for the compiled ones, ``channels`` for the result.
 ``backend="pinocchio"`` evaluates the same dynamics through ``pin.aba``/``pin.rnea`` on
@@ -17,13 +17,13 @@ from typing import Any
 
 import numpy as np
 
-from .._errors import ArgumentError, SimulationError, state_text
-from .._jit import njit
-from ..core.backends import NumericBackend
-from ..core.codegen import CompilerMissing, Generated, generate
-from ..core.equilibrium import Equilibrium, static_state
-from ..core.machine import AT_CORE, AUTO, CORE_AUTO, WINDING, Machine
-from . import integrators as integ
+from winder._errors import ArgumentError, SimulationError, state_text
+from winder.model.backends import NumericBackend
+from winder.model.codegen import CompilerMissing, Generated, generate
+from winder.model.machine import AT_CORE, AUTO, CORE_AUTO, WINDING, Machine
+from winder.solve import integrators as integ
+from winder.solve._jit import njit
+from winder.solve.equilibrium import Equilibrium, static_state
 
 __all__ = ["MachineSystem", "LEGACY_CHANNELS", "CHANNELS", "EXTRA_CHANNELS",
            "NoCompilerWarning"]

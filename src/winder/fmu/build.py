@@ -15,7 +15,7 @@ Interface of a single-drum scene (the old format)
   by the input ``drum_torque_command``.
 - input ``drum_torque_command`` [N·m] (named apart from the output channel
   ``drum_torque``, which reports the torque acting in either mode).
-- outputs: every result channel (:data:`winder._stepper.OUTPUTS`) and
+- outputs: every result channel (:data:`winder.solve.stepper.OUTPUTS`) and
   ``web_speed_reference`` = ``min(a_w t, v_w)`` [m/s], the profile a speed controller
   follows.
 
@@ -48,8 +48,8 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from ._errors import WinderError
-from ._scene import Scene, load_scene
+from winder._errors import WinderError
+from winder.scene.load import Scene, load_scene
 
 __all__ = ["build_fmu", "FMU_PARAMETERS", "fmu_parameters", "parameter_value",
            "scene_with_parameters", "FmuError"]
@@ -73,9 +73,9 @@ FMU_PARAMETERS: dict[str, tuple[str, str, str]] = {
 # pythonfmu's binary finds the class by the pattern ``class X(Fmi2Slave):`` in this file,
 # hence the alias.
 _SLAVE_SCRIPT = '''"""winder FMU: the scene in resources/scene.toml (needs a Python with winder)."""
-from winder._fmu_slave import WinderSlave as Fmi2Slave
+from winder.fmu.slave import WinderSlave as Fmi2Slave
 
-_pinned_globals = [globals()]  # see winder._fmu_slave.WinderSlave.__init__
+_pinned_globals = [globals()]  # see winder.fmu.slave.WinderSlave.__init__
 
 
 class Winder(Fmi2Slave):
@@ -201,8 +201,8 @@ def build_fmu(scene_path: str | Path, out: str | Path) -> Path:
     or a signal. Raises :class:`FmuError` when pythonfmu is missing or the build fails."""
     # imported here, not at the top: FMU hosts import this module (the slave, FMPy hosts),
     # and with more modules loaded there pythonfmu 0.7's heap corruption (see
-    # winder._fmu_slave) showed again: 1-3 of the 7 FMU host tests aborted per run
-    from ._files import atomic_write, scratch_dir
+    # winder.fmu.slave) showed again: 1-3 of the 7 FMU host tests aborted per run
+    from winder.io.files import atomic_write, scratch_dir
 
     try:
         from pythonfmu import FmuBuilder

@@ -3,7 +3,7 @@
 ``winder.jacobian(system, t, y)`` is :meth:`MachineSystem.jac` behind the argument checks
 of the public API: CasADi differentiates the one symbolic expression of the dynamics
 (Pinocchio's ABA on symbols, the force elements, the variable-mass ``−Ẏv``) and the
-generated C evaluates it (:mod:`winder.core.codegen`). On the numeric Pinocchio path (no C
+generated C evaluates it (:mod:`winder.model.codegen`). On the numeric Pinocchio path (no C
 compiler) it is a central difference of ``system.rhs``.
 """
 
@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._args import number, show
-from ._errors import ArgumentError, ArgumentTypeError
-from .solve.system import MachineSystem
+from winder._args import number, show
+from winder._errors import ArgumentError, ArgumentTypeError
+from winder.solve.system import MachineSystem
 
 __all__ = ["jacobian"]
 

@@ -12,7 +12,7 @@ and atomic writes that leave the complete file or nothing.
 - :func:`atomic_write` and :func:`atomic_write_all` write into hidden temporary files
   (``.winder-XXXXXXXX.tmp``, short whatever the target's name) beside the targets and move
   them into place when all are complete; on an error, Ctrl-C, SIGTERM or SIGHUP the
-  temporaries are removed (see :mod:`winder._interrupt`).
+  temporaries are removed (see :mod:`winder.io.interrupt`).
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Any
 
-from ._errors import WinderError
-from ._interrupt import deferred, on_abort
+from winder._errors import WinderError
+from winder.io.interrupt import deferred, on_abort
 
 __all__ = ["OutputError", "atomic_write", "atomic_write_all", "check_output_dir", "csv_writer",
            "check_output_file", "safe_stem", "scratch_dir"]

@@ -9,12 +9,18 @@ from typing import Any
 
 import numpy as np
 
-from ._errors import ArgumentError, SimulationError, state_text
-from ._result import Result
-from ._scene import Scene
-from ._simulate import _as_scene, budget_error, check_budgets, check_real, check_tolerances
-from .solve import integrators as integ
-from .solve.system import LEGACY_CHANNELS, MachineSystem
+from winder._errors import ArgumentError, SimulationError, state_text
+from winder.io.result import Result
+from winder.scene.load import Scene
+from winder.solve import integrators as integ
+from winder.solve.simulate import (
+    _as_scene,
+    budget_error,
+    check_budgets,
+    check_real,
+    check_tolerances,
+)
+from winder.solve.system import LEGACY_CHANNELS, MachineSystem
 
 __all__ = ["Stepper", "INPUTS", "OUTPUTS", "inputs_of", "outputs_of"]
 

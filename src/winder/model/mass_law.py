@@ -18,9 +18,9 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ._args import number
-from ._errors import ArgumentError, ModelError
-from ._scene import max_com_offset
+from winder._args import number
+from winder._errors import ArgumentError, ModelError
+from winder.scene.load import max_com_offset
 
 __all__ = ["MassLaw", "MassProperties", "FunctionMassLaw", "PaperRollLaw", "paper_roll_mass",
            "skew"]
@@ -140,7 +140,7 @@ class PaperRollLaw(MassLaw):
     ----------
     core_radius: ``r_c`` > 0 [m]; core_mass: > 0 [kg]; core_inertia: ``J_core`` > 0
     [kg·m²]; width: ``L`` > 0 [m]; density: ``ρ`` >= 0 [kg/m³]; com_offset: ``e`` [m],
-    ``0 <= e < min(r_c, √(J_core/m_core))`` (:func:`winder._scene.max_com_offset`: the
+    ``0 <= e < min(r_c, √(J_core/m_core))`` (:func:`winder.scene.load.max_com_offset`: the
     centre of mass inside the core, the inertia about it positive). All finite.
 
     The laws are defined for ``r >= r_c`` (finite): :meth:`mass`, :meth:`polar_inertia`,

@@ -1,12 +1,12 @@
 """Generated C for a machine: its right-hand side, exact Jacobian, channels and switching
 functions, compiled once per structure and cached on disk.
 
-The machine's dynamics (:meth:`~winder.core.machine.Machine.evaluate`) runs once on CasADi
+The machine's dynamics (:meth:`~winder.model.machine.Machine.evaluate`) runs once on CasADi
 symbols; four functions of ``(t, x, p, m)`` (time, state, parameters, locked modes) are
 generated as C, wrapped with flat entry points ``int NAME(const double* t, const double*
 x, const double* p, const double* m, double* out)`` and compiled with the system C
 compiler. The cache key is everything that changes the generated code: the machine's
-structure (:meth:`~winder.core.machine.Machine.structure_key`), the source of the physics
+structure (:meth:`~winder.model.machine.Machine.structure_key`), the source of the physics
 (:mod:`winder.core`, :mod:`winder.forces`, the mass law), the CasADi version and the compiler flags.
 Writes are atomic (a temporary file, then ``os.replace``), so processes building the same
 model at once all succeed. Parameter values are run-time inputs: changing one compiles
@@ -28,8 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from .._errors import WinderError
-from .machine import Machine
+from winder._errors import WinderError
+from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
            "stats"]
@@ -61,8 +61,8 @@ def cache_dir() -> Path:
 def _source_hash() -> str:
     h = hashlib.sha256()
     root = Path(__file__).resolve().parent.parent
-    files = [root / "_mass_law.py"]
-    for sub in ("core", "forces"):
+    files: list[Path] = []
+    for sub in ("model", "parts", "forces"):  # everything the generated code is built from
         files += sorted([*(root / sub).glob("*.py"), *(root / sub).glob("*.cpp")])
     for f in files:
         h.update(f.name.encode())
@@ -127,7 +127,7 @@ class Generated:
 def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Path:
     import casadi as ca
 
-    from .backends import SymbolicBackend
+    from winder.model.backends import SymbolicBackend
 
     t = ca.SX.sym("t")
     x = ca.SX.sym("x", machine.n_states)
@@ -167,11 +167,11 @@ def generate(machine: Machine, *, directory: Path | None = None,
              route: str | None = None) -> Generated:
     """The compiled functions of ``machine``: from the cache, or generated and compiled
     (and cached). ``route``: how Pinocchio's algorithms reach the symbols (one of
-    :data:`~winder.core.backends.ROUTES`; default ``cpp`` where its generator is built).
+    :data:`~winder.model.backends.ROUTES`; default ``cpp`` where its generator is built).
     Raises :class:`CompilerMissing` without a C compiler."""
     import casadi as ca
 
-    from .backends import default_route
+    from winder.model.backends import default_route
 
     global _SOURCE
     if _SOURCE is None:

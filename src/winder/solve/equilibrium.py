@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._errors import WinderError
-from ..forces.contact import rest_penetration
-from .backends import NumericBackend
-from .machine import AUTO, CORE_AUTO, FREE, IN_CONTACT, Body, Machine, Nip
+from winder._errors import WinderError
+from winder.forces.contact import rest_penetration
+from winder.model.backends import NumericBackend
+from winder.model.machine import AUTO, CORE_AUTO, FREE, IN_CONTACT, Body, Machine, Nip
 
 __all__ = ["static_state", "resting_state", "Resting", "Equilibrium", "EquilibriumError",
            "RESIDUAL_LIMIT", "balance_keys", "body_key", "nip_key"]

@@ -13,14 +13,20 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ._args import ATOL_MAX, RTOL_MAX, show
-from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, SimulationError, state_text
-from ._result import Result
-from ._scene import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
-from .core.machine import CORE_AUTO
-from .solve import integrators as integ
-from .solve.rosenbrock import ros2
-from .solve.system import MachineSystem
+from winder._args import ATOL_MAX, RTOL_MAX, show
+from winder._errors import (
+    ArgumentError,
+    ArgumentTypeError,
+    BudgetExceeded,
+    SimulationError,
+    state_text,
+)
+from winder.io.result import Result
+from winder.model.machine import CORE_AUTO
+from winder.scene.load import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
+from winder.solve import integrators as integ
+from winder.solve.rosenbrock import ros2
+from winder.solve.system import MachineSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
            "check_real", "check_tolerances", "check_budgets", "budget_error"]
@@ -136,7 +142,7 @@ def _output_grid(t_s: float, T: float, dt: float, t_key: str, dt_key: str) -> np
 
 
 class _Bar(Protocol):
-    """A progress bar (:class:`winder._progress.Progress`)."""
+    """A progress bar (:class:`winder.io.progress.Progress`)."""
 
     def update(self, t: float) -> None: ...
 
@@ -389,7 +395,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                                 f"their cores ({cores})")
     bar = None
     if progress:  # tqdm only where a bar is drawn (FMU hosts never import it)
-        from ._progress import Progress
+        from winder.io.progress import Progress
 
         bar = Progress(T, scene.name)
     guards = _Guards(system.state_names, meth, limit=limit, max_wall=wall_limit, bar=bar,
@@ -407,7 +413,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                                        max_step, guards, stats, at)
                 system.nfev, n_events = int(stats[0]), int(stats[3])
             else:
-                from ._stepwise import run_stepwise
+                from winder.solve.stepwise import run_stepwise
 
                 filled, n_events = run_stepwise(system, meth, y0, t_s, t_out, Ys, breaks,
                                                 rtol, atol, max_step, events, jacobian, guards)

@@ -17,8 +17,8 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-from ._args import number, show
-from ._errors import ArgumentError, ArgumentTypeError
+from winder._args import number, show
+from winder._errors import ArgumentError, ArgumentTypeError
 
 __all__ = ["VariableMassModel"]
 

@@ -40,13 +40,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._args import integer, number, show
-from ._errors import ArgumentError, ArgumentTypeError
-from ._linearise import jacobian
-from ._scene import _MAX, Scene
-from .core.equilibrium import EquilibriumError, nip_key, resting_state
-from .core.machine import AUTO, IN_CONTACT
-from .solve.system import MachineSystem
+from winder._args import integer, number, show
+from winder._errors import ArgumentError, ArgumentTypeError
+from winder.analysis.linearise import jacobian
+from winder.model.machine import AUTO, IN_CONTACT
+from winder.scene.load import _MAX, Scene
+from winder.solve.equilibrium import EquilibriumError, nip_key, resting_state
+from winder.solve.system import MachineSystem
 
 __all__ = ["Mode", "ModeMap", "operating_point", "modes_at", "mode_map", "MAX_POINTS"]
 
@@ -226,7 +226,7 @@ class _Linearisation:
         """The initial guess at radius ``r`` [m], already near the solution: no-slip speeds
         from the drums, then every free body resting on the bodies below it with each nip
         at the static penetration of its law under the load it carries (closed form,
-        :func:`~winder.core.equilibrium.resting_state`; the nips' damping sees the radius
+        :func:`~winder.solve.equilibrium.resting_state`; the nips' damping sees the radius
         growth), friction states 0."""
         m = self.machine
         y = np.array(m.state_initial, dtype=float)

@@ -15,10 +15,10 @@ import scipy.optimize  # noqa: F401
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
-from ._errors import WinderError
-from ._fmu import fmu_parameters, parameter_value, scene_with_parameters
-from ._scene import load_scene
-from ._stepper import OUTPUTS, Stepper
+from winder._errors import WinderError
+from winder.fmu.build import fmu_parameters, parameter_value, scene_with_parameters
+from winder.scene.load import load_scene
+from winder.solve.stepper import OUTPUTS, Stepper
 
 __all__ = ["WinderSlave"]
 
@@ -27,7 +27,7 @@ _PINNED: list[dict[str, Any]] = []
 
 class WinderSlave(Fmi2Slave):
     """Co-simulation slave: parameters, torque inputs, all channels as outputs (the
-    interface of :mod:`winder._fmu`: single-drum scenes keep their own)."""
+    interface of :mod:`winder.fmu.build`: single-drum scenes keep their own)."""
 
     author = "winder"
     description = "Paper winding machine from winder (scene in resources/scene.toml)"

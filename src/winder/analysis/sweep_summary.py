@@ -38,9 +38,9 @@ from typing import Any
 
 import numpy as np
 
-from ._result import Result
-from ._scene import Scene
-from .parts import RollPart
+from winder.io.result import Result
+from winder.parts import RollPart
+from winder.scene.load import Scene
 
 __all__ = ["BAND_COLUMNS", "SCALAR_COLUMNS", "NIP_SCALAR_COLUMNS", "default_band_edges",
            "summarise", "empty_summary", "nip_columns", "scene_nip_names", "wound_roll"]
@@ -147,7 +147,7 @@ def _layout(result: Result) -> tuple[str, dict[str, tuple[str, str]], tuple[str,
     """``(radius channel, {nip: (normal force, penetration channel)}, per-nip names)``."""
     if "normal_force" in result:  # single-drum scene: the old channel names
         return "radius", {"nip": ("normal_force", "penetration")}, ()
-    from ._scene import scene_from_dict
+    from winder.scene.load import scene_from_dict
 
     scene = scene_from_dict(result.meta["scene_dict"])
     nips = tuple(n.name for n in scene.nips)

@@ -24,9 +24,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ._args import ATOL_MAX, RTOL_MAX, check_real, show
-from ._errors import ArgumentError, ArgumentTypeError, SceneError
-from .parts import (
+from winder._args import ATOL_MAX, RTOL_MAX, check_real, show
+from winder._errors import ArgumentError, ArgumentTypeError, SceneError
+from winder.parts import (
     AXES,
     CONTACT_LAWS,
     ROLL_KINDS,
@@ -544,7 +544,7 @@ def key_unit(path: str, data: Mapping[str, Any] | None = None) -> str:
         return ""
     unit = _UNITS.get((".".join([head, *rest[:-1]]), rest[-1]), "")
     if unit == "N/m" and rest[-1] == "stiffness" and data is not None:
-        from ._sweep_grid import get_path  # its law's: k δ^p of a Hunt–Crossley nip
+        from winder.analysis.sweep_grid import get_path  # its law's: k δ^p of a Hunt–Crossley nip
 
         try:
             law = get_path(data, path[:-len("stiffness")] + "law")
@@ -1139,8 +1139,8 @@ def _check_rest_on_nip(scene: Scene) -> None:
     start inside the drum."""
     if not scene.effects.contact or scene.roll.initial_height is not None:
         return
-    from ._mass_law import PaperRollLaw
-    from .forces.contact import rest_penetration
+    from winder.forces.contact import rest_penetration
+    from winder.model.mass_law import PaperRollLaw
 
     roll = scene.roll
     r = roll.initial_radius
@@ -1230,7 +1230,7 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
 
 # ---- key documentation (docs/scene-reference.md) ---------------------------------------
 # A self-contained block: the unit and meaning of every scene key, and the default where
-# it is not a plain dataclass default. ``winder.scene_reference`` joins it with _SPEC,
+# it is not a plain dataclass default. ``winder.scene.reference`` joins it with _SPEC,
 # _PART_SPEC, _MAX and _CHOICES (type, range, required) into docs/scene-reference.md; a
 # test regenerates that file and fails when it is stale, and fails on a key of the
 # schemas missing here. Keys of a scene of parts that repeat a single-drum key

@@ -11,7 +11,7 @@ from pathlib import Path
 import fmpy
 from fmpy.fmi2 import FMU2Slave
 
-from ._fmu import FmuError
+from winder.fmu.build import FmuError
 
 __all__ = ["loaded_fmu", "start_fmu"]
 

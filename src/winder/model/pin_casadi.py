@@ -25,7 +25,7 @@ versions and the source, so it is rebuilt only when one of them changes. Generat
 are cached per model text on disk (same folder) and in memory. Every file is written under a
 temporary name in its final directory and renamed, so concurrent processes both succeed.
 
-``python -m winder.core.pin_casadi`` builds the generator (``make venv``/``make test`` run it).
+``python -m winder.model.pin_casadi`` builds the generator (``make venv``/``make test`` run it).
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
 
-from .._errors import ArgumentTypeError, WinderError
+from winder._errors import ArgumentTypeError, WinderError
 
 if TYPE_CHECKING:
     import casadi as ca
@@ -296,7 +296,7 @@ def functions(model: pin.Model) -> PinFunctions:
 
 
 def main() -> int:
-    """``python -m winder.core.pin_casadi``: build the generator if needed, print its path.
+    """``python -m winder.model.pin_casadi``: build the generator if needed, print its path.
 
     Exits 0 with a warning where g++ is missing (the features that need it say so when used),
     1 when the build fails.

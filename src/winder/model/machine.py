@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from .._mass_law import paper_roll_mass
+from winder.model.mass_law import paper_roll_mass
 
 __all__ = ["Machine", "Body", "Nip", "Web", "Evaluation", "AUTO", "FREE", "IN_CONTACT", "CORE_AUTO",
            "WINDING", "AT_CORE"]
@@ -106,7 +106,7 @@ class Machine:
     """
 
     def __init__(self, scene: Any) -> None:
-        from ..forces import DRIVES, FORCES
+        from winder.forces import DRIVES, FORCES
 
         self.scene = scene
         fx = scene.effects
@@ -151,7 +151,7 @@ class Machine:
         self.span = spanned.span if spanned is not None else None
         self.unwind = spanned.unwind if spanned is not None else None
         if self.span is not None and not fx.web_tension:
-            from .._errors import ModelError
+            from winder._errors import ModelError
 
             raise ModelError(f"{scene.source}: [effects] web_tension = false with a "
                              "[web.span]: the span's tension is the web_tension effect; "

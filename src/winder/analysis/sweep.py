@@ -1,10 +1,10 @@
 """Parameter sweeps on Dask distributed: every grid point a full simulation, summarised.
 
-:func:`sweep` builds the grid (:mod:`winder._sweep_grid`, every point validated before
+:func:`sweep` builds the grid (:mod:`winder.analysis.sweep_grid`, every point validated before
 anything is submitted), skips the runs already done in the output directory, submits the
 rest as independent tasks to a Dask cluster (an embedded ``LocalCluster`` with one
 single-threaded worker process per core, or an existing scheduler), and writes each
-finished run's summary row as soon as it arrives (:mod:`winder._sweep_table`). A run that
+finished run's summary row as soon as it arrives (:mod:`winder.analysis.sweep_table`). A run that
 fails records its status and message; a task whose worker died more often than the
 scheduler allows (``distributed.scheduler.allowed-failures``) is reported as missing and
 retried by the next call.
@@ -25,15 +25,15 @@ from typing import Any
 
 import numpy as np
 
-from ._args import RTOL_MAX
-from ._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, WinderError
-from ._progress import SweepProgress
-from ._result import Result
-from ._scene import Scene, load_scene
-from ._simulate import simulate
-from ._sweep_grid import Grid, Value, build_grid, parse_spec, scene_hash, split_keys
-from ._sweep_summary import default_band_edges, empty_summary, summarise
-from ._sweep_table import RunStore, SweepTable, row_schema, table_meta
+from winder._args import RTOL_MAX
+from winder._errors import ArgumentError, ArgumentTypeError, BudgetExceeded, WinderError
+from winder.analysis.sweep_grid import Grid, Value, build_grid, parse_spec, scene_hash, split_keys
+from winder.analysis.sweep_summary import default_band_edges, empty_summary, summarise
+from winder.analysis.sweep_table import RunStore, SweepTable, row_schema, table_meta
+from winder.io.progress import SweepProgress
+from winder.io.result import Result
+from winder.scene.load import Scene, load_scene
+from winder.solve.simulate import simulate
 
 __all__ = ["sweep", "run_one", "run_settings", "run_id"]
 
@@ -48,7 +48,7 @@ def run_settings(*, t_end: float | None = None, rtol: float | None = None,
 
     ``t_end`` [s], ``rtol`` [-], ``output_step`` [s], ``max_wall`` [s] (wall-clock budget
     per run) go to :func:`winder.simulate`; ``window`` [s] and ``threshold`` [-] to
-    :func:`winder._sweep_summary.summarise`."""
+    :func:`winder.analysis.sweep_summary.summarise`."""
     out: dict[str, Any] = {}
     for name, value, optional in (("t_end", t_end, True), ("rtol", rtol, True),
                                   ("output_step", output_step, True),
@@ -182,7 +182,7 @@ def sweep(scene: Scene | str | Path,
     ----------
     scene: the base scene (a :class:`~winder.Scene` or a scene file).
     vary: ``{key path: values}``; values are a list or a spec string (``"15:45:16"``:
-        16 values from 15 to 45; ``"1e7,2e7"``); see :mod:`winder._sweep_grid`. Tied keys
+        16 values from 15 to 45; ``"1e7,2e7"``); see :mod:`winder.analysis.sweep_grid`. Tied keys
         share one axis (each run sets them all to the same value): the key
         ``"drum.front.drive.web_speed,drum.rear.drive.web_speed"`` or a tuple of key
         paths.

@@ -26,11 +26,11 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from ._errors import WinderError
-from ._files import atomic_write
-from ._result import Result
-from ._sweep_grid import Axis
-from ._sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS, nip_columns, scene_nip_names
+from winder._errors import WinderError
+from winder.analysis.sweep_grid import Axis
+from winder.analysis.sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS, nip_columns, scene_nip_names
+from winder.io.files import atomic_write
+from winder.io.result import Result
 
 __all__ = ["SweepTable", "RunStore", "row_schema", "table_meta", "RUN_COLUMNS",
            "SUMMARY_FILE"]
@@ -142,7 +142,7 @@ class SweepTable:
         swept key, ``run_id`` (hash of the run's scene and settings), ``scene_hash``,
         ``status`` (``ok``, ``failed`` or ``budget``), ``message``, ``wall_time`` [s]
         (integration), ``task_time`` [s] (the whole task on its worker), ``worker``, the
-        scalar summary columns and per-band list columns (``winder._sweep_summary``; a
+        scalar summary columns and per-band list columns (``winder.analysis.sweep_summary``; a
         scene of parts also has them per nip, ``NIP.column``).
     keys: the swept key paths (each tied key on its own, as the columns).
     axes: the grid's axes, each a tuple of its key paths (several: tied keys, equal in

@@ -1,9 +1,9 @@
 """The runnability map: web speed against roll diameter, coloured by vibration level, with
-the critical-speed lines of the resonance map (:mod:`winder._modes`) on top.
+the critical-speed lines of the resonance map (:mod:`winder.analysis.modes`) on top.
 
 Each run of a sweep is one row of cells (its web speed) across the radius bands of its
 summary; the colour is the band's vibration level (half peak-to-peak nip force over the
-mean nip force, :mod:`winder._sweep_summary`): 1 and above means the roll lifts off.
+mean nip force, :mod:`winder.analysis.sweep_summary`): 1 and above means the roll lifts off.
 Where the roll turns ``k`` times per bounce period the imbalance drives the nip at
 resonance: at diameter ``d`` that happens at web speed ``v_k(d) = π d f_bounce(d/2) / k``,
 drawn for ``k = 1, 2, 3`` from the linearised modes of the panel's scene. When swept keys
@@ -25,12 +25,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import LogNorm  # noqa: E402
 
-from ._errors import ArgumentError, WinderError  # noqa: E402
-from ._files import atomic_write  # noqa: E402
-from ._modes import mode_map  # noqa: E402
-from ._scene import key_unit, scene_from_dict  # noqa: E402
-from ._sweep_grid import set_path, split_keys  # noqa: E402
-from ._sweep_table import SweepTable  # noqa: E402
+from winder._errors import ArgumentError, WinderError  # noqa: E402
+from winder.analysis.modes import mode_map  # noqa: E402
+from winder.analysis.sweep_grid import set_path, split_keys  # noqa: E402
+from winder.analysis.sweep_table import SweepTable  # noqa: E402
+from winder.io.files import atomic_write  # noqa: E402
+from winder.scene.load import key_unit, scene_from_dict  # noqa: E402
 
 __all__ = ["runnability_map", "map_layout", "axis_label", "SPEED_KEY"]
 

@@ -13,10 +13,10 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, DenseOutput, OdeSolver, Radau
 from scipy.optimize import brentq
 
-from ._simulate import _STEP_OVER, _WALL_EVERY, _Guards, _Stop
-from .core.machine import AT_CORE, WINDING
-from .solve import integrators as integ
-from .solve.system import MachineSystem
+from winder.model.machine import AT_CORE, WINDING
+from winder.solve import integrators as integ
+from winder.solve.simulate import _STEP_OVER, _WALL_EVERY, _Guards, _Stop
+from winder.solve.system import MachineSystem
 
 __all__ = ["run_stepwise"]
 

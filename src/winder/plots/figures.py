@@ -19,10 +19,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ._files import atomic_write, safe_stem  # noqa: E402
-from ._result import Result  # noqa: E402
-from ._scene import Scene  # noqa: E402
-from .parts import WebPart  # noqa: E402
+from winder.io.files import atomic_write, safe_stem  # noqa: E402
+from winder.io.result import Result  # noqa: E402
+from winder.parts import WebPart  # noqa: E402
+from winder.scene.load import Scene  # noqa: E402
 
 __all__ = ["paper_figures", "machine_figures", "campbell_figure", "normal_force_envelope",
            "window_mean", "nip_colours", "NIP_COLOURS", "collected"]
@@ -35,7 +35,7 @@ _COLLECTED: list[tuple[Path, bytes]] | None = None
 def collected() -> Iterator[list[tuple[Path, bytes]]]:
     """Inside the block the figure functions render their PNGs into the list yielded,
     ``(path, bytes)`` each, and write nothing: the caller writes them (with
-    :func:`winder._files.atomic_write_all`, together with its other files)."""
+    :func:`winder.io.files.atomic_write_all`, together with its other files)."""
     global _COLLECTED
     previous, _COLLECTED = _COLLECTED, []
     try:
@@ -160,7 +160,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     ax[0].set_title(f"{name}: nip normal force (Fig. 8)")
     t_lift = _first_liftoff(result)
     if closeup is None and t_lift is not None and scene is not None:
-        from ._simulate import simulate
+        from winder.solve.simulate import simulate
 
         closeup = simulate(scene, t_end=min(t_lift + 2.0, t[-1]), output_step=2e-4)
     if closeup is not None and t_lift is not None:
@@ -225,7 +225,7 @@ def _parts_scene(result: Result, scene: Scene | None) -> Scene:
     """The scene of ``result``: ``scene`` or the one stored in its meta."""
     if scene is not None:
         return scene
-    from ._scene import scene_from_dict
+    from winder.scene.load import scene_from_dict
 
     return scene_from_dict(result.meta["scene_dict"])
 

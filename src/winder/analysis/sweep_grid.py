@@ -34,8 +34,8 @@ from typing import Any
 
 import numpy as np
 
-from ._errors import ArgumentError, SceneError
-from ._scene import Scene, scene_from_dict
+from winder._errors import ArgumentError, SceneError
+from winder.scene.load import Scene, scene_from_dict
 
 __all__ = ["Axis", "Grid", "parse_spec", "parse_vary", "split_keys", "axis_keys", "resolve",
            "get_path", "set_path", "scene_hash", "build_grid"]

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from ._errors import WinderError
-from ._files import atomic_write, atomic_write_all, csv_writer
+from winder._errors import WinderError
+from winder.io.files import atomic_write, atomic_write_all, csv_writer
 
 __all__ = ["Result", "ResultFileError", "load_result"]
 

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from .mathns import NUMERIC, SYMBOLIC, MathNamespace
+from winder.model.mathns import NUMERIC, SYMBOLIC, MathNamespace
 
 __all__ = ["NumericBackend", "SymbolicBackend", "ROUTES", "default_route"]
 
@@ -62,14 +62,14 @@ class NumericBackend:
 
 
 #: Routes to Pinocchio's algorithms on CasADi symbols: ``cpp`` (Pinocchio's own templated
-#: ABA/RNEA instantiated on ``casadi::SX``, :mod:`winder.core.pin_casadi`) and ``py`` (the
-#: same algorithms over the ``pin.Model``'s structure, :mod:`winder.core.spatial`).
+#: ABA/RNEA instantiated on ``casadi::SX``, :mod:`winder.model.pin_casadi`) and ``py`` (the
+#: same algorithms over the ``pin.Model``'s structure, :mod:`winder.model.spatial`).
 ROUTES = ("cpp", "py")
 
 
 def default_route() -> str:
     """``cpp`` where its generator is built (``make venv`` builds it), else ``py``."""
-    from .pin_casadi import generator_path
+    from winder.model.pin_casadi import generator_path
 
     try:
         return "cpp" if generator_path(build=False) is not None else "py"
@@ -82,7 +82,7 @@ class _CppRoute:
     call signature (velocities as a list of 6-vectors)."""
 
     def __init__(self, model: pin.Model) -> None:
-        from .pin_casadi import functions
+        from winder.model.pin_casadi import functions
 
         self.fns = functions(model)
         self.nj = model.njoints - 1
@@ -102,7 +102,7 @@ class SymbolicBackend:
     """Pinocchio's ABA/RNEA/kinematics on CasADi ``SX`` by one of :data:`ROUTES`."""
 
     def __init__(self, model: pin.Model, route: str = "py") -> None:
-        from .spatial import SpatialFunctions
+        from winder.model.spatial import SpatialFunctions
 
         if route not in ROUTES:
             raise ValueError(f"route = {route!r} is unknown; valid: {', '.join(ROUTES)}")

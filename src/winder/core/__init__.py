@@ -1,1 +1,0 @@
-"""The core of the generated Pinocchio/CasADi model (issue 14)."""
