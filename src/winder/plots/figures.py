@@ -24,8 +24,9 @@ from winder.io.result import Result  # noqa: E402
 from winder.parts import WebPart  # noqa: E402
 from winder.scene.load import Scene  # noqa: E402
 
-__all__ = ["paper_figures", "machine_figures", "campbell_figure", "normal_force_envelope",
-           "window_mean", "nip_colours", "NIP_COLOURS", "collected"]
+__all__ = ["paper_figures", "closeup_end", "CLOSEUP_STEP", "machine_figures",
+           "campbell_figure", "normal_force_envelope", "window_mean", "nip_colours",
+           "NIP_COLOURS", "collected"]
 
 #: The figures rendered inside :func:`collected` (path, PNG bytes); None outside it.
 _COLLECTED: list[tuple[Path, bytes]] | None = None
@@ -69,6 +70,21 @@ def _first_liftoff(result: Result) -> float | None:
     return float(result.t[idx[0]]) if len(idx) else None
 
 
+#: Sampling [s] of the close-up run of Fig. 8 (:func:`closeup_end`).
+CLOSEUP_STEP = 2e-4
+
+
+def closeup_end(result: Result) -> float | None:
+    """End time [s] of the finely sampled run (from t = 0, every :data:`CLOSEUP_STEP`)
+    whose close-up of the first lift-off Fig. 8 of :func:`paper_figures` draws: 2 s after
+    it, at most the end of ``result``. None when the figure needs none (a scene of parts,
+    or no lift-off). The caller runs it (figures draw results, they never simulate)."""
+    if "normal_force" not in result:
+        return None
+    t_lift = _first_liftoff(result)
+    return None if t_lift is None else min(t_lift + 2.0, float(result.t[-1]))
+
+
 def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = None,
                   closeup: Result | None = None) -> list[Path]:
     """Write the paper's figures for ``result`` into ``out_dir``; returns the paths.
@@ -76,7 +92,8 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     With contact: speeds + drum torque (Figs. 4/5), roll vertical velocity + radius
     (Fig. 6), roll angular velocity + acceleration (Fig. 7), nip normal force with a
     close-up of the first lift-off (Fig. 8; ``closeup`` is a finely sampled result of
-    that window, re-simulated from ``scene`` when not given). Without contact: the free
+    that window, up to :func:`closeup_end`; without it the panel shows the first 60 s of
+    ``result``). Without contact: the free
     spin ω with the conserved ``J ω`` (Fig. 2). A result of a scene of parts gets
     :func:`machine_figures` instead.
     """
@@ -159,10 +176,6 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     ax[0].set_xlabel("t [s]")
     ax[0].set_title(f"{name}: nip normal force (Fig. 8)")
     t_lift = _first_liftoff(result)
-    if closeup is None and t_lift is not None and scene is not None:
-        from winder.solve.simulate import simulate
-
-        closeup = simulate(scene, t_end=min(t_lift + 2.0, t[-1]), output_step=2e-4)
     if closeup is not None and t_lift is not None:
         tc = closeup.t
         w = (tc >= t_lift - 0.3) & (tc <= t_lift + 1.0)

@@ -9,17 +9,13 @@ from typing import Any
 
 import numpy as np
 
+from winder._args import real_argument
 from winder._errors import ArgumentError, SimulationError, state_text
 from winder.io.result import Result
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
-from winder.solve.simulate import (
-    _as_scene,
-    budget_error,
-    check_budgets,
-    check_real,
-    check_tolerances,
-)
+from winder.solve.budgets import budget_error, check_budgets, check_tolerances
+from winder.solve.simulate import _as_scene
 from winder.solve.system import LEGACY_CHANNELS, MachineSystem
 
 __all__ = ["Stepper", "INPUTS", "OUTPUTS", "inputs_of", "outputs_of"]
@@ -125,9 +121,9 @@ class Stepper:
         if self.inputs[name] not in self.system.machine.param_names:
             raise ArgumentError(f"{name} is an input only with [drum.drive] kind = 'torque'; "
                                 "this scene prescribes the drum speed")
-        v = check_real(name, value, math.isfinite,
-                       "a finite number [N]" if name.endswith("setpoint") else
-                       "a finite number [N·m]")
+        v = real_argument(name, value, math.isfinite,
+                          "a finite number [N]" if name.endswith("setpoint") else
+                          "a finite number [N·m]")
         self.system.set_input(self.inputs[name], v)
         self._outputs = None
 
@@ -150,9 +146,9 @@ class Stepper:
             raise SimulationError(f"the run has ended: {self.ended}", time=self.t,
                                   state=self.state)
         resolution = integ.TIME_RESOLUTION * max(1.0, abs(self.t))
-        dt = check_real("dt", dt, lambda v: math.isfinite(v) and v >= resolution,
-                        f"finite and >= {resolution:.3g} s (the time resolution at t = "
-                        f"{self.t:.6g} s, 1e-14·max(1 s, |t|))")
+        dt = real_argument("dt", dt, lambda v: math.isfinite(v) and v >= resolution,
+                           f"finite and >= {resolution:.3g} s (the time resolution at t = "
+                           f"{self.t:.6g} s, 1e-14·max(1 s, |t|))")
         t_start, t_end = self.t, self.t + dt
         stops = [b for b in self._breaks if self.t < b < t_end] + [t_end]
         empty_t, empty_y = np.empty(0), np.empty((len(self.y), 0))
