@@ -18,6 +18,8 @@ from winder.model.machine import CORE_AUTO
 from winder.scene.load import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
 from winder.solve import integrators as integ
 from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances
+from winder.solve.dopri5 import dopri5
+from winder.solve.rk4 import rk4
 from winder.solve.rosenbrock import ros2
 from winder.solve.stepwise import run_stepwise
 from winder.solve.system import MachineSystem
@@ -116,7 +118,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
             if budget <= 0:
                 raise _Stop("max_rhs")
             if meth in COMPILED_METHODS:
-                run = integ.dopri5 if meth == "DOPRI5" else ros2
+                run = dopri5 if meth == "DOPRI5" else ros2
                 status, t, h, k = run(fns, table, t, tb, y, p, modes, rtol, atol, h, hmax,
                                       t_out, Ys, k, budget, stats)
             else:  # RK4: chunks of budget/4 steps
@@ -124,7 +126,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
                 t_next = min(tb, t + step * budget / 4)
                 if tb - t_next < 1e-9 * step:
                     t_next = tb
-                status, t, h, k = integ.rk4(fns, table, t, t_next, y, p, modes, step, t_out,
+                status, t, h, k = rk4(fns, table, t, t_next, y, p, modes, step, t_out,
                                             Ys, k, stats)
             at[:] = [t, h, k]
             guards.steps = int(stats[1])

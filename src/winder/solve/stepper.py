@@ -15,6 +15,7 @@ from winder.io.result import Result
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
 from winder.solve.budgets import budget_error, check_budgets, check_tolerances
+from winder.solve.dopri5 import dopri5
 from winder.solve.simulate import _as_scene
 from winder.solve.system import LEGACY_CHANNELS, MachineSystem
 
@@ -163,7 +164,7 @@ class Stepper:
                 if over is not None:
                     raise self._over(over, t_start, t_end, spent, steps0, stiff0, wall0)
                 budget = min(integ.CHUNK, self.max_rhs - spent)
-                status, t, h, _ = integ.dopri5(sy.fns, sy.table, self.t, tb, self.y,
+                status, t, h, _ = dopri5(sy.fns, sy.table, self.t, tb, self.y,
                                                sy.params, sy.modes, self.rtol, self.atol,
                                                self._h, math.inf, empty_t, empty_y, 0,
                                                budget, self._stats)
