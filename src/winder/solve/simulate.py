@@ -274,7 +274,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                 wall = time.perf_counter() - guards.wall0
                 partial = Result(system.channels(t_out[:filled], Ys[:, :filled]),
                                  _meta(scene, system, meth, rtol, atol, wall, 0, t_s, T,
-                                       partial=True))
+                                       partial=True), units=system.channel_units)
             if bar is not None:
                 bar.update(t_at)
             raise guards.exceeded(stop.kind, t_at, y_at, h_at, system.nfev,
@@ -300,7 +300,8 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
     if bad:
         raise SimulationError(f"non-finite values in result channels {bad}")
-    return Result(channels, _meta(scene, system, meth, rtol, atol, wall, n_events, t_s, T))
+    return Result(channels, _meta(scene, system, meth, rtol, atol, wall, n_events, t_s, T),
+                  units=system.channel_units)
 
 
 def _meta(scene: Scene, system: MachineSystem, meth: str, rtol: float, atol: float,

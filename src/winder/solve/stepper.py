@@ -198,9 +198,12 @@ class Stepper:
 
     def _over(self, kind: str, t_start: float, t_end: float, nfev: int, steps0: int,
               stiff0: int, wall0: float) -> Exception:
+        outputs = self.outputs()
+        units = self.system.channel_units
         partial = Result({"t": np.array([self.t]),
-                          **{k: np.array([v]) for k, v in self.outputs().items()}},
-                         {"scene": self.scene.name, "partial": True})
+                          **{k: np.array([v]) for k, v in outputs.items()}},
+                         {"scene": self.scene.name, "partial": True},
+                         units={k: units[k] for k in ("t", *outputs) if k in units})
         limit: Any = self.max_rhs if kind == "max_rhs" else self.max_wall
         return budget_error(kind, limit, meth="DOPRI5", t=self.t, t_start=t_start,
                             t_end=t_end, step=self._h or None,
