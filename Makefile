@@ -50,6 +50,7 @@ demo: $(STAMP) pin-casadi chromium
 
 test: $(STAMP) pin-casadi chromium
 	$(PY) -m ruff check src viewer tests examples benchmarks
+	$(VENV)/bin/lint-imports
 	$(PY) -m pytest -q
 
 test-slow: $(STAMP) chromium

@@ -11,6 +11,8 @@ import pytest
 import winder
 from winder.model.machine import AT_CORE, WINDING
 from winder.solve import integrators as integ
+from winder.solve.dopri5 import dopri5
+from winder.solve.rk4 import rk4
 from winder.solve.system import MachineSystem
 
 
@@ -47,11 +49,11 @@ def test_integrators_land_on_the_core(paper_scene, method) -> None:
     stats = np.zeros(5, dtype=np.int64)
     t_out, Y_out = np.empty(0), np.empty((len(y), 0))
     if method == "dopri5":
-        status, t, _, _ = integ.dopri5(system.fns, system.table, 0.0, t_mid, y,
+        status, t, _, _ = dopri5(system.fns, system.table, 0.0, t_mid, y,
                                        system.params, m, 1e-10, 1e-12, 0.0, np.inf, t_out,
                                        Y_out, 0, 10**8, stats)
     else:
-        status, t, _, _ = integ.rk4(system.fns, system.table, 0.0, t_mid, y, system.params,
+        status, t, _, _ = rk4(system.fns, system.table, 0.0, t_mid, y, system.params,
                                     m, 1e-4, t_out, Y_out, 0, stats)
     assert status == integ.DONE and t == t_mid
     assert stats[3] >= 1  # the core event happened

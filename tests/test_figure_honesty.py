@@ -28,7 +28,7 @@ def test_torque_panels_full_range_and_clipped_share() -> None:
     share = spikes.size / t.size
     fig, (full, zoom) = plt.subplots(2, 1)
     try:
-        _plots._torque_panels(full, zoom, t, torque)
+        _plots._torque_panels(full, zoom, t, torque, "N·m")
         lo, hi = full.get_ylim()
         assert lo <= -385.0 and hi >= 557.0
         zlo, zhi = zoom.get_ylim()
@@ -36,7 +36,8 @@ def test_torque_panels_full_range_and_clipped_share() -> None:
         outside = np.mean((torque < zlo) | (torque > zhi))
         assert outside == pytest.approx(share, abs=1e-12)
         assert f"{share:.2%} of samples lie outside" in zoom.get_title()
-        assert "-385 to 557 N m" in zoom.get_title() and "-385 to 557 N m" in full.get_title()
+        assert "-385 to 557 N·m" in zoom.get_title() and "-385 to 557 N·m" in full.get_title()
+        assert full.get_ylabel() == zoom.get_ylabel() == "drum torque [N·m]"
     finally:
         plt.close(fig)
 
@@ -109,7 +110,7 @@ def test_fig4_of_a_run_shows_the_whole_torque(tmp_path, monkeypatch):
     (_, _), ((flo, fhi), ftitle), ((zlo, zhi), ztitle) = \
         limits["paper_winding_fig4_speeds_torque.png"]
     assert flo <= torque.min() and fhi >= torque.max()
-    assert f"full range {torque.min():.0f} to {torque.max():.0f} N m" in ftitle
+    assert f"full range {torque.min():.0f} to {torque.max():.0f} N·m" in ftitle
     clipped = np.mean((torque < zlo) | (torque > zhi))
     assert 0.0 < clipped < 1.0  # the zoom leaves the ramp and the impacts out, and says so
     assert f"{clipped:.2%} of samples lie outside" in ztitle

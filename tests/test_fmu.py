@@ -470,3 +470,54 @@ def test_tension_control_example_equals_the_model_controller(tmp_path, models_di
     J = paper_roll_mass(log["parent_radius"], 0.4, 3000.0, 300.0, np.pi * 650.0 * 5.0)[1]
     np.testing.assert_allclose(J, log["parent_inertia"], rtol=1e-13)
     assert (tmp_path / "tension_control_fmu.png").stat().st_size > 10_000
+
+
+# ---- units ---------------------------------------------------------------------------------
+def _model_description(path: Path):  # noqa: ANN202 - an ElementTree root
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    with zipfile.ZipFile(path) as zf:
+        return ET.fromstring(zf.read("modelDescription.xml"))
+
+
+def _check_output_units(root, want: dict[str, str]) -> None:  # noqa: ANN001
+    """Every output of ``root`` has the unit ``want[name]`` (FMI name), and
+    ``<UnitDefinitions>`` (right after ``<CoSimulation>``, as FMI 2.0 orders them) defines
+    each unit used once, with the base-unit exponents of :mod:`winder.model.units`."""
+    from winder.model.units import BASE_UNITS, DIMENSIONS, fmi_name
+
+    outputs = {v.get("name"): v.find("Real").get("unit")
+               for v in root.iter("ScalarVariable") if v.get("causality") == "output"}
+    assert outputs == {k: fmi_name(want[k]) for k in outputs}
+    tags = [child.tag for child in root]
+    assert tags.index("UnitDefinitions") == tags.index("CoSimulation") + 1
+    defs = {u.get("name"): u.find("BaseUnit").attrib for u in root.iter("Unit")}
+    assert len(defs) == len(list(root.iter("Unit")))
+    by_fmi = {fmi_name(u): d for u, d in DIMENSIONS.items()}
+    used = {r.get("unit") for r in root.iter("Real")} - {None}
+    assert set(defs) == used
+    for name, base in defs.items():
+        assert set(base) <= set(BASE_UNITS)
+        assert {k: int(v) for k, v in base.items()} == by_fmi[name], name
+
+
+def test_outputs_declare_their_units(fmu_path, two_drum_fmu, two_drum_scene) -> None:
+    """The model descriptions of a single-drum and a two-drum FMU: each output's ``unit``
+    is its channel's (a few by hand: ``drum_speed`` rad/s, ``normal_force`` N,
+    ``inertia_rate`` kg·m²/s, ``set_z_dot`` m/s, ``front_torque`` N·m)."""
+    from winder.solve.system import MachineSystem
+
+    legacy = _model_description(fmu_path)
+    _check_output_units(legacy, {**MachineSystem(winder.load_scene(
+        Path(__file__).resolve().parents[1] / "models" / "paper_winding.toml"),
+        backend="pinocchio").channel_units, "web_speed_reference": "m/s"})
+    unit = {v.get("name"): v.find("Real").get("unit") for v in legacy.iter("ScalarVariable")
+            if v.find("Real") is not None}
+    assert unit["drum_speed"] == "rad/s" and unit["normal_force"] == "N"
+    assert unit["inertia_rate"] == "kg.m2/s" and unit["web_speed_reference"] == "m/s"
+    parts = _model_description(two_drum_fmu)
+    _check_output_units(parts, MachineSystem(two_drum_scene, backend="pinocchio").channel_units)
+    unit = {v.get("name"): v.find("Real").get("unit") for v in parts.iter("ScalarVariable")}
+    assert unit["set_z_dot"] == "m/s" and unit["front_torque"] == "N.m"
+    assert unit["rear_nip_normal_force"] == "N" and unit["set_inertia_rate"] == "kg.m2/s"

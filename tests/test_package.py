@@ -96,3 +96,139 @@ def test_every_exception_of_the_package_is_a_winder_error() -> None:
                         not issubclass(cls, Warning | winder.WinderError):
                     outside.append(f"{rel}:{node.lineno} class {node.name}")
     assert not outside, outside
+
+
+# ---- layout: layers, cycles, module sizes ---------------------------------------------------
+ROOT = Path(__file__).resolve().parents[1]
+#: Longest module [lines], and the modules over it until their split lands (one each).
+MAX_LINES = 600
+# removed at merge (#22 parts/schema): the scene split, and the machine whose behaviour moves
+# into its parts (other branches of #22)
+OVERSIZE = {"src/winder/scene/load.py", "src/winder/model/machine.py"}
+
+
+def _modules() -> dict[str, Path]:
+    """Every module of the package by dotted name (viewer/ is ``winder.viewer``)."""
+    mods = {}
+    for path in [*(ROOT / "src" / "winder").rglob("*.py"), *(ROOT / "viewer").glob("*.py")]:
+        parts = path.relative_to(ROOT).with_suffix("").parts
+        parts = ("winder", "viewer", *parts[1:]) if parts[0] == "viewer" else parts[1:]
+        mods[".".join(parts).removesuffix(".__init__")] = path
+    return mods
+
+
+def _imports(name: str, path: Path, known: set[str]) -> set[str]:
+    """The package modules ``name`` imports, anywhere in its file (in functions too)."""
+    import ast
+
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                up = package.split(".")[:len(package.split(".")) - node.level + 1]
+                base = ".".join([*up, *([base] if base else [])])
+            targets = [f"{base}.{a.name}" for a in node.names] + [base]
+        else:
+            continue
+        for t in targets:
+            while t and t not in known:
+                t = t.rpartition(".")[0]
+            if t and t != name and (t != "winder" or targets == ["winder"]):
+                found.add(t)
+                break
+    return found
+
+
+def _contract() -> tuple[list[set[str]], set[tuple[str, str]]]:
+    """The layers (top first, each a set of packages) and ignored imports of pyproject's
+    import-linter contract."""
+    import tomllib
+
+    data = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    (contract,) = data["tool"]["importlinter"]["contracts"]
+    layers = [{p.strip() for p in layer.split("|")} for layer in contract["layers"]]
+    layers[[i for i, la in enumerate(layers) if "winder.fmu" in la][0]].add("winder.viewer")
+    ignored = {tuple(s.strip() for s in i.split("->")) for i in contract["ignore_imports"]}
+    return layers, ignored
+
+
+def _rank(module: str, layers: list[set[str]]) -> int | None:
+    for i, layer in enumerate(layers):
+        if any(module == p or module.startswith(p + ".") for p in layer):
+            return i
+    return None
+
+
+def test_imports_point_down_the_layers_and_never_in_a_circle() -> None:
+    """An AST scan (imports inside functions included), independent of import-linter: no
+    module imports a layer above its own or a sibling of its layer (``winder.viewer``
+    included, which import-linter cannot see), only the contract's ignored imports
+    excepted, and the import graph of the package's modules has no cycle (the scan finds
+    a planted upward import and a planted cycle)."""
+    layers, ignored = _contract()
+    mods = _modules()
+    graph = {m: _imports(m, p, set(mods)) for m, p in mods.items()}
+
+    def upward(g: dict[str, set[str]]) -> list[str]:
+        bad = []
+        for m, deps in g.items():
+            rm = _rank(m, layers)
+            for d in deps:
+                rd = _rank(d, layers)
+                if rm is None or rd is None or (m, d) in ignored:
+                    continue
+                top = lambda x: ".".join(x.split(".")[:2])  # noqa: E731
+                if rd < rm or (rd == rm and top(d) != top(m)):
+                    bad.append(f"{m} -> {d}")
+        return bad
+
+    def cycle(g: dict[str, set[str]]) -> list[str] | None:
+        colour: dict[str, int] = {}
+        stack: list[str] = []
+
+        def visit(m: str) -> list[str] | None:
+            colour[m] = 1
+            stack.append(m)
+            for d in sorted(g.get(m, ())):
+                if (m, d) in ignored or d == "winder":
+                    continue
+                if colour.get(d) == 1:
+                    return [*stack[stack.index(d):], d]
+                if d not in colour and (found := visit(d)):
+                    return found
+            stack.pop()
+            colour[m] = 2
+            return None
+
+        for m in sorted(g):
+            if m not in colour and (found := visit(m)):
+                return found
+        return None
+
+    assert upward(graph) == []
+    assert cycle(graph) is None
+    # the oracle sees what it must: an upward import, a sibling import and a cycle
+    planted = {**graph, "winder.io.files": graph["winder.io.files"] | {"winder.solve.simulate"},
+               "winder.viewer._motion": graph["winder.viewer._motion"] | {"winder.fmu.build"}}
+    assert upward(planted) == ["winder.io.files -> winder.solve.simulate",
+                               "winder.viewer._motion -> winder.fmu.build"]
+    looped = {**graph, "winder.solve.budgets": graph["winder.solve.budgets"]
+              | {"winder.solve.simulate"}}
+    assert cycle(looped) is not None and "winder.solve.budgets" in cycle(looped)
+    assert "winder.solve.simulate" in graph["winder.solve.stepper"]  # the scan reads imports
+    assert "winder.solve.simulate" in graph["winder.cli"]  # ... inside functions too
+
+
+def test_no_module_is_over_600_lines() -> None:
+    """One concept per module: every module of src/winder and viewer/ has at most 600
+    lines (those in :data:`OVERSIZE` until their split lands)."""
+    sizes = {str(p.relative_to(ROOT)): len(p.read_text().splitlines())
+             for p in _modules().values()}
+    assert len(sizes) > 60 and sizes["src/winder/solve/simulate.py"] > 100
+    over = {p: n for p, n in sizes.items() if n > MAX_LINES and p not in OVERSIZE}
+    assert over == {}
+    assert all(sizes[p] > MAX_LINES for p in OVERSIZE)  # an exception no longer needed goes

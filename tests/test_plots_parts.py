@@ -79,7 +79,7 @@ def test_parts_figures_draw_the_channels(short_run, two_drum, tmp_path, monkeypa
     (title, speeds), *torques = drawn[names[0]]
     assert "[rad/s]" in title and len(torques) == 2
     for d, (title, lines) in zip(("front", "rear"), torques, strict=True):
-        assert title == f"drum {d}: drive torque [kN m]"
+        assert title == f"drum {d}: drive torque [kN·m]"
         same(speeds[f"drum {d}"], r[f"{d}_speed"])
         same(lines[f"drum {d}"], r[f"{d}_torque"] / 1e3)
         np.testing.assert_allclose(lines["mean over 0.5 s"][1], mean(r[f"{d}_torque"]) / 1e3,
@@ -316,3 +316,38 @@ def test_closeup_shows_the_first_opening(short_run, two_drum, tmp_path, monkeypa
     x, y = lines["nip rear_nip (rear–set)"]
     np.testing.assert_array_equal(x, t[w])
     np.testing.assert_array_equal(y, rear[w] / 1e3)
+
+
+def test_axis_labels_come_from_the_result_units(short_run, two_drum, tmp_path,
+                                                monkeypatch) -> None:
+    """The axes are labelled with the units the result carries (``Result.units``, with
+    ``k``/``m`` for values drawn in thousands/thousandths): the run's own SI units; other
+    unit texts give other labels; a result without units gets labels without brackets."""
+    labels: dict[str, list[tuple[str, str]]] = {}
+    save = _plots._save
+
+    def capture(fig, path: Path) -> Path:
+        labels[Path(path).name] = [(a.get_ylabel(), a.get_xlabel()) for a in fig.axes]
+        return save(fig, path)
+
+    monkeypatch.setattr(_plots, "_save", capture)
+    _plots.machine_figures(short_run, tmp_path, scene=two_drum)
+    stem = "two_drum_winder"
+    drums, nips = labels[f"{stem}_drums.png"], labels[f"{stem}_nip_forces.png"]
+    assert drums[0][0] == "speed Ω [rad/s]" and drums[1][0] == "torque [kN·m]"
+    assert drums[-1][1] == "t [s]" and nips[0][0] == "F_n [kN]"
+    assert labels[f"{stem}_slip.png"][0][0] == "slip [m/s]"
+    assert [y for y, _ in labels[f"{stem}_positions.png"]][:3] == ["x [m]", "z [m]", "[mm]"]
+    assert labels[f"{stem}_rolls.png"][1][0] == "radius r [m]"
+    other = winder.Result(dict(short_run), short_run.meta,
+                          units={**short_run.units, "front_speed": "rev/min", "t": "min",
+                                 "front_torque": "lbf·ft"})
+    _plots.machine_figures(other, tmp_path, scene=two_drum)
+    drums = labels[f"{stem}_drums.png"]
+    assert drums[0][0] == "speed Ω [rev/min]" and drums[1][0] == "torque [klbf·ft]"
+    assert drums[-1][1] == "t [min]"
+    labels.clear()
+    _plots.machine_figures(winder.Result(dict(short_run), short_run.meta), tmp_path,
+                           scene=two_drum)
+    assert labels[f"{stem}_drums.png"][0][0] == "speed Ω"
+    assert not any("[" in y + x for rows in labels.values() for y, x in rows)

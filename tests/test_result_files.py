@@ -21,9 +21,14 @@ HYPO = settings(max_examples=120, deadline=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture])
 
 
+#: Units of the channels of :func:`good_result_arrays`.
+UNITS = {"t": "s", "radius": "m", "z": "m", "roll_angle": "rad", "roll_speed": "rad/s",
+         "drum_speed": "rad/s", "drum_angle": "rad"}
+
+
 def _original(tmp_path: Path) -> tuple[winder.Result, bytes, bytes]:
     arrays = good_result_arrays(40)
-    res = winder.Result(arrays, {"scene": "free_spin"})
+    res = winder.Result(arrays, {"scene": "free_spin"}, units=UNITS)
     res.save(tmp_path / "full.csv", tmp_path / "full.npz")
     return res, (tmp_path / "full.npz").read_bytes(), (tmp_path / "full.csv").read_bytes()
 
@@ -63,6 +68,7 @@ def test_npz_with_changed_bytes_is_refused_or_intact(data, tmp_path: Path) -> No
     if back is not None:  # a change the archive's checksums allow (names, dates): intact
         for k in res:
             np.testing.assert_array_equal(back[k], res[k])
+        assert dict(back.units) == UNITS
 
 
 @HYPO
@@ -173,3 +179,58 @@ def test_csv_writes_zero_not_minus_zero(tmp_path: Path) -> None:
     assert np.array_equal(np.signbit(back["x"][~zeros & ~np.isnan(expect)]),
                           np.signbit(values[~zeros & ~np.isnan(expect)]))
     assert n == 16
+
+
+# ---- units --------------------------------------------------------------------------------
+def test_units_travel_with_the_npz(tmp_path: Path) -> None:
+    """``Result.units`` is written to the NPZ (member ``__units__``) and read back equal;
+    the CSV keeps its one header row of channel names (no units: they come back empty)."""
+    res = winder.Result(good_result_arrays(), {"scene": "s"}, units=UNITS)
+    res.save(tmp_path / "r.csv", tmp_path / "r.npz")
+    back = winder.load_result(tmp_path / "r.npz")
+    assert dict(back.units) == UNITS and list(back.units) == list(UNITS)
+    assert back.meta == {"scene": "s"}  # the units are not metadata
+    with np.load(tmp_path / "r.npz") as raw:  # what another NPZ reader sees
+        assert __import__("json").loads(str(raw["__units__"])) == UNITS
+    lines = (tmp_path / "r.csv").read_text().splitlines()
+    assert lines[0] == ",".join(res)  # one header row: the channel names, unchanged
+    assert np.array(lines[1].split(","), dtype=float).shape == (len(res),)
+    assert dict(winder.load_result(tmp_path / "r.csv").units) == {}
+    again = winder.load_result(back.save(tmp_path / "again.npz"))  # and once more
+    assert dict(again.units) == UNITS
+
+
+def test_npz_without_units_still_loads(tmp_path: Path) -> None:
+    """An NPZ written before results carried units (channels and ``__meta__`` only) loads,
+    with no units."""
+    arrays = good_result_arrays()
+    back = winder.load_result(write_npz(tmp_path / "old.npz", arrays, {"scene": "old"}))
+    assert dict(back.units) == {} and back.meta == {"scene": "old"}
+    np.testing.assert_array_equal(back["radius"], arrays["radius"])
+
+
+def test_bad_units_are_refused(tmp_path: Path) -> None:
+    """A units member that is not a JSON object of a channel's unit texts is refused, naming
+    the file; a Result refuses a unit for a channel it does not have; units are
+    read-only."""
+    arrays = good_result_arrays()
+    for name, units in {"list.npz": "[1, 2]", "text.npz": "{oops",
+                        "ghost.npz": '{"speed": "rad/s"}', "number.npz": '{"z": 1}'}.items():
+        with open(tmp_path / name, "wb") as fh:
+            np.savez(fh, __units__=np.array(units), **arrays)
+        with pytest.raises(ResultFileError, match=f"{name}.*units"):
+            winder.load_result(tmp_path / name)
+    with pytest.raises(winder.WinderError, match="'speed'"):
+        winder.Result(arrays, units={"speed": "rad/s"})
+    res = winder.Result(arrays, units={"z": "m"})
+    with pytest.raises(TypeError):
+        res.units["z"] = "mm"  # type: ignore[index]
+
+
+def test_simulated_results_carry_the_units_of_every_channel(models_dir: Path) -> None:
+    """A run's result has a unit for each of its channels, the system's ``channel_units``,
+    also written to and read back from its NPZ."""
+    res = winder.simulate(models_dir / "free_spin.toml", t_end=1.0, output_step=0.5)
+    assert set(res.units) == set(res)
+    assert res.units["t"] == "s" and res.units["roll_speed"] == "rad/s"
+    assert res.units["inertia_rate"] == "kg·m²/s" and res.units["normal_force"] == "N"

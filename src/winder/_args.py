@@ -6,11 +6,15 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Callable
 from typing import Any
+
+import numpy as np
 
 from winder._errors import ArgumentError, ArgumentTypeError
 
-__all__ = ["show", "range_text", "check_real", "number", "integer", "RTOL_MAX", "ATOL_MAX"]
+__all__ = ["show", "range_text", "check_real", "real_argument", "number", "integer",
+           "RTOL_MAX", "ATOL_MAX"]
 
 #: The largest relative tolerance a scene, :func:`winder.simulate` or the CLI accepts [-]
 #: (beyond it the integrators' error control means nothing).
@@ -45,23 +49,46 @@ def range_text(lo: float | None, lo_open: bool = False, hi: float | None = None,
     return text if hi is None else f"{text} and <= {hi:g}{u}"
 
 
+def _as_float(value: Any) -> float | None:
+    """``value`` as a float (an integer beyond the float range as ``±inf``), or None when it
+    is not a real number (``bool`` and ``numpy.bool_`` are not numbers here)."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+        return None
+    try:
+        return float(value)
+    except OverflowError:  # an integer beyond the float range
+        return math.inf if value > 0 else -math.inf
+
+
 def check_real(value: Any, *, lo: float | None = None, lo_open: bool = False,
                hi: float | None = None, unit: str = "") -> tuple[float, str | None, bool]:
     """``(x, problem, wrong_type)``: ``value`` as a float and, if it is not a finite real
     number in ``[lo, hi]`` (``(lo, hi]`` when ``lo_open``; ``|value| <= hi`` when ``lo`` is
     None), what is wrong with it (``"must be finite, got nan"``) and whether its type is."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    x = _as_float(value)
+    if x is None:
         return math.nan, f"expected a number, got {show(value)} ({type(value).__name__})", True
-    try:
-        x = float(value)
-    except OverflowError:  # an integer beyond the float range
-        x = math.inf if value > 0 else -math.inf
     if not math.isfinite(x):
         return x, f"must be finite, got {show(value)}", False
     if (lo is not None and (x <= lo if lo_open else x < lo)) or \
             (hi is not None and (x if lo is not None else abs(x)) > hi):
         return x, f"must be {range_text(lo, lo_open, hi, unit)}, got {show(value)}", False
     return x, None, False
+
+
+def real_argument(name: str, value: Any, ok: Callable[[float], bool], valid: str) -> float:
+    """``value`` as a float if it is a real number (:func:`check_real`'s conversion) with
+    ``ok(value)``; else :class:`~winder.ArgumentTypeError` (not a number) or
+    :class:`~winder.ArgumentError` naming ``name``, the value and ``valid`` (the valid
+    range, in words). For arguments whose range is not an interval (``inf`` allowed, whole
+    numbers) or whose message names a scene key."""
+    v = _as_float(value)
+    if v is None:
+        raise ArgumentTypeError(f"{name} must be a real number ({valid}), got {value!r} of "
+                                f"type {type(value).__name__}")
+    if not ok(v):
+        raise ArgumentError(f"{name} = {show(value)} is out of range; valid: {valid}")
+    return v
 
 
 def number(where: str, name: str, value: Any, *, lo: float | None = None,

@@ -17,6 +17,7 @@ from pythonfmu.enums import Fmi2Status
 
 from winder._errors import WinderError
 from winder.fmu.build import fmu_parameters, parameter_value, scene_with_parameters
+from winder.fmu.units import UnitReal, with_unit_definitions
 from winder.scene.load import load_scene
 from winder.solve.stepper import OUTPUTS, Stepper
 
@@ -79,19 +80,26 @@ class WinderSlave(Fmi2Slave):
                                                      else "drive torque [N m]")))
         self._outputs = ((*OUTPUTS, "web_speed_reference") if self._legacy else
                          tuple(k for k in st.output_names if k not in self._inputs))
+        units = {**st.system.channel_units, "web_speed_reference": "m/s"}
         for name in self._outputs:
-            self.register_variable(Real(name, causality=Fmi2Causality.output,
-                                        variability=Fmi2Variability.continuous,
-                                        initial=Fmi2Initial.exact))
+            self.register_variable(UnitReal(name, causality=Fmi2Causality.output,
+                                            variability=Fmi2Variability.continuous,
+                                            initial=Fmi2Initial.exact, unit=units[name]))
         # a run that can end inside a step (an unwinding roll) tells the time it reached
         self._clock = not self._legacy and st.system.machine.unwind is not None
         if self._clock:
             self.t = 0.0
-            self.register_variable(Real(
+            self.register_variable(UnitReal(
                 "t", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
-                initial=Fmi2Initial.exact,
+                initial=Fmi2Initial.exact, unit="s",
                 description="time of the outputs [s]: the end of the last step, or where "
                             "the run ended inside it"))
+
+    def to_xml(self, model_options: dict[str, str] | None = None) -> Any:
+        """pythonfmu's model description with the units of the outputs (``unit``
+        attributes and ``<UnitDefinitions>``)."""
+        root = super().to_xml(model_options or {})
+        return with_unit_definitions(root, self.vars.values())
 
     def _build(self) -> None:
         """A Stepper of the scene with the parameters' values (again only when they

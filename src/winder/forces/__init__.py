@@ -6,7 +6,7 @@ from winder.forces.gravity import Gravity
 from winder.forces.imbalance import Imbalance
 from winder.forces.rider_load import RiderLoad
 from winder.forces.slip_relaxation import SlipRelaxation
-from winder.forces.tension_control import TensionControl
+from winder.forces.tension_control import TensionController
 from winder.forces.variable_mass import VariableMass
 from winder.forces.web_momentum import WebMomentum
 from winder.forces.web_tension import WebTension
@@ -20,4 +20,4 @@ FORCES: dict[str, type[ForceElement]] = {
 }
 
 #: Force elements a part's drive calls for (not ``[effects]`` keys), by drive kind.
-DRIVES: dict[str, type[ForceElement]] = {"tension_control": TensionControl}
+DRIVES: dict[str, type[ForceElement]] = {"tension_control": TensionController}

@@ -29,10 +29,10 @@ from winder.forces._base import ForceElement
 if TYPE_CHECKING:
     from winder.model.machine import Evaluation, Machine, Web
 
-__all__ = ["TensionControl"]
+__all__ = ["TensionController"]
 
 
-class TensionControl(ForceElement):
+class TensionController(ForceElement):
     """The unwind's tension controller, one per tension-controlled unwinding roll (on the
     span of its web); state ``ROLL.tension_integral`` [N·s]."""
 

@@ -12,6 +12,7 @@ import zipfile
 import zlib
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -21,7 +22,7 @@ from winder.io.files import atomic_write, atomic_write_all, csv_writer
 
 __all__ = ["Result", "ResultFileError", "load_result"]
 
-#: Most members an NPZ result may have (channels and ``__meta__``).
+#: Most members an NPZ result may have (channels, ``__meta__`` and ``__units__``).
 _MAX_MEMBERS = 1000
 
 
@@ -35,10 +36,14 @@ class Result(Mapping[str, np.ndarray]):
     Attributes
     ----------
     meta: dict with scene name and source, method, rtol, atol, rhs evaluations, wall time.
+    units: channel → unit (``{"t": "s", "drum_speed": "rad/s", ...}``, SI with ``rad``
+        for angles; read-only); channels without a known unit are absent (a result read
+        from a CSV, or from an NPZ written before results carried units, has none).
     """
 
     def __init__(self, channels: Mapping[str, np.ndarray],
-                 meta: Mapping[str, Any] | None = None) -> None:
+                 meta: Mapping[str, Any] | None = None, *,
+                 units: Mapping[str, str] | None = None) -> None:
         if "t" not in channels:
             raise WinderError("a result needs a 't' channel")
         n = len(channels["t"])
@@ -47,6 +52,19 @@ class Result(Mapping[str, np.ndarray]):
             if v.shape != (n,):
                 raise WinderError(f"channel {k!r} has shape {v.shape}, expected ({n},)")
         self.meta: dict[str, Any] = dict(meta or {})
+        units = dict(units or {})
+        for k, u in units.items():
+            if k not in self._channels:
+                raise WinderError(f"a unit for channel {k!r}, which this result does not "
+                                  f"have; channels: {', '.join(self._channels)}"[:300])
+            if not isinstance(u, str):
+                raise WinderError(f"the unit of channel {k!r} must be a string, got {u!r}")
+        self._units = MappingProxyType(units)
+
+    @property
+    def units(self) -> Mapping[str, str]:
+        """Channel → unit [SI; read-only] (see the class docstring)."""
+        return self._units
 
     @property
     def t(self) -> np.ndarray:
@@ -73,16 +91,18 @@ class Result(Mapping[str, np.ndarray]):
 
     def _writer(self, path: str | Path) -> Callable[[Path], None]:
         """The function that writes this result to a (temporary) file, by ``path``'s
-        suffix: ``.csv`` (header: channel names) or ``.npz`` (channels + ``__meta__``)."""
+        suffix: ``.csv`` (header: channel names) or ``.npz`` (channels, ``__meta__`` and
+        ``__units__``, JSON texts)."""
         suffix = Path(path).suffix.lower()
         if suffix == ".csv":
             return csv_writer(self._channels, fmt="%.15g")
         if suffix == ".npz":
             meta = np.array(json.dumps(self.meta, default=str))
+            units = np.array(json.dumps(dict(self._units)))
 
             def write_npz(tmp: Path) -> None:
-                with open(tmp, "wb") as fh:
-                    np.savez(fh, __meta__=meta, **self._channels)  # stored: 50× faster than deflate
+                with open(tmp, "wb") as fh:  # stored: 50× faster than deflate
+                    np.savez(fh, __meta__=meta, __units__=units, **self._channels)
             return write_npz
         raise WinderError(f"{path}: unknown result format {suffix!r}; valid: .csv, .npz")
 
@@ -91,8 +111,8 @@ class Result(Mapping[str, np.ndarray]):
         return atomic_write(path, self._writer(Path(path).with_suffix(".csv")))
 
     def to_npz(self, path: str | Path) -> Path:
-        """Write an NPZ (channels + ``__meta__`` JSON; stored, not compressed: writing the
-        700 s cycle takes 0.02 s instead of 1 s), atomically."""
+        """Write an NPZ (channels, ``__meta__`` and ``__units__`` JSON; stored, not
+        compressed: writing the 700 s cycle takes 0.02 s instead of 1 s), atomically."""
         return atomic_write(path, self._writer(Path(path).with_suffix(".npz")))
 
     def save(self, path: str | Path, *more: str | Path) -> Path:
@@ -126,7 +146,24 @@ def _read_npy(data: bytes) -> np.ndarray:
     return array.reshape(shape, order="F" if fortran else "C")
 
 
-def _read_npz(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+def _json_member(p: Path, arrays: dict[str, np.ndarray], name: str) -> dict[str, Any]:
+    """The JSON object of member ``name`` (popped from ``arrays``); ``{}`` without it."""
+    if name not in arrays:
+        return {}
+    raw = arrays.pop(name)
+    try:
+        if raw.shape != () or raw.dtype.kind != "U":
+            raise ValueError("not a text")
+        value = json.loads(str(raw))
+        if not isinstance(value, dict):
+            raise ValueError("not a JSON object")
+    except ValueError as exc:
+        raise _bad(p, f"bad {'metadata' if name == '__meta__' else 'units'} ({name}: "
+                      f"{exc})") from None
+    return value
+
+
+def _read_npz(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any], dict[str, Any]]:
     arrays: dict[str, np.ndarray] = {}
     try:
         with zipfile.ZipFile(p) as zf:
@@ -146,18 +183,13 @@ def _read_npz(p: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     except (ValueError, EOFError, zlib.error, struct.error, NotImplementedError,
             RuntimeError, OverflowError, UnicodeError) as exc:
         raise _bad(p, f"damaged or not a winder result: {exc}") from None
-    meta: dict[str, Any] = {}
-    if "__meta__" in arrays:
-        raw = arrays.pop("__meta__")
-        try:
-            if raw.shape != () or raw.dtype.kind != "U":
-                raise ValueError("not a text")
-            meta = json.loads(str(raw))
-            if not isinstance(meta, dict):
-                raise ValueError("not a JSON object")
-        except ValueError as exc:
-            raise _bad(p, f"bad metadata (__meta__: {exc})") from None
-    return arrays, meta
+    meta = _json_member(p, arrays, "__meta__")
+    units = _json_member(p, arrays, "__units__")
+    for k, u in units.items():
+        if k not in arrays or not isinstance(u, str):
+            raise _bad(p, f"bad units (__units__: {k!r}: {u!r} is not the unit text of one "
+                          "of its channels)"[:300])
+    return arrays, meta, units
 
 
 def _read_csv(p: Path) -> dict[str, np.ndarray]:
@@ -207,14 +239,17 @@ def load_result(path: str | Path) -> Result:
 
     Raises :class:`ResultFileError` (a ``ValueError``) naming the file when it is missing,
     damaged, not a winder result (NPZ members that need unpickling are refused, never
-    loaded), or its time channel is not finite and increasing."""
+    loaded), or its time channel is not finite and increasing. The units of an NPZ come
+    back in :attr:`Result.units` (none from a CSV, or an NPZ written before results
+    carried units)."""
     p = Path(path)
+    units: dict[str, Any] = {}
     try:
         if not p.is_file():
             raise _bad(p, "not a file" if p.exists() else "no such result file")
         suffix = p.suffix.lower()
         if suffix == ".npz":
-            arrays, meta = _read_npz(p)
+            arrays, meta, units = _read_npz(p)
         elif suffix == ".csv":
             arrays, meta = _read_csv(p), {"scene": p.stem, "source": str(p)}
         else:
@@ -222,4 +257,4 @@ def load_result(path: str | Path) -> Result:
     except OSError as exc:
         raise _bad(p, f"cannot be read ({exc.strerror or exc})") from None
     _check_channels(p, arrays)
-    return Result({k: np.array(v, dtype=float) for k, v in arrays.items()}, meta)
+    return Result({k: np.array(v, dtype=float) for k, v in arrays.items()}, meta, units=units)

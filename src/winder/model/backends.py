@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from winder._errors import ArgumentError
 from winder.model.mathns import NUMERIC, SYMBOLIC, MathNamespace
 
 __all__ = ["NumericBackend", "SymbolicBackend", "ROUTES", "default_route"]
@@ -105,7 +106,7 @@ class SymbolicBackend:
         from winder.model.spatial import SpatialFunctions
 
         if route not in ROUTES:
-            raise ValueError(f"route = {route!r} is unknown; valid: {', '.join(ROUTES)}")
+            raise ArgumentError(f"route = {route!r} is unknown; valid: {', '.join(ROUTES)}")
         self.M = SYMBOLIC
         self.route = route
         self.f: Any = _CppRoute(model) if route == "cpp" else SpatialFunctions(model)

@@ -16,6 +16,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from winder._errors import ModelError
+
 __all__ = ["JointInfo", "joint_infos", "SpatialFunctions", "python_route"]
 
 
@@ -36,7 +38,7 @@ def joint_infos(model: pin.Model) -> list[JointInfo]:
     for i in range(1, model.njoints):
         jm = model.joints[i]
         if jm.nq != 1 or jm.nv != 1:
-            raise ValueError(f"joint {model.names[i]!r} ({jm.shortname()}): only 1-DoF "
+            raise ModelError(f"joint {model.names[i]!r} ({jm.shortname()}): only 1-DoF "
                              "revolute and prismatic joints are supported")
         jd = jm.createData()
         jm.calc(jd, np.zeros(model.nq))

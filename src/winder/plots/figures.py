@@ -24,8 +24,9 @@ from winder.io.result import Result  # noqa: E402
 from winder.parts import WebPart  # noqa: E402
 from winder.scene.load import Scene  # noqa: E402
 
-__all__ = ["paper_figures", "machine_figures", "campbell_figure", "normal_force_envelope",
-           "window_mean", "nip_colours", "NIP_COLOURS", "collected"]
+__all__ = ["paper_figures", "closeup_end", "CLOSEUP_STEP", "machine_figures",
+           "campbell_figure", "normal_force_envelope", "window_mean", "nip_colours",
+           "NIP_COLOURS", "collected"]
 
 #: The figures rendered inside :func:`collected` (path, PNG bytes); None outside it.
 _COLLECTED: list[tuple[Path, bytes]] | None = None
@@ -63,10 +64,33 @@ def _label(text: object, limit: int = 80) -> str:
     return re.sub(r"[\x00-\x1f\x7f]", "?", str(text))[:limit].replace("$", r"\$")
 
 
+def _in(result: Result, channel: str, prefix: str = "") -> str:
+    """`` [unit]`` of ``channel`` from :attr:`Result.units` (``prefix`` ``k`` for values
+    drawn in thousands, ``m`` in thousandths: ``[kN]``, ``[mm]``); empty when the result
+    has no unit for it (read from a CSV)."""
+    unit = result.units.get(channel)
+    return f" [{prefix}{unit}]" if unit else ""
+
+
 def _first_liftoff(result: Result) -> float | None:
     fn = result["normal_force"]
     idx = np.flatnonzero(fn <= 0.0)
     return float(result.t[idx[0]]) if len(idx) else None
+
+
+#: Sampling [s] of the close-up run of Fig. 8 (:func:`closeup_end`).
+CLOSEUP_STEP = 2e-4
+
+
+def closeup_end(result: Result) -> float | None:
+    """End time [s] of the finely sampled run (from t = 0, every :data:`CLOSEUP_STEP`)
+    whose close-up of the first lift-off Fig. 8 of :func:`paper_figures` draws: 2 s after
+    it, at most the end of ``result``. None when the figure needs none (a scene of parts,
+    or no lift-off). The caller runs it (figures draw results, they never simulate)."""
+    if "normal_force" not in result:
+        return None
+    t_lift = _first_liftoff(result)
+    return None if t_lift is None else min(t_lift + 2.0, float(result.t[-1]))
 
 
 def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = None,
@@ -76,7 +100,8 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     With contact: speeds + drum torque (Figs. 4/5), roll vertical velocity + radius
     (Fig. 6), roll angular velocity + acceleration (Fig. 7), nip normal force with a
     close-up of the first lift-off (Fig. 8; ``closeup`` is a finely sampled result of
-    that window, re-simulated from ``scene`` when not given). Without contact: the free
+    that window, up to :func:`closeup_end`; without it the panel shows the first 60 s of
+    ``result``). Without contact: the free
     spin ω with the conserved ``J ω`` (Fig. 2). A result of a scene of parts gets
     :func:`machine_figures` instead.
     """
@@ -91,7 +116,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     if np.all(result["normal_force"] == 0.0) and np.all(result["friction_force"] == 0.0):
         fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
         ax[0].plot(t, result["roll_speed"], label="roll speed ω")
-        ax[0].set_ylabel("ω [rad/s]")
+        ax[0].set_ylabel("ω" + _in(result, "roll_speed"))
         ax[0].set_title(f"{name}: free spin, paper added from rest (Fig. 2)")
         jw = result["inertia"] * result["roll_speed"]
         ax[1].plot(t, jw, color="C2", label="J ω")
@@ -99,7 +124,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
         span = np.ptp(jw) / max(abs(jw[0]), 1e-300)
         ax[1].set_title(f"angular momentum J ω (relative variation {span:.1e})")
         ax[1].set_ylim(jw[0] * 0.9, jw[0] * 1.1) if jw[0] > 0 else None
-        ax[1].set_xlabel("t [s]")
+        ax[1].set_xlabel("t" + _in(result, "t"))
         for a in ax:
             a.grid(True, alpha=0.3)
             a.legend()
@@ -108,7 +133,7 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     fig, ax = plt.subplots(3, 1, figsize=(9, 9.5), sharex=True)
     ax[0].plot(t, result["drum_speed"], label="drum Ω")
     ax[0].plot(t, result["roll_speed"], label="roll ω", alpha=0.8)
-    ax[0].set_ylabel("speed [rad/s]")
+    ax[0].set_ylabel("speed" + _in(result, "drum_speed"))
     ax[0].set_ylim(0, 1.05 * max(np.max(result["roll_speed"]), np.max(result["drum_speed"])))
     R = float(result.meta.get("drum_radius", 0.5))
     eq = np.flatnonzero(np.diff(np.sign(result["radius"] - R)))
@@ -118,20 +143,20 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     ax[0].set_title(f"{name}: drum and roll speed, drum torque "
                     f"({'with' if web else 'without'} web momentum, Fig. {4 if web else 5})")
     torque = result["drum_torque"]
-    _torque_panels(ax[1], ax[2], t, torque)
-    ax[2].set_xlabel("t [s]")
+    _torque_panels(ax[1], ax[2], t, torque, result.units.get("drum_torque", ""))
+    ax[2].set_xlabel("t" + _in(result, "t"))
     for a in ax:
         a.grid(True, alpha=0.3)
     paths.append(_save(fig, out / f"{stem}_fig{4 if web else 5}_speeds_torque.png"))
 
     fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
     ax[0].plot(t, result["z_dot"] * 1e3, lw=0.5)
-    ax[0].set_ylabel("roll vertical velocity ż [mm/s]")
+    ax[0].set_ylabel("roll vertical velocity ż" + _in(result, "z_dot", "m"))
     ax[0].set_title(f"{name}: roll vertical velocity and radius (Fig. 6)")
     ax[1].plot(t, result["radius"], label="roll radius r")
     ax[1].plot(t, result["z"] - result["z"][0], label="rise of the roll axis z − z₀")
-    ax[1].set_ylabel("[m]")
-    ax[1].set_xlabel("t [s]")
+    ax[1].set_ylabel(_in(result, "radius").strip())
+    ax[1].set_xlabel("t" + _in(result, "t"))
     ax[1].legend()
     for a in ax:
         a.grid(True, alpha=0.3)
@@ -139,11 +164,11 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
 
     fig, ax = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
     ax[0].plot(t, result["roll_speed"], lw=0.6)
-    ax[0].set_ylabel("roll speed ω [rad/s]")
+    ax[0].set_ylabel("roll speed ω" + _in(result, "roll_speed"))
     ax[0].set_title(f"{name}: roll angular velocity and acceleration (Fig. 7)")
     ax[1].plot(t, result["roll_accel"], lw=0.4, color="C1")
-    ax[1].set_ylabel("roll acceleration ω̇ [rad/s²]")
-    ax[1].set_xlabel("t [s]")
+    ax[1].set_ylabel("roll acceleration ω̇" + _in(result, "roll_accel"))
+    ax[1].set_xlabel("t" + _in(result, "t"))
     for a in ax:
         a.grid(True, alpha=0.3)
     paths.append(_save(fig, out / f"{stem}_fig7_roll_speed_accel.png"))
@@ -155,14 +180,10 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
         ax[0].plot(t, result["mass"] * g / 1e3, color="k", lw=0.8,
                    label=f"weight m g (g = {g:g} m/s²)")
         ax[0].legend()
-    ax[0].set_ylabel("normal force F_n [kN]")
-    ax[0].set_xlabel("t [s]")
+    ax[0].set_ylabel("normal force F_n" + _in(result, "normal_force", "k"))
+    ax[0].set_xlabel("t" + _in(result, "t"))
     ax[0].set_title(f"{name}: nip normal force (Fig. 8)")
     t_lift = _first_liftoff(result)
-    if closeup is None and t_lift is not None and scene is not None:
-        from winder.solve.simulate import simulate
-
-        closeup = simulate(scene, t_end=min(t_lift + 2.0, t[-1]), output_step=2e-4)
     if closeup is not None and t_lift is not None:
         tc = closeup.t
         w = (tc >= t_lift - 0.3) & (tc <= t_lift + 1.0)
@@ -173,23 +194,26 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
         w = t <= min(t[-1], 60.0)
         ax[1].plot(t[w], result["normal_force"][w], lw=0.6)
         ax[1].set_title("first 60 s (no lift-off in this run)")
-    ax[1].set_ylabel("F_n [N]")
-    ax[1].set_xlabel("t [s]")
+    ax[1].set_ylabel("F_n" + _in(result, "normal_force"))
+    ax[1].set_xlabel("t" + _in(result, "t"))
     for a in ax:
         a.grid(True, alpha=0.3)
     paths.append(_save(fig, out / f"{stem}_fig8_normal_force.png"))
     return paths
 
 
-def _torque_panels(full: plt.Axes, zoom: plt.Axes, t: np.ndarray, torque: np.ndarray
-                   ) -> None:
-    """The drum torque [N·m] twice: ``full`` on its whole range (the impacts of a bouncing
-    roll), ``zoom`` on the range of its 0.5–99.5 percentiles (after t = 45 s in a long
-    run) with its mean over 0.5 s, saying in its title what it leaves out."""
+def _torque_panels(full: plt.Axes, zoom: plt.Axes, t: np.ndarray, torque: np.ndarray,
+                   unit: str) -> None:
+    """The drum torque (in ``unit``, its channel's) twice: ``full`` on its whole range (the
+    impacts of a bouncing roll), ``zoom`` on the range of its 0.5–99.5 percentiles (after
+    t = 45 s in a long run) with its mean over 0.5 s, saying in its title what it leaves
+    out."""
     lo_all, hi_all = float(np.min(torque)), float(np.max(torque))
+    u = f" {unit}" if unit else ""
+    label = f"drum torque [{unit}]" if unit else "drum torque"
     full.plot(t, torque, color="C3", lw=0.6)
-    full.set_ylabel("drum torque [N m]")
-    full.set_title(f"drum torque, full range {lo_all:.0f} to {hi_all:.0f} N m", fontsize=10)
+    full.set_ylabel(label)
+    full.set_title(f"drum torque, full range {lo_all:.0f} to {hi_all:.0f}{u}", fontsize=10)
     full.axhline(0.0, color="k", lw=0.5)
     late = t > 45 if t[-1] > 50 else np.ones_like(t, dtype=bool)
     lo, hi = np.percentile(torque[late], [0.5, 99.5])
@@ -198,10 +222,10 @@ def _torque_panels(full: plt.Axes, zoom: plt.Axes, t: np.ndarray, torque: np.nda
     zoom.plot(*window_mean(t, torque), color="k", lw=0.8, label="mean over 0.5 s")
     zoom.set_ylim(lo - pad, hi + pad)
     zoom.axhline(0.0, color="k", lw=0.5)
-    zoom.set_ylabel("drum torque [N m]")
+    zoom.set_ylabel(label)
     clipped = np.mean((torque < lo - pad) | (torque > hi + pad))
-    zoom.set_title(f"zoom on {lo - pad:.0f} to {hi + pad:.0f} N m: clipped, {clipped:.2%} of "
-                   f"samples lie outside (full range {lo_all:.0f} to {hi_all:.0f} N m above)",
+    zoom.set_title(f"zoom on {lo - pad:.0f} to {hi + pad:.0f}{u}: clipped, {clipped:.2%} of "
+                   f"samples lie outside (full range {lo_all:.0f} to {hi_all:.0f}{u} above)",
                    fontsize=10)
     zoom.legend(fontsize=8, loc="upper right")
 
@@ -291,36 +315,42 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
 
     # drums: speeds, then one torque row per drum
     fig, ax = _rows(1 + len(scene.drums))
+    first = scene.drums[0].name
+    unit = _in(result, f"{first}_speed")
     _panel(ax[0], t, [(f"drum {d.name}", result[f"{d.name}_speed"]) for d in scene.drums],
-           "speed Ω [rad/s]", f"{name}: drum speeds [rad/s]")
+           "speed Ω" + unit, f"{name}: drum speeds{unit}")
     for a, d in zip(ax[1:], scene.drums, strict=True):
-        _panel(a, t, [(f"drum {d.name}", result[f"{d.name}_torque"] / 1e3)], "torque [kN m]",
-               f"drum {d.name}: drive torque [kN m]", lw=0.4)
+        unit = _in(result, f"{d.name}_torque", "k")
+        _panel(a, t, [(f"drum {d.name}", result[f"{d.name}_torque"] / 1e3)], "torque" + unit,
+               f"drum {d.name}: drive torque{unit}", lw=0.4)
         a.plot(*window_mean(t, result[f"{d.name}_torque"] / 1e3), color="k", lw=0.8,
                label="mean over 0.5 s")
         a.legend(fontsize=8, loc="upper left")
         a.axhline(0.0, color="k", lw=0.5)
-    ax[-1].set_xlabel("t [s]")
+    ax[-1].set_xlabel("t" + _in(result, "t"))
     paths.append(_save(fig, out / f"{stem}_drums.png"))
 
     # rolls: speed and radius
     fig, ax = _rows(2, 3.0)
+    speed = _in(result, f"{scene.rolls[0].name}_speed") if scene.rolls else ""
+    radius = _in(result, f"{scene.rolls[0].name}_radius") if scene.rolls else ""
     _panel(ax[0], t, [(f"roll {r.name}", result[f"{r.name}_speed"]) for r in scene.rolls]
            + [(f"rider {r.name}", result[f"{r.name}_speed"]) for r in scene.riders],
-           "speed ω [rad/s]", f"{name}: roll and rider speeds [rad/s]")
+           "speed ω" + speed, f"{name}: roll and rider speeds{speed}")
     _panel(ax[1], t, [(f"roll {r.name}", result[f"{r.name}_radius"]) for r in scene.rolls],
-           "radius r [m]", "paper roll radii [m]")
-    ax[1].set_xlabel("t [s]")
+           "radius r" + radius, "paper roll radii" + radius)
+    ax[1].set_xlabel("t" + _in(result, "t"))
     paths.append(_save(fig, out / f"{stem}_rolls.png"))
 
     # nips: one row per nip (same scale), then a close-up of the first opening
     forces = {n.name: result[f"{n.name}_normal_force"] for n in scene.nips}
+    kn = _in(result, f"{scene.nips[0].name}_normal_force", "k") if scene.nips else ""
     fig, axes = plt.subplots(len(forces) + 1, 1, figsize=(9, 3.2 + 2.3 * len(forces)),
                              squeeze=False)
     ax = axes[:, 0]
     for i, (n, f) in enumerate(forces.items()):
-        _panel(ax[i], t, [(nip_label[n], f / 1e3)], "F_n [kN]",
-               (f"{name}: nip normal forces [kN] (F_n = 0: nip open)\n" if i == 0 else "")
+        _panel(ax[i], t, [(nip_label[n], f / 1e3)], "F_n" + kn,
+               (f"{name}: nip normal forces{kn} (F_n = 0: nip open)\n" if i == 0 else "")
                + f"{nip_label[n]}: {np.mean(f <= 0.0):.1%} of samples open", lw=0.4,
                colors=[color[n]])
         tm, fm = window_mean(t, f / 1e3)
@@ -331,23 +361,23 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     top = max([float(np.max(f)) / 1e3 for f in forces.values()] + [0.0])
     for a in ax[:-1]:  # one scale, from 0 (nip open) to the largest force of any nip
         a.set_ylim(-0.04 * top - 1e-3, 1.06 * top + 1e-3)
-    ax[len(forces) - 1].set_xlabel("t [s]")
+    ax[len(forces) - 1].set_xlabel("t" + _in(result, "t"))
     opens = [(tt, n) for n, f in forces.items() if (tt := _first_open(t, f)) is not None]
     if opens:
         t_open, which = min(opens)
         w = (t >= t_open - 0.3) & (t <= t_open + 1.0)
-        title = f"close-up: first opening, {nip_label[which]} at t ≈ {t_open:.2f} s [kN]"
+        title = f"close-up: first opening, {nip_label[which]} at t ≈ {t_open:.2f} s{kn}"
     else:
         w = t <= min(t[-1], t[0] + 5.0)
-        title = "first 5 s [kN] (no nip opens in this run)"
-    _panel(ax[-1], t[w], [(nip_label[n], f[w] / 1e3) for n, f in forces.items()], "F_n [kN]",
+        title = f"first 5 s{kn} (no nip opens in this run)"
+    _panel(ax[-1], t[w], [(nip_label[n], f[w] / 1e3) for n, f in forces.items()], "F_n" + kn,
            title + f" (samples every {np.median(np.diff(t)) if len(t) > 1 else 0:g} s)",
            colors=[color[n] for n in forces])
     for line in ax[-1].get_lines():
         line.set_marker(".")
         line.set_markersize(3)
     ax[-1].legend(fontsize=7, loc="upper right", framealpha=0.9)
-    ax[-1].set_xlabel("t [s]")
+    ax[-1].set_xlabel("t" + _in(result, "t"))
     paths.append(_save(fig, out / f"{stem}_nip_forces.png"))
 
     # free coordinates of every body, one row each
@@ -359,27 +389,30 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
         i = 0
         for body, c in coords:
             y = result[f"{body}_{c}"]
-            _panel(ax[i], t, [(f"{body} {c}", y)], f"{c} [m]",
-                   (f"{name}: free coordinates [m]\n" if i == 0 else "")
-                   + f"{body}: {'horizontal' if c == 'x' else 'vertical'} position {c} [m]",
+            unit = _in(result, f"{body}_{c}")
+            _panel(ax[i], t, [(f"{body} {c}", y)], c + unit,
+                   (f"{name}: free coordinates{unit}\n" if i == 0 else "")
+                   + f"{body}: {'horizontal' if c == 'x' else 'vertical'} position {c}{unit}",
                    lw=0.5)
             i += 1
             if c == "z":  # the rise with the radius hides the bounce: show it apart
                 _panel(ax[i], t, [(f"{body} z − mean", 1e3 * (y - np.interp(
-                    t, *window_mean(t, y))))], "[mm]",
-                    f"{body}: bounce, z less its mean over 0.5 s [mm]", lw=0.4)
+                    t, *window_mean(t, y))))], _in(result, f"{body}_z", "m").strip(),
+                    f"{body}: bounce, z less its mean over 0.5 s"
+                    + _in(result, f"{body}_z", "m"), lw=0.4)
                 i += 1
-        ax[-1].set_xlabel("t [s]")
+        ax[-1].set_xlabel("t" + _in(result, "t"))
         paths.append(_save(fig, out / f"{stem}_positions.png"))
 
     # slip velocities, one row per nip
     fig, ax = _rows(len(scene.nips))
     for i, n in enumerate(scene.nips):
+        unit = _in(result, f"{n.name}_slip_velocity")
         _panel(ax[i], t, [(nip_label[n.name], result[f"{n.name}_slip_velocity"])],
-               "slip [m/s]", (f"{name}: nip slip velocities [m/s]\n" if i == 0 else "")
+               "slip" + unit, (f"{name}: nip slip velocities{unit}\n" if i == 0 else "")
                + nip_label[n.name], lw=0.4, colors=[color[n.name]])
         ax[i].axhline(0.0, color="k", lw=0.5)
-    ax[-1].set_xlabel("t [s]")
+    ax[-1].set_xlabel("t" + _in(result, "t"))
     paths.append(_save(fig, out / f"{stem}_slip.png"))
     spans = [w for w in scene.webs if w.span is not None]
     for w in spans:  # one figure per span: STEM_span.png, or STEM_WEB_span.png
@@ -402,25 +435,29 @@ def _span_figure(result: Result, scene: Scene, web: WebPart, pre: str, path: Pat
     wound = [r for r in scene.rolls if r.name == entry.b]
     error = f"{pre}tension_error"
     fig, ax = _rows(4 if error in result else 3)
-    _panel(ax[0], t, [("span tension", result[f"{pre}span_tension"])], "T [N]",
-           f"{name}: web span tension [N] (EA = {span.EA:.3g} N, L = {span.length:g} m)",
+    unit = _in(result, f"{pre}span_tension")
+    _panel(ax[0], t, [("span tension", result[f"{pre}span_tension"])], "T" + unit,
+           f"{name}: web span tension{unit} (EA = {span.EA:.3g} N, L = {span.length:g} m)",
            lw=0.6)
     rows = 1
     if error in result:
-        _panel(ax[1], t, [("set-point − T", result[error])], "error [N]",
-               f"tension error of the unwind's controller [N]: peak "
+        unit = _in(result, error)
+        _panel(ax[1], t, [("set-point − T", result[error])], "error" + unit,
+               f"tension error of the unwind's controller{unit}: peak "
                f"{np.max(np.abs(result[error])):.3g} N, RMS "
                f"{np.sqrt(np.mean(result[error] ** 2)):.3g} N", lw=0.6)
         ax[1].axhline(0.0, color="k", lw=0.5)
         rows = 2
+    unit = _in(result, f"{unwind.name}_torque", "k")
     _panel(ax[rows], t, [(f"roll {unwind.name}", result[f"{unwind.name}_torque"] / 1e3)],
-           "torque [kN m]", f"unwind torque of {unwind.name} [kN m] (negative: braking)",
+           "torque" + unit, f"unwind torque of {unwind.name}{unit} (negative: braking)",
            lw=0.6)
     ax[rows].axhline(0.0, color="k", lw=0.5)
+    unit = _in(result, f"{unwind.name}_radius")
     _panel(ax[rows + 1], t, [(f"roll {r.name}", result[f"{r.name}_radius"])
-                             for r in [unwind, *wound]], "radius r [m]",
-           "radii of the unwinding and the wound rolls [m]")
-    ax[-1].set_xlabel("t [s]")
+                             for r in [unwind, *wound]], "radius r" + unit,
+           "radii of the unwinding and the wound rolls" + unit)
+    ax[-1].set_xlabel("t" + _in(result, "t"))
     return _save(fig, path)
 
 
@@ -514,7 +551,8 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
             b.axvline(rc, color="C3", lw=0.8, alpha=0.5)
         if len(pairs) > 1:
             b.legend(fontsize=8, loc="upper right")
-        b.set_ylabel("normal force envelope [kN]")
+        b.set_ylabel("normal force envelope"
+                     + _in(result, next(iter(pairs.values()))[0], "k"))
         b.grid(alpha=0.3)
         b.set_title("simulated nip normal force (min-max over 0.5 s)", fontsize=10)
     if len(r) > 1:  # the map's radii (--radius-min/max), the envelope too where it is longer

@@ -1,13 +1,16 @@
-"""Compiled integrators over generated machines: adaptive Dormand–Prince 5(4) with located
-mode switches, and classical fixed-step RK4.
+"""What the compiled integrators share: the locked modes of a generated machine, their
+located switches, the penetration guard, the status codes and the call of the generated
+functions. The integrators are :func:`~winder.solve.dopri5.dopri5` (adaptive
+Dormand–Prince 5(4), :mod:`winder.solve.dopri5`), :func:`~winder.solve.rk4.rk4`
+(classical fixed-step RK4, :mod:`winder.solve.rk4`) and
+:func:`~winder.solve.rosenbrock.ros2` (:mod:`winder.solve.rosenbrock`).
 
-``dopri5`` is Hairer's DOPRI5 (tableau, error estimate, 4th-order dense output and step
-control of ``scipy``'s RK45) with the machine's *locked modes*: per nip the contact mode
-(touching or not) and per wound roll the core mode of spec §2 stay fixed within a step.
-When an accepted step ends on the other side of a switching function, the crossing is
-located on the step's dense output (Illinois method, to ~1e-12 s), the step is cut there
-and the integration restarts in the new mode. The discontinuity of a damped normal force
-at touch-down and the kink at lift-off never fall inside a step. A roll unwinding to its
+The *locked modes*: per nip the contact mode (touching or not) and per wound roll the core
+mode of spec §2 stay fixed within a step. When an accepted step ends on the other side of
+a switching function, the crossing is located on the step's dense output (Illinois
+method, to ~1e-12 s; :func:`sample_and_switch`), the step is cut there and the
+integration restarts in the new mode. The discontinuity of a damped normal force at
+touch-down and the kink at lift-off never fall inside a step. A roll unwinding to its
 core lands exactly on ``r_c``.
 
 The machine's functions are called through their addresses (:mod:`winder.model.ccall`):
@@ -20,11 +23,11 @@ and param),
 zero the roll has run out of web, the radius lands on ``r_c`` and the integration stops
 with :data:`EXHAUSTED`).
 
-Both functions integrate ``y`` in place, write samples at output times into a caller's
-array and keep counters in ``stats = [nfev, accepted, rejected, events, stiff steps]``.
-Status codes: :data:`DONE`, :data:`PAUSED` (the evaluation budget of this call is spent;
-call again to resume), :data:`STEP_UNDERFLOW`, :data:`NON_FINITE`, :data:`EXHAUSTED`,
-:data:`PENETRATED`.
+Every integrator integrates ``y`` in place, writes samples at output times into a
+caller's array and keeps counters in ``stats = [nfev, accepted, rejected, events, stiff
+steps]``. Status codes: :data:`DONE`, :data:`PAUSED` (the evaluation budget of this call
+is spent; call again to resume), :data:`STEP_UNDERFLOW`, :data:`NON_FINITE`,
+:data:`EXHAUSTED`, :data:`PENETRATED`.
 
 The guard of every accepted step (:func:`guard_step`: DOPRI5 and ROS2 in
 :func:`sample_and_switch`, RK4 after its non-finite check): where a nip's guard function
@@ -34,8 +37,7 @@ step (from its start to its end) takes it there (a step that jumps through the o
 body), the first crossing of the bound is located, ``y`` moves there and the integration
 stops with :data:`PENETRATED`: one body's axis inside the other means the integrator lost
 the contact (a step or tolerance far too coarse for the nip), and every later number
-would be wrong.
-"""
+would be wrong."""
 
 from __future__ import annotations
 
@@ -47,7 +49,7 @@ from winder.model.ccall import call
 from winder.model.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
 from winder.solve._jit import njit
 
-__all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "switch_buffer", "first_step",
+__all__ = ["modes_of", "evaluate", "switches", "switch_buffer", "first_step",
            "sample_and_switch", "DONE", "PAUSED",
            "STEP_UNDERFLOW", "NON_FINITE", "EXHAUSTED", "PENETRATED", "CHUNK",
            "TIME_RESOLUTION", "beyond_bound", "guard_step",
@@ -64,20 +66,6 @@ F_RHS, F_JAC, F_OUT, F_SW = 0, 1, 2, 3
 TIME_RESOLUTION = 1e-14
 #: Evaluations per call of a caller that checks its budgets between calls (20–40 ms).
 CHUNK = 200_000
-
-# Dormand–Prince 5(4) tableau
-C2, C3, C4, C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
-A21 = 1 / 5
-A31, A32 = 3 / 40, 9 / 40
-A41, A42, A43 = 44 / 45, -56 / 15, 32 / 9
-A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
-A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
-A71, A73, A74, A75, A76 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
-E1, E3, E4, E5, E6, E7 = (71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525,
-                          -1 / 40)
-D1, D3, D4 = -12715105075 / 11282082432, 87487479700 / 32700410799, -10690763975 / 1880347072
-D5, D6, D7 = 701980252875 / 199316789632, -1453857185 / 822651844, 69997945 / 29380423
-
 
 @njit
 def evaluate(fns: np.ndarray, which: int, tb: np.ndarray, t: float, y: np.ndarray,
@@ -411,250 +399,3 @@ def sample_and_switch(fns: np.ndarray, table: np.ndarray, rc: np.ndarray, t: flo
         if new_mode == END or (table[slot, 0] == K_CORE and new_mode == AT_CORE):
             y[table[slot, 3]] = p[table[slot, 4]]  # land exactly on the core
     return slot, new_mode, t_end, k
-
-
-@njit
-def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
-           p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
-           max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
-           stats: np.ndarray) -> tuple[int, float, float, int]:
-    """Integrate ``y`` from ``t0`` to ``t1``. Samples at ``t_out[k:]`` up to ``t1`` go to
-    the columns of ``Y_out``. ``h <= 0`` picks the first step. Stops after ``budget``
-    evaluations with :data:`PAUSED`. Modes ``m`` start from the state (:func:`modes_of`)
-    and switch at located events. Returns ``(status, t, h, k)``."""
-    n = y.shape[0]
-    k1, k2, k3, k4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    k5, k6, k7 = np.empty(n), np.empty(n), np.empty(n)
-    yt, y1 = np.empty(n), np.empty(n)
-    rc = np.empty((5, n))
-    tb = np.empty(1)
-    g, g0 = switch_buffer(table), switch_buffer(table)
-    t = t0
-    modes_of(fns, table, tb, t, y, p, m, g, False)
-    evaluate(fns, F_RHS, tb, t, y, p, m, k1)
-    nfev = 1
-    if h <= 0.0:
-        h = first_step(y, k1, rtol, atol)
-    rejected_last = False
-    status = DONE
-    while t < t1:
-        if nfev >= budget:
-            status = PAUSED
-            break
-        hh = min(h, max_step)
-        if t + 1.01 * hh >= t1:
-            hh = t1 - t
-            if hh < TIME_RESOLUTION * max(1.0, abs(t)):  # a sliver is left
-                k = _sliver(t, t1, y, k1, t_out, Y_out, k)
-                t = t1
-                break
-        if hh < TIME_RESOLUTION * max(1.0, abs(t)):
-            status = STEP_UNDERFLOW
-            break
-        for i in range(n):
-            yt[i] = y[i] + hh * A21 * k1[i]
-        evaluate(fns, F_RHS, tb, t + C2 * hh, yt, p, m, k2)
-        for i in range(n):
-            yt[i] = y[i] + hh * (A31 * k1[i] + A32 * k2[i])
-        evaluate(fns, F_RHS, tb, t + C3 * hh, yt, p, m, k3)
-        for i in range(n):
-            yt[i] = y[i] + hh * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-        evaluate(fns, F_RHS, tb, t + C4 * hh, yt, p, m, k4)
-        for i in range(n):
-            yt[i] = y[i] + hh * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-        evaluate(fns, F_RHS, tb, t + C5 * hh, yt, p, m, k5)
-        for i in range(n):
-            yt[i] = y[i] + hh * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
-                                 + A65 * k5[i])
-        evaluate(fns, F_RHS, tb, t + hh, yt, p, m, k6)
-        for i in range(n):
-            y1[i] = y[i] + hh * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i]
-                                 + A76 * k6[i])
-        evaluate(fns, F_RHS, tb, t + hh, y1, p, m, k7)
-        nfev += 6
-        err = 0.0
-        for i in range(n):
-            sk = atol + rtol * max(abs(y[i]), abs(y1[i]))
-            ei = hh * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i]
-                       + E7 * k7[i])
-            err += (ei / sk) ** 2
-        err = math.sqrt(err / n)
-        if not math.isfinite(err):
-            stats[2] += 1
-            h = 0.1 * hh
-            if h < 1e-14 * max(1.0, abs(t)):
-                status = NON_FINITE
-                break
-            rejected_last = True
-            continue
-        if err > 1.0:
-            stats[2] += 1
-            h = hh * max(0.2, 0.9 * err ** -0.2)
-            rejected_last = True
-            continue
-        # accepted. Stiffness test of Hairer's DOPRI5: h·|λ| from the last two stages
-        if stats.shape[0] > 4:
-            stnum = stden = 0.0
-            for i in range(n):
-                stnum += (k7[i] - k6[i]) ** 2
-                stden += (y1[i] - yt[i]) ** 2
-            if stden > 0.0 and hh * hh * stnum > 3.25 ** 2 * stden:
-                stats[4] += 1
-        for i in range(n):  # dense output coefficients
-            dyi = y1[i] - y[i]
-            bspl = hh * k1[i] - dyi
-            rc[0, i] = y[i]
-            rc[1, i] = dyi
-            rc[2, i] = bspl
-            rc[3, i] = dyi - hh * k7[i] - bspl
-            rc[4, i] = hh * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i]
-                             + D7 * k7[i])
-        slot, new_mode, t_end, k = sample_and_switch(fns, table, rc, t, hh, t1, tb, p, m, y,
-                                                     y1, yt, g, g0, t_out, Y_out, k)
-        stats[1] += 1
-        if slot == GUARD:  # a nip beyond its penetration bound: stop at the crossing
-            t = t_end
-            status = PENETRATED
-            break
-        if slot >= 0:  # event: restart at the crossing in the new mode
-            t = t_end
-            if new_mode == END:
-                status = EXHAUSTED
-                break
-            m[slot] = new_mode
-            evaluate(fns, F_RHS, tb, t, y, p, m, k1)
-            nfev += 1
-            stats[3] += 1
-            h = hh
-            rejected_last = False
-            continue
-        for i in range(n):
-            y[i] = y1[i]
-            k1[i] = k7[i]
-        t = t + hh if t + hh < t1 else t1
-        fac = 0.9 * max(err, 1e-10) ** -0.2
-        fac = min(fac, 1.0) if rejected_last else min(fac, 10.0)
-        h = hh * max(0.2, fac)
-        rejected_last = False
-    stats[0] += nfev
-    return status, t, h, k
-
-
-@njit
-def _hermite(y0: np.ndarray, f0: np.ndarray, y1: np.ndarray, f1: np.ndarray, h: float,
-             s: float, out: np.ndarray) -> None:
-    """Cubic Hermite interpolant of a step of length ``h`` at ``s`` in ``[0, 1]``."""
-    h00, h10 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s
-    h01, h11 = -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2
-    for i in range(out.shape[0]):
-        out[i] = h00 * y0[i] + h10 * h * f0[i] + h01 * y1[i] + h11 * h * f1[i]
-
-
-@njit
-def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
-        p: np.ndarray, m: np.ndarray, h: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
-        stats: np.ndarray) -> tuple[int, float, float, int]:
-    """Classical RK4 with steps of at most ``h`` evenly dividing ``[t0, t1]`` (the clamped
-    nip law, no contact event location: for real-time stepping). The core events of
-    spec §2 are located on the step's cubic Hermite interpolant; the step is cut there
-    and the rest of the interval divided again. Samples by the same interpolant.
-    Returns ``(status, t, h, k)``."""
-    n = y.shape[0]
-    k1, k2, k3, k4 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    yt, y1 = np.empty(n), np.empty(n)
-    rc = np.empty((5, n))
-    tb = np.empty(1)
-    g, g0 = switch_buffer(table), switch_buffer(table)
-    modes_of(fns, table, tb, t0, y, p, m, g, True)
-    evaluate(fns, F_RHS, tb, t0, y, p, m, k1)
-    nfev = 1
-    t = t0
-    hh = h
-    status = DONE
-    while t < t1 and status == DONE:
-        if t1 - t < TIME_RESOLUTION * max(1.0, abs(t)):
-            k = _sliver(t, t1, y, k1, t_out, Y_out, k)
-            t = t1
-            break
-        steps = max(1, int(math.ceil((t1 - t) / h - 1e-9)))
-        ts = t
-        hh = (t1 - ts) / steps
-        for j in range(steps):
-            tn = t1 if j == steps - 1 else ts + (j + 1) * hh
-            hs = tn - t
-            for i in range(n):
-                yt[i] = y[i] + 0.5 * hs * k1[i]
-            evaluate(fns, F_RHS, tb, t + 0.5 * hs, yt, p, m, k2)
-            for i in range(n):
-                yt[i] = y[i] + 0.5 * hs * k2[i]
-            evaluate(fns, F_RHS, tb, t + 0.5 * hs, yt, p, m, k3)
-            for i in range(n):
-                yt[i] = y[i] + hs * k3[i]
-            evaluate(fns, F_RHS, tb, t + hs, yt, p, m, k4)
-            for i in range(n):
-                y1[i] = y[i] + hs / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            evaluate(fns, F_RHS, tb, tn, y1, p, m, k2)  # f at the step end (next k1)
-            nfev += 4
-            stats[1] += 1
-            ok = True
-            for i in range(n):
-                if not math.isfinite(y1[i]):
-                    ok = False
-            if not ok:
-                status = NON_FINITE
-                break
-            # core events (spec §2): first point of the interpolant on the new side
-            _, slot, new_mode = _next_event(fns, table, np.empty((5, n)), t, hs, tb, p, m,
-                                            y1, yt, g, False)
-            theta = 1.0
-            if slot >= 0:
-                gi = table[slot, 1] if new_mode in (AT_CORE, END) else table[slot, 2]
-                ta, tb_ = 0.0, 1.0
-                for _ in range(60):
-                    th = 0.5 * (ta + tb_)
-                    _hermite(y, k1, y1, k2, hs, th, yt)
-                    if _switch_at(fns, gi, tb, t + th * hs, yt, p, m, g) > 0.0:
-                        tb_ = th
-                    else:
-                        ta = th
-                theta = tb_
-            for i in range(n):  # the step's cubic Hermite in DOPRI5's dense form
-                rc[0, i] = y[i]
-                rc[1, i] = y1[i] - y[i]
-                rc[2, i] = hs * k1[i] - rc[1, i]
-                rc[3, i] = rc[1, i] - hs * k2[i] - rc[2, i]
-                rc[4, i] = 0.0
-            theta_guard = guard_step(fns, table, rc, t, hs, theta, tb, p, m, y, y1, yt, g,
-                                     g0, t_out, k, slot < 0)
-            if theta_guard <= theta:  # stopped where the first nip crosses its bound
-                t = t + theta_guard * hs
-                status = PENETRATED
-                break
-            t_end = t + theta * hs
-            while k < t_out.shape[0] and t_out[k] <= t_end + 1e-13 * max(1.0, abs(t_end)):
-                _hermite(y, k1, y1, k2, hs, min(theta, max(0.0, (t_out[k] - t) / hs)), yt)
-                for i in range(n):
-                    Y_out[i, k] = yt[i]
-                k += 1
-            if slot < 0:
-                for i in range(n):
-                    y[i] = y1[i]
-                    k1[i] = k2[i]
-                t = tn
-                continue
-            _hermite(y, k1, y1, k2, hs, theta, yt)
-            for i in range(n):
-                y[i] = yt[i]
-            if new_mode in (AT_CORE, END):
-                y[table[slot, 3]] = p[table[slot, 4]]  # land exactly on the core
-            t = t_end if theta < 1.0 else tn
-            if new_mode == END:
-                status = EXHAUSTED
-                break
-            m[slot] = new_mode
-            evaluate(fns, F_RHS, tb, t, y, p, m, k1)
-            nfev += 1
-            stats[3] += 1
-            break  # divide the rest of the interval again
-    stats[0] += nfev
-    return status, t, hh, k

@@ -4,7 +4,7 @@
 L-stable, order 2 with an order-3 error estimate; each step costs one Jacobian, one LU
 of ``W = I − h d J`` and three right-hand sides (``d = 1/(2 + √2)``). The time derivative
 of the right-hand side (the drive's ramp) is a forward difference. The locked modes and
-their located switches are those of :func:`winder.solve.integrators.dopri5`: the step's
+their located switches are those of :func:`winder.solve.dopri5.dopri5`: the step's
 interpolant ``y + h θ(1−θ)/(1−2d) k1 + h θ(θ−2d)/(1−2d) k2`` is written in DOPRI5's
 dense-output form, so event location is shared.
 """
@@ -92,7 +92,7 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
          t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
          stats: np.ndarray) -> tuple[int, float, float, int]:
     """Integrate ``y`` from ``t0`` to ``t1`` (arguments and results as
-    :func:`~winder.solve.integrators.dopri5`; ``stats[4]`` counts Jacobians)."""
+    :func:`~winder.solve.dopri5.dopri5`; ``stats[4]`` counts Jacobians)."""
     n = y.shape[0]
     f0, f1, f2 = np.empty(n), np.empty(n), np.empty(n)
     k1, k2, k3 = np.empty(n), np.empty(n), np.empty(n)

@@ -4,32 +4,28 @@ progress."""
 from __future__ import annotations
 
 import math
-import numbers
 import os
 import time
-from collections.abc import Callable
 from types import MappingProxyType
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
-from winder._args import ATOL_MAX, RTOL_MAX, show
-from winder._errors import (
-    ArgumentError,
-    ArgumentTypeError,
-    BudgetExceeded,
-    SimulationError,
-    state_text,
-)
+from winder._args import real_argument
+from winder._errors import ArgumentError, ArgumentTypeError, SimulationError
 from winder.io.result import Result
 from winder.model.machine import CORE_AUTO
 from winder.scene.load import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
 from winder.solve import integrators as integ
+from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances
+from winder.solve.dopri5 import dopri5
+from winder.solve.rk4 import rk4
 from winder.solve.rosenbrock import ros2
+from winder.solve.stepwise import run_stepwise
 from winder.solve.system import MachineSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
-           "check_real", "check_tolerances", "check_budgets", "budget_error"]
+           "check_tolerances", "check_budgets", "budget_error"]
 
 #: What ``method="auto"`` picks (chosen from the work–precision study, docs/), per backend.
 DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
@@ -37,51 +33,12 @@ DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
 #: of :mod:`winder.solve.rosenbrock` (stiff machines, exact Jacobian).
 COMPILED_METHODS = ("DOPRI5", "ROS2")
 #: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
-_WALL_EVERY = 256  # evaluations between wall-clock checks on the Python paths
-_STEP_OVER = 1e-6  # [s] integrated without contact events after a grazing contact
 #: Jacobians for scipy's implicit methods: ``exact`` (generated; ``pinocchio`` is its old
 #: name) or ``fd`` (the integrator's finite differences).
 JACOBIANS = ("exact", "fd", "pinocchio")
 
 
 # ---- arguments ----------------------------------------------------------------------
-
-def check_real(name: str, value: Any, ok: Callable[[float], bool], valid: str) -> float:
-    """``value`` as a float if it is a real number with ``ok(value)``; else
-    :class:`~winder.ArgumentTypeError` (not a number) or :class:`~winder.ArgumentError`
-    naming ``name``, the value and ``valid`` (the valid range, in words)."""
-    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
-        raise ArgumentTypeError(f"{name} must be a real number ({valid}), got {value!r} of "
-                                f"type {type(value).__name__}")
-    try:
-        v = float(value)
-    except OverflowError:  # an integer beyond the float range
-        v = math.inf if value > 0 else -math.inf
-    if not ok(v):
-        raise ArgumentError(f"{name} = {show(value)} is out of range; valid: {valid}")
-    return v
-
-
-def check_tolerances(rtol: Any, atol: Any) -> tuple[float, float]:
-    """Validated ``(rtol, atol)``: rtol finite in ``(0, RTOL_MAX]``, atol finite in
-    ``(0, ATOL_MAX]``."""
-    r = check_real("rtol", rtol, lambda v: math.isfinite(v) and 0.0 < v <= RTOL_MAX,
-                   f"finite, > 0 and <= {RTOL_MAX:g} (a relative tolerance, e.g. 1e-6)")
-    a = check_real("atol", atol, lambda v: math.isfinite(v) and 0.0 < v <= ATOL_MAX,
-                   f"finite, > 0 and <= {ATOL_MAX:g} (an absolute tolerance in state units "
-                   "[m, rad, N], e.g. 1e-8)")
-    return r, a
-
-
-def check_budgets(max_rhs: Any, max_wall: Any) -> tuple[int, float]:
-    """Validated ``(max_rhs, max_wall)``: a whole number of evaluations ``>= 1`` and a wall
-    time ``> 0`` [s] (``inf`` for none)."""
-    n = check_real("max_rhs", max_rhs, lambda v: math.isfinite(v) and v >= 1 and v == int(v),
-                   "a whole number >= 1 (right-hand side evaluations)")
-    w = check_real("max_wall", max_wall, lambda v: v > 0.0,
-                   "> 0 (wall-clock seconds; inf for no limit)")
-    return int(n), w
-
 
 def _check_choice(name: str, value: Any, valid: tuple[str, ...]) -> str:
     if not isinstance(value, str):
@@ -141,118 +98,6 @@ def _output_grid(t_s: float, T: float, dt: float, t_key: str, dt_key: str) -> np
     return t_out
 
 
-class _Bar(Protocol):
-    """A progress bar (:class:`winder.io.progress.Progress`)."""
-
-    def update(self, t: float) -> None: ...
-
-    def close(self) -> None: ...
-
-
-# ---- progress and budgets -------------------------------------------------------------
-
-#: How to raise each budget, from :func:`~winder.simulate` (``how`` of :func:`budget_error`).
-RAISE_SIMULATE = {"max_rhs": "simulate(max_rhs=...), [solver] max_rhs, or --max-evals on the "
-                             "command line",
-                  "max_wall": "simulate(max_wall=...), [solver] max_wall, or --max-wall on "
-                              "the command line"}
-
-
-def budget_error(kind: str, limit: float, *, meth: str, t: float, t_start: float,
-                 t_end: float, step: float | None, steps: int, stiff_steps: int | None,
-                 nfev: int, wall: float, state: dict[str, float],
-                 partial: Result | None = None, how: dict[str, str] = RAISE_SIMULATE,
-                 alternatives: str = "method='Radau' or 'LSODA'") -> BudgetExceeded:
-    """The :class:`~winder.BudgetExceeded` of a run that reached its budget ``kind``
-    (``max_rhs`` or ``max_wall``) at ``t`` [s], naming the time, the last step [s] and the
-    state, and saying which of three it is:
-
-    - the step size collapsed (last step below 1e-3 of the mean step so far, or no
-      progress): stiff or discontinuous here;
-    - stiff: over a quarter of the accepted steps (``stiff_steps`` of ``steps``) at the
-      stability limit (DOPRI5's stiffness test), with the projection below;
-    - merely long: steady steps; the evaluations and wall time to reach ``t_end`` at the
-      current rate.
-    """
-    name = "evaluation" if kind == "max_rhs" else "wall-clock"
-    value = f"{int(limit)} evaluations" if kind == "max_rhs" else f"{limit:g} s"
-    raise_it = f"raise {kind} ({how[kind]})"
-    span, done = t_end - t_start, t - t_start
-    where = state_text(state)
-    h = f"{step:.3g} s" if step is not None else "none yet"
-    msg = (f"{name} budget {kind} = {value} reached at t = {t:.6g} s of t_end = {t_end:g} s "
-           f"with method {meth!r} after {nfev} evaluations and {wall:.3g} s (last step {h}; "
-           f"state: {where}). ")
-    mean_step = done / steps if steps else 0.0
-    projection = ""
-    if done > 0.0:
-        projection = (f"at the current rate it needs about {nfev * span / done:.3g} "
-                      f"evaluations and {wall * span / done:.3g} s in all to reach t_end")
-    if done <= 0.0 or step is None or step < 1e-3 * mean_step:
-        msg += (f"The step size collapsed (last step {h}, mean step {mean_step:.3g} s): the "
-                f"problem is stiff or discontinuous near t = {t:.6g} s for this method; try "
-                f"{alternatives}, a looser rtol, or check the scene there; or {raise_it}.")
-    elif stiff_steps is not None and steps and stiff_steps > 0.25 * steps:
-        msg += (f"The problem is stiff for {meth!r}: {100 * stiff_steps / steps:.0f} % of "
-                f"its steps (mean {mean_step:.3g} s) are limited by stability, not accuracy; "
-                f"{projection}. Try {alternatives}, or {raise_it}.")
-    else:
-        msg += (f"The run is long, not stiff (steady steps, mean {mean_step:.3g} s): "
-                f"{projection}; {raise_it}.")
-    if partial is not None:
-        msg += f" The samples up to t = {partial.t[-1]:.6g} s are in .partial."
-    return BudgetExceeded(msg, time=t, state=state, step=step, partial=partial)
-
-
-class _Stop(Exception):
-    """Raised inside the right-hand side when a budget is spent (Python paths)."""
-
-    def __init__(self, kind: str) -> None:
-        super().__init__(kind)
-        self.kind = kind
-
-
-class _Guards:
-    """The run's budgets (evaluations ``max_rhs``, wall clock ``max_wall``) and progress,
-    shared by the scipy and the compiled paths."""
-
-    def __init__(self, names: tuple[str, ...], meth: str, *, limit: int, max_wall: float,
-                 bar: _Bar | None, t_start: float, t_end: float) -> None:
-        self.names, self.meth = names, meth
-        self.limit, self.max_wall, self.bar = limit, max_wall, bar
-        self.t_start, self.t_end = t_start, t_end
-        self.wall0 = time.perf_counter()
-        self.steps = 0
-        self.stiff_steps: int | None = None  # known for the compiled DOPRI5
-
-    def state(self, y: np.ndarray) -> dict[str, float]:
-        return dict(zip(self.names, map(float, y), strict=True))
-
-    def error(self, msg: str, t: float, y: np.ndarray) -> SimulationError:
-        state = self.state(y)
-        return SimulationError(f"{msg} at t = {t:.6g} s (state: {state_text(state)})", time=t,
-                               state=state)
-
-    def wall_spent(self) -> bool:
-        return time.perf_counter() - self.wall0 > self.max_wall
-
-    def tick(self, t: float) -> None:
-        """Progress and the wall clock (call after each step or chunk)."""
-        if self.bar is not None:
-            self.bar.update(t)
-        if self.wall_spent():
-            raise _Stop("max_wall")
-
-    def exceeded(self, kind: str, t: float, y: np.ndarray, step: float | None, nfev: int,
-                 partial: Result | None) -> BudgetExceeded:
-        limit = self.limit if kind == "max_rhs" else self.max_wall
-        return budget_error(kind, limit, meth=self.meth, t=t, t_start=self.t_start,
-                            t_end=self.t_end, step=step, steps=self.steps,
-                            stiff_steps=self.stiff_steps, nfev=nfev,
-                            wall=time.perf_counter() - self.wall0, state=self.state(y),
-                            partial=partial)
-
-
 # ---- the compiled paths ----------------------------------------------------------------
 
 def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.ndarray,
@@ -273,7 +118,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
             if budget <= 0:
                 raise _Stop("max_rhs")
             if meth in COMPILED_METHODS:
-                run = integ.dopri5 if meth == "DOPRI5" else ros2
+                run = dopri5 if meth == "DOPRI5" else ros2
                 status, t, h, k = run(fns, table, t, tb, y, p, modes, rtol, atol, h, hmax,
                                       t_out, Ys, k, budget, stats)
             else:  # RK4: chunks of budget/4 steps
@@ -281,7 +126,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
                 t_next = min(tb, t + step * budget / 4)
                 if tb - t_next < 1e-9 * step:
                     t_next = tb
-                status, t, h, k = integ.rk4(fns, table, t, t_next, y, p, modes, step, t_out,
+                status, t, h, k = rk4(fns, table, t, t_next, y, p, modes, step, t_out,
                                             Ys, k, stats)
             at[:] = [t, h, k]
             guards.steps = int(stats[1])
@@ -365,16 +210,16 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                                       scene.solver.max_wall if max_wall is None else max_wall)
     positive = "finite and > 0 [s]"
     t_key = "[scene] duration" if t_end is None else "t_end"
-    T = check_real(t_key, scene.scene.duration if t_end is None else t_end,
-                   lambda v: math.isfinite(v) and v > 0.0, positive)
+    T = real_argument(t_key, scene.scene.duration if t_end is None else t_end,
+                      lambda v: math.isfinite(v) and v > 0.0, positive)
     dt_key = "[scene] output_step" if output_step is None else "output_step"
-    dt = check_real(dt_key, scene.scene.output_step if output_step is None else output_step,
-                    lambda v: math.isfinite(v) and v > 0.0, positive)
+    dt = real_argument(dt_key, scene.scene.output_step if output_step is None else output_step,
+                       lambda v: math.isfinite(v) and v > 0.0, positive)
     if max_step is not None:
-        max_step = check_real("max_step", max_step, lambda v: math.isfinite(v) and v > 0.0,
-                              positive)
-    t_s = check_real("t_start", t_start, lambda v: math.isfinite(v) and 0.0 <= v < T,
-                     f"finite, >= 0 and < {t_key} = {T:g} [s]")
+        max_step = real_argument("max_step", max_step, lambda v: math.isfinite(v) and v > 0.0,
+                                 positive)
+    t_s = real_argument("t_start", t_start, lambda v: math.isfinite(v) and 0.0 <= v < T,
+                        f"finite, >= 0 and < {t_key} = {T:g} [s]")
     t_out = _output_grid(t_s, T, dt, t_key, dt_key)
     system = MachineSystem(scene, backend=be)
     if initial_state is None:
@@ -413,8 +258,6 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                                        max_step, guards, stats, at)
                 system.nfev, n_events = int(stats[0]), int(stats[3])
             else:
-                from winder.solve.stepwise import run_stepwise
-
                 filled, n_events = run_stepwise(system, meth, y0, t_s, t_out, Ys, breaks,
                                                 rtol, atol, max_step, events, jacobian, guards)
         except _Stop as stop:
@@ -431,7 +274,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                 wall = time.perf_counter() - guards.wall0
                 partial = Result(system.channels(t_out[:filled], Ys[:, :filled]),
                                  _meta(scene, system, meth, rtol, atol, wall, 0, t_s, T,
-                                       partial=True))
+                                       partial=True), units=system.channel_units)
             if bar is not None:
                 bar.update(t_at)
             raise guards.exceeded(stop.kind, t_at, y_at, h_at, system.nfev,
@@ -457,7 +300,8 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
     if bad:
         raise SimulationError(f"non-finite values in result channels {bad}")
-    return Result(channels, _meta(scene, system, meth, rtol, atol, wall, n_events, t_s, T))
+    return Result(channels, _meta(scene, system, meth, rtol, atol, wall, n_events, t_s, T),
+                  units=system.channel_units)
 
 
 def _meta(scene: Scene, system: MachineSystem, meth: str, rtol: float, atol: float,

@@ -9,17 +9,14 @@ from typing import Any
 
 import numpy as np
 
+from winder._args import real_argument
 from winder._errors import ArgumentError, SimulationError, state_text
 from winder.io.result import Result
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
-from winder.solve.simulate import (
-    _as_scene,
-    budget_error,
-    check_budgets,
-    check_real,
-    check_tolerances,
-)
+from winder.solve.budgets import budget_error, check_budgets, check_tolerances
+from winder.solve.dopri5 import dopri5
+from winder.solve.simulate import _as_scene
 from winder.solve.system import LEGACY_CHANNELS, MachineSystem
 
 __all__ = ["Stepper", "INPUTS", "OUTPUTS", "inputs_of", "outputs_of"]
@@ -125,9 +122,9 @@ class Stepper:
         if self.inputs[name] not in self.system.machine.param_names:
             raise ArgumentError(f"{name} is an input only with [drum.drive] kind = 'torque'; "
                                 "this scene prescribes the drum speed")
-        v = check_real(name, value, math.isfinite,
-                       "a finite number [N]" if name.endswith("setpoint") else
-                       "a finite number [N·m]")
+        v = real_argument(name, value, math.isfinite,
+                          "a finite number [N]" if name.endswith("setpoint") else
+                          "a finite number [N·m]")
         self.system.set_input(self.inputs[name], v)
         self._outputs = None
 
@@ -150,9 +147,9 @@ class Stepper:
             raise SimulationError(f"the run has ended: {self.ended}", time=self.t,
                                   state=self.state)
         resolution = integ.TIME_RESOLUTION * max(1.0, abs(self.t))
-        dt = check_real("dt", dt, lambda v: math.isfinite(v) and v >= resolution,
-                        f"finite and >= {resolution:.3g} s (the time resolution at t = "
-                        f"{self.t:.6g} s, 1e-14·max(1 s, |t|))")
+        dt = real_argument("dt", dt, lambda v: math.isfinite(v) and v >= resolution,
+                           f"finite and >= {resolution:.3g} s (the time resolution at t = "
+                           f"{self.t:.6g} s, 1e-14·max(1 s, |t|))")
         t_start, t_end = self.t, self.t + dt
         stops = [b for b in self._breaks if self.t < b < t_end] + [t_end]
         empty_t, empty_y = np.empty(0), np.empty((len(self.y), 0))
@@ -167,7 +164,7 @@ class Stepper:
                 if over is not None:
                     raise self._over(over, t_start, t_end, spent, steps0, stiff0, wall0)
                 budget = min(integ.CHUNK, self.max_rhs - spent)
-                status, t, h, _ = integ.dopri5(sy.fns, sy.table, self.t, tb, self.y,
+                status, t, h, _ = dopri5(sy.fns, sy.table, self.t, tb, self.y,
                                                sy.params, sy.modes, self.rtol, self.atol,
                                                self._h, math.inf, empty_t, empty_y, 0,
                                                budget, self._stats)
@@ -201,9 +198,12 @@ class Stepper:
 
     def _over(self, kind: str, t_start: float, t_end: float, nfev: int, steps0: int,
               stiff0: int, wall0: float) -> Exception:
+        outputs = self.outputs()
+        units = self.system.channel_units
         partial = Result({"t": np.array([self.t]),
-                          **{k: np.array([v]) for k, v in self.outputs().items()}},
-                         {"scene": self.scene.name, "partial": True})
+                          **{k: np.array([v]) for k, v in outputs.items()}},
+                         {"scene": self.scene.name, "partial": True},
+                         units={k: units[k] for k in ("t", *outputs) if k in units})
         limit: Any = self.max_rhs if kind == "max_rhs" else self.max_wall
         return budget_error(kind, limit, meth="DOPRI5", t=self.t, t_start=t_start,
                             t_end=t_end, step=self._h or None,

@@ -15,7 +15,7 @@ from scipy.optimize import brentq
 
 from winder.model.machine import AT_CORE, WINDING
 from winder.solve import integrators as integ
-from winder.solve.simulate import _STEP_OVER, _WALL_EVERY, _Guards, _Stop
+from winder.solve.budgets import _STEP_OVER, _WALL_EVERY, _Guards, _Stop
 from winder.solve.system import MachineSystem
 
 __all__ = ["run_stepwise"]

@@ -48,6 +48,30 @@ CHANNELS = ("t", *list(LEGACY_CHANNELS)[:15])
 EXTRA_CHANNELS = tuple(list(LEGACY_CHANNELS)[15:])
 
 
+# provisional: replaced by the parts' declarations at merge ---------------------------------
+#: Unit of a result channel by the ending of its name (machines.md §9, winder-model §8),
+#: the longest ending first: ``NAME_x_dot`` [m/s] before ``NAME_x`` [m], ``web_speed``
+#: [m/s] before ``NAME_speed`` [rad/s].
+_UNIT_BY_SUFFIX = (
+    ("x_accel", "m/s²"), ("z_accel", "m/s²"), ("x_dot", "m/s"), ("z_dot", "m/s"),
+    ("inertia_rate", "kg·m²/s"), ("mass_rate", "kg/s"), ("normal_force", "N"),
+    ("friction_force", "N"), ("slip_velocity", "m/s"), ("penetration", "m"),
+    ("span_tension", "N"), ("tension_error", "N"), ("web_speed", "m/s"), ("web_force", "N"),
+    ("accel", "rad/s²"), ("speed", "rad/s"), ("angle", "rad"), ("torque", "N·m"),
+    ("radius", "m"), ("mass", "kg"), ("inertia", "kg·m²"), ("load", "N"), ("x", "m"),
+    ("z", "m"), ("t", "s"),
+)
+
+
+def _channel_unit(name: str) -> str:
+    """The unit of result channel ``name`` from the ending of its name."""
+    for suffix, unit in _UNIT_BY_SUFFIX:
+        if name == suffix or name.endswith("_" + suffix):
+            return unit
+    raise SimulationError(f"internal error: no unit for result channel {name!r}")
+# end provisional ------------------------------------------------------------------------------
+
+
 class NoCompilerWarning(UserWarning):
     """The generated path is unavailable (no C compiler): the numeric Pinocchio path runs."""
 
@@ -295,6 +319,15 @@ class MachineSystem:
             "The state was " + state_text(state) + ".", time=t, state=state)
 
     # ---- outputs ----------------------------------------------------------------------------
+    # provisional: replaced by the parts' declarations at merge
+    @property
+    def channel_units(self) -> dict[str, str]:
+        """Unit of every result channel of :meth:`channels` (``t`` [s] first; SI units,
+        ``rad`` for angles): ``{"t": "s", "drum_speed": "rad/s", ...}``."""
+        names = list(LEGACY_CHANNELS) if getattr(self.scene, "legacy", False) else \
+            self.machine.channel_names
+        return {"t": "s", **{n: _channel_unit(n) for n in names}}
+
     def channels(self, t: np.ndarray, Y: np.ndarray) -> dict[str, np.ndarray]:
         """All result channels at times ``t`` for states ``Y`` (``(n_states, len(t))``):
         machines.md §9 names, or winder-model §8 names for a single-drum scene."""

@@ -1,0 +1,506 @@
+"""The quasi-steady operating point of a winding machine and its linear modes, for the
+resonance map (:mod:`winder.analysis.modes`).
+
+At each radius of the wound roll (the roll the web enters, ``[web] entry_nip``) the machine
+is linearised with its exact Jacobian (:func:`winder.jacobian`) about its quasi-steady
+**operating point**:
+
+- every speed-profile drum at its full speed ``ratio · v / R`` (``v`` the web speed);
+- every roll and rider turning so that its surface speed stays constant: the rotation
+  accelerations are ``ω̇ = −ω ṙ/r`` for a paper roll (its slow deceleration as it grows)
+  and ``0`` for a rider; the nip slip and the friction states take the values that carry
+  these accelerations against the web forces (slip-relaxation friction at its steady value
+  ``F_t = F_ss(v_s)``, ``dF_t/dt = 0``);
+- every free translational coordinate (``x``, ``z``) in balance: its acceleration is 0
+  with the translational velocities 0 (the nips' damping sees only the radius growth
+  ``δ̇ = ṙ``);
+- angles 0, the imbalance off (``com_offset = 0``: it is the excitation), the other
+  paper rolls at their initial radius.
+
+These unknowns (positions, rotation speeds, friction states) solve ``rhs = target`` by
+damped Newton steps on the exact Jacobian from touching positions and no-slip speeds (the
+nips held in contact while solving, checked in contact after). The Jacobian restricted to
+the fast states (positions and velocities of the free coordinates, rotation speeds,
+friction states; angles and radii are slow or absent) gives the modes. Each free
+coordinate names one **bounce mode**: the eigenpair in which that coordinate carries the
+largest share of the mode's kinetic energy (``½ m |ẋ|²`` per free coordinate, ``½ J |θ̇|²``
+per turning body), an oscillating pair first (share ≥ 1/4), each pair used once
+(``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a single-drum scene); the rest are the
+slip/torsion modes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from winder._args import number, show
+from winder._errors import ArgumentError, ArgumentTypeError
+from winder.analysis.linearise import jacobian
+from winder.model.machine import AUTO, IN_CONTACT
+from winder.scene.load import _MAX, Scene
+from winder.solve.equilibrium import EquilibriumError, nip_key, resting_state
+from winder.solve.system import MachineSystem
+
+__all__ = ["Mode", "operating_point", "WEB_SPEED_MAX"]
+
+WEB_SPEED_MAX = _MAX[("drum.drive", "web_speed")]  # [m/s], as in a scene
+#: Most Newton steps of one operating point.
+_NEWTON_STEPS = 200
+#: A scaled residual (each equation over its largest Jacobian entry: a step in the unknowns'
+#: units) at which the operating point is solved where stiff nips leave no descent (the
+#: Jacobian's condition number reaches 1e15).
+_ROUND_OFF = 1e-12
+#: Units of the equations' residuals, by the ending of the state's name.
+_RATE_UNIT = {"x_dot": " m/s²", "z_dot": " m/s²", "theta_dot": " rad/s²", "friction": " N/s"}
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One eigenvalue (of a pair): ``frequency`` [Hz] (damped, 0 for a real eigenvalue),
+    ``natural_frequency`` ``|λ|/2π`` [Hz], ``damping_ratio`` [-], ``kind`` (``bounce`` or
+    ``slip``) and ``coordinate``: the free coordinate that dominates a bounce mode
+    (``BODY.x``/``BODY.z``), or the state that dominates a slip mode."""
+
+    eigenvalue: complex
+    kind: str
+    coordinate: str = ""
+
+    @property
+    def frequency(self) -> float:
+        return abs(self.eigenvalue.imag) / (2 * math.pi)
+
+    @property
+    def natural_frequency(self) -> float:
+        return abs(self.eigenvalue) / (2 * math.pi)
+
+    @property
+    def damping_ratio(self) -> float:
+        lam = self.eigenvalue
+        return -lam.real / abs(lam) if abs(lam) > 0 else 0.0
+
+
+def _where_drum(scene: Scene, name: str) -> str:
+    return "[drum.drive]" if scene.legacy else f"[[drum]] {name!r} drive"
+
+
+def _check_scene(scene: Scene, where: str) -> None:
+    """An :class:`ArgumentError` if the scene has no winding operating point."""
+    if not isinstance(scene, Scene):
+        raise ArgumentTypeError(f"{where}: scene must be a winder.Scene (winder.load_scene), "
+                                f"got {show(scene)} ({type(scene).__name__})")
+    if not scene.effects.contact:
+        raise ArgumentError(f"{where}: {scene.source}: the resonance map needs the nip: "
+                            "[effects] contact = false; valid: contact = true")
+    if scene.web is None:
+        raise ArgumentError(f"{where}: {scene.source}: the resonance map needs a wound roll "
+                            "and the web entering it ([web] entry_nip); this scene has no "
+                            "[web]")
+    for d in scene.drums:
+        if d.drive.kind != "speed_profile":
+            raise ArgumentError(f"{where}: {scene.source}: the resonance map needs "
+                                f"{_where_drum(scene, d.name)} kind = 'speed_profile' (its "
+                                f"web speed is the operating speed), got {d.drive.kind!r}")
+    if not scene.effects.gravity or scene.scene.gravity == 0.0:
+        raise ArgumentError(f"{where}: {scene.source}: the resonance map needs the roll's "
+                            "weight on the nip, but [effects] gravity = "
+                            f"{str(scene.effects.gravity).lower()} and [scene] gravity = "
+                            f"{scene.scene.gravity!r}; valid: gravity on and > 0")
+    for n in scene.nips:
+        if n.friction.mu == 0.0:
+            key = "[friction] mu" if scene.legacy else f"[[nip]] {n.name!r} friction mu"
+            raise ArgumentError(f"{where}: {scene.source}: {key} = 0: without friction the "
+                                "drum does not drive the roll, so there is no winding "
+                                "operating point and no slip mode; valid: mu > 0")
+
+
+def _entry_drum(scene: Scene):  # noqa: ANN202 - a DrumPart
+    nip = next(n for n in scene.nips if n.name == scene.web.entry_nip)
+    return next(d for d in scene.drums if d.name == nip.a)
+
+
+def _web_speed(where: str, scene: Scene, web_speed: float | None, lo_open: bool) -> float:
+    """The operating web speed [m/s]: the argument, or the ``web_speed`` of the drum the web
+    wraps; finite, ``> 0`` (``>= 0`` where ``lo_open`` is false)."""
+    if web_speed is None:
+        drum = _entry_drum(scene)
+        v = drum.drive.web_speed
+        if lo_open and not v > 0.0:
+            key = _where_drum(scene, drum.name)
+            raise ArgumentError(f"{where}: web_speed is not given and the scene's {key} "
+                                f"web_speed is {v!r} ({scene.source}); valid: a web speed "
+                                "> 0 m/s")
+        return v
+    return number(where, "web_speed", web_speed, lo=0.0, lo_open=lo_open,
+                  hi=WEB_SPEED_MAX, unit="m/s")
+
+
+class _Linearisation:
+    """The machine of a scene at its operating points (see the module docstring): one
+    :class:`MachineSystem` with the imbalance off and the drums at full speed ``v``."""
+
+    def __init__(self, scene: Scene, v: float) -> None:
+        self.scene, self.v = scene, v
+        self.system = sys_ = MachineSystem(scene)
+        m = self.machine = sys_.machine
+        p = sys_.params
+        for b in m.rolls:
+            if f"{b.name}.com_offset" in m.param_names:
+                p[m.param_index(f"{b.name}.com_offset")] = 0.0
+        for b in m.bodies:
+            if b.prescribed:  # full speed from t = 0
+                p[m.param_index(f"{b.name}.ramp_time")] = 0.0
+                p[m.param_index(f"{b.name}.web_speed")] = v
+        self.t = 0.0
+        self.roll = m.entry.b
+        self.i_r = m.index(f"{self.roll.name}.radius")
+        self.rc = self.roll.part.core_radius
+        names = m.state_names
+        self.positions = [m.index(f"{b.name}.{c}") for b in m.bodies for c in b.free]
+        self.coords = [f"{b.name}.{c}" for b in m.bodies for c in b.free]
+        self.velocities = [m.index(f"{n}_dot") for n in self.coords]
+        self.speeds = [m.index(f"{b.name}.theta_dot") for b in m.bodies if not b.prescribed]
+        slow = {m.index(f"{b.name}.theta") for b in m.bodies if not b.prescribed}
+        slow |= {m.index(f"{b.name}.radius") for b in m.rolls}
+        taken = set(self.positions) | set(self.velocities) | set(self.speeds) | slow
+        self.others = [i for i in range(len(names)) if i not in taken]  # friction, ...
+        # unknowns of the balance and their equations (rates)
+        self.unknowns = self.positions + self.speeds + self.others
+        self.equations = self.velocities + self.speeds + self.others
+        self.fast = self.positions + self.velocities + self.speeds + self.others
+        self.paper = {m.index(f"{b.name}.theta_dot"): m.index(f"{b.name}.radius")
+                      for b in m.rolls}
+        self._speed_slots = np.arange(len(self.positions),
+                                      len(self.positions) + len(self.speeds))
+        self.v_ref = min(n.part.friction.slip_velocity for n in m.nips)
+        self.contact = np.array([n.endswith(".contact") for n in m.mode_names])
+        self.idle: list[str] = []  # states without dynamics, found at the first solve
+        self._idle_checked = False
+
+    def _drop_idle(self, y: np.ndarray) -> None:
+        """Drop from the unknowns, the equations and the modes every state besides the
+        positions and speeds whose rate is identically zero (its row of the exact Jacobian
+        vanishes at ``y`` and at a perturbed state, and its rate is 0): with an effect off
+        such a state (a friction state without relaxation, say) has no dynamics, stays at
+        its initial value and would only make the Newton matrix singular."""
+        self._idle_checked = True
+        rng = np.random.default_rng(0)
+        y2 = y.copy()
+        y2[self.unknowns] *= 1.0 + 1e-3 * rng.standard_normal(len(self.unknowns))
+        idle = []
+        sys_ = self.system
+        for yy in (y, y2):
+            f, J = sys_.rhs(self.t, yy), sys_.jac(self.t, yy)
+            idle.append({i for i in self.others if f[i] == 0.0 and not np.any(J[i])})
+        drop = idle[0] & idle[1]
+        if not drop:
+            return
+        self.idle = [self.machine.state_names[i] for i in sorted(drop)]
+        self.others = [i for i in self.others if i not in drop]
+        self.unknowns = self.positions + self.speeds + self.others
+        self.equations = self.velocities + self.speeds + self.others
+        self.fast = self.positions + self.velocities + self.speeds + self.others
+
+    # ---- the operating point ------------------------------------------------------------
+    def _radius_of(self, y: np.ndarray, name: str) -> float:
+        return self.machine.radius(y, self.machine.body[name])
+
+    def _speed_radius(self, y: np.ndarray) -> np.ndarray:
+        """Radius [m] of each body whose speed is an unknown."""
+        return np.array([self._radius_of(y, b.name) for b in self.machine.bodies
+                         if not b.prescribed])
+
+    def guess(self, r: float) -> np.ndarray:
+        """The initial guess at radius ``r`` [m], already near the solution: no-slip speeds
+        from the drums, then every free body resting on the bodies below it with each nip
+        at the static penetration of its law under the load it carries (closed form,
+        :func:`~winder.solve.equilibrium.resting_state`; the nips' damping sees the radius
+        growth), friction states 0."""
+        m = self.machine
+        y = np.array(m.state_initial, dtype=float)
+        y[self.i_r] = r
+        # no slip, θ̇_b = −θ̇_a r_a / r_b across each nip, from the drums
+        omega = {b.name: b.sense * b.part.drive.ratio * self.v / b.part.radius
+                 for b in m.bodies if b.prescribed}
+        for _ in m.nips:
+            for n in m.nips:
+                a, b = n.a.name, n.b.name
+                ra, rb = self._radius_of(y, a), self._radius_of(y, b)
+                if a in omega and b not in omega:
+                    omega[b] = -omega[a] * ra / rb
+                elif b in omega and a not in omega:
+                    omega[a] = -omega[b] * rb / ra
+        for b in m.bodies:
+            if not b.prescribed and b.name in omega:
+                y[m.index(f"{b.name}.theta_dot")] = omega[b.name]
+        movable = {b.name for b in m.bodies if b.free}
+        return resting_state(m, y, self.system.params, movable, t=self.t, rates=True).state
+
+    def _guess(self, r: float, where: str) -> np.ndarray:
+        """:meth:`guess`; a nip too soft for its load or a body that cannot reach its
+        supports there is an :class:`ArgumentError` naming the key."""
+        try:
+            return self.guess(r)
+        except EquilibriumError as exc:
+            raise ArgumentError(f"{where}: at radius = {r:g} m: {exc}") from None
+
+    def continued(self, r: float, where: str, prev: tuple[np.ndarray, np.ndarray]
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """``(start, guess)`` at radius ``r`` [m] continuing ``prev`` = ``(solution,
+        guess)`` of the previous radius: the guess at ``r`` plus the previous solution's
+        departure from its own guess (the slip, the friction, the positions' correction)."""
+        g = self._guess(r, where)
+        y_prev, g_prev = prev
+        y = g.copy()
+        u = self.unknowns
+        y[u] = g[u] + (y_prev[u] - g_prev[u])
+        return y, g
+
+    def _residual(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``rhs − target`` on the equations and its exact Jacobian in the unknowns."""
+        f = self.system.rhs(self.t, y)
+        J = self.system.jac(self.t, y)
+        for i_w, i_r in self.paper.items():  # constant surface speed: ω̇ = −ω ṙ / r
+            f[i_w] += y[i_w] * f[i_r] / y[i_r]
+            J[i_w, i_w] += (f[i_r] + y[i_w] * J[i_r, i_w]) / y[i_r]
+        return f[self.equations], J[np.ix_(self.equations, self.unknowns)]
+
+    def _scales(self, y: np.ndarray) -> np.ndarray:
+        """The natural scale of each unknown: 1 m for a position (its steps are judged
+        relative to 1 m), the slip speed ``v_ref/r`` [rad/s] for a rotation speed, 1 N for
+        a friction state (or the value, where larger)."""
+        m = self.machine
+        s = []
+        for i in self.unknowns:
+            name = m.state_names[i]
+            if name.endswith("theta_dot"):
+                s.append(self.v_ref / self._radius_of(y, name[:-len(".theta_dot")]))
+            else:
+                s.append(1.0)
+        return np.array(s)
+
+    def _newton(self, y: np.ndarray) -> tuple[bool, np.ndarray, np.ndarray]:
+        """Globalised Newton from ``y`` (changed in place): the exact Jacobian, rows scaled
+        by their largest entry at the start, each step limited so that no surface speed
+        moves by more than half the slip velocity (the slip law saturates beyond a few
+        ``v_ref``), then halved until the scaled residual decreases (Armijo); converged at a
+        step below 1e-10 of the unknowns' scale, or where no step descends any more with the
+        scaled residual at round-off (:data:`_ROUND_OFF`). Returns
+        ``(converged, scaled residual, raw residual)``."""
+        u = self.unknowns
+        floor = np.ones(len(u))  # [m], [rad/s], [N]
+        res, J = self._residual(y)
+        D = 1.0 / np.maximum(np.max(np.abs(J), axis=1), 1e-300)
+        merit = np.linalg.norm(D * res)
+        for _ in range(_NEWTON_STEPS):
+            if not (np.all(np.isfinite(J)) and np.isfinite(merit)):
+                return False, D * res, res
+            # least squares: singular where a nip carries no load yet (δ = 0)
+            step = np.linalg.lstsq(J, -res, rcond=None)[0]
+            x0 = y[u].copy()
+            if np.all(np.abs(step) <= 1e-10 * np.maximum(np.abs(x0), floor)):
+                y[u] = x0 + step
+                res, _ = self._residual(y)
+                return True, D * res, res
+            big = np.abs(step[self._speed_slots]) * self._speed_radius(y)
+            step *= min(1.0, float(np.min(self.v_ref / 2 / np.maximum(big, 1e-300),
+                                          initial=np.inf)))
+            lam = 1.0
+            while lam > 1e-6:
+                y[u] = x0 + lam * step
+                res_n, J_n = self._residual(y)
+                m_n = np.linalg.norm(D * res_n)
+                if np.isfinite(m_n) and m_n <= (1 - 1e-4 * lam) * merit or m_n == 0:
+                    break
+                lam /= 2
+            else:  # no descent left: solved if the residual is at round-off
+                y[u] = x0
+                return bool(np.max(np.abs(D * res)) <= _ROUND_OFF), D * res, res
+            res, J, merit = res_n, J_n, m_n
+        return False, D * res, res
+
+    def _trust_region(self, y: np.ndarray) -> bool:
+        """Levenberg–Marquardt (MINPACK) on the exact Jacobian in the unknowns' natural
+        scales, from ``y`` (changed in place): the fallback where the line search stalls."""
+        from scipy.optimize import least_squares
+
+        u = self.unknowns
+        s = self._scales(y)
+        res0, J0 = self._residual(y)
+        D = 1.0 / np.maximum(np.max(np.abs(J0 * s[None, :]), axis=1), 1e-300)
+        x0 = y[u] / s
+        cache: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+
+        def both(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            key = z.tobytes()
+            if key not in cache:
+                cache.clear()
+                yy = y.copy()
+                yy[u] = z * s
+                r_, J_ = self._residual(yy)
+                cache[key] = (D * r_, D[:, None] * J_ * s[None, :])
+            return cache[key]
+
+        sol = least_squares(lambda z: both(z)[0], x0, jac=lambda z: both(z)[1], method="lm",
+                            xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=100 * len(u))
+        y[u] = sol.x * s
+        return bool(np.all(np.isfinite(sol.fun)))
+
+    def solve(self, r: float, where: str, start: np.ndarray | None = None) -> np.ndarray:
+        """The operating point at radius ``r`` [m] (an :class:`ArgumentError` if none):
+        globalised Newton steps (:meth:`_newton`; Levenberg–Marquardt where they stall)
+        from ``start`` (the previous radius of a map, continued) or :meth:`guess`, to a
+        step below 1e-10 of the unknowns' scale (1 m, 1 rad/s, 1 N or their value)."""
+        sys_ = self.system
+        converged, scaled, raw = False, np.array([np.inf]), np.array([np.inf])
+        y = self._guess(r, where) if start is None else start.copy()
+        sys_.modes[self.contact] = IN_CONTACT  # smooth while solving
+        try:
+            with np.errstate(all="ignore"):
+                if not self._idle_checked:
+                    self._drop_idle(y)
+                for attempt in ("newton", "trust_region", "guess"):
+                    if attempt == "guess":
+                        if start is None:
+                            break
+                        y = self._guess(r, where)
+                        start = None
+                    elif attempt == "trust_region":
+                        self._trust_region(y)
+                    converged, scaled, raw = self._newton(y)
+                    if converged:
+                        break
+        except (np.linalg.LinAlgError, FloatingPointError, ArithmeticError):
+            converged = False
+        except Exception as exc:  # a non-finite rhs on the way: no balance
+            if type(exc).__name__ != "SimulationError":
+                raise
+            converged = False
+        finally:
+            sys_.modes[self.contact] = AUTO
+        v = self.v
+        nips = "the nip cannot" if len(self.machine.nips) == 1 else "the nips cannot"
+        saturated = self._saturated(y)
+        if converged and saturated:  # gross slip: the friction cannot hold the speeds
+            raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s "
+                                f"{nips} carry the roll's torque and weight: no operating "
+                                f"point without gross slip ({saturated[2:]}); valid: a lower "
+                                "web speed or a smaller radius")
+        if not converged:
+            bad = np.where(np.isfinite(scaled), np.abs(scaled), np.inf)
+            k = int(np.argmax(bad)) if len(bad) == len(self.equations) else 0
+            name = self.machine.state_names[self.equations[k]]
+            unit = _RATE_UNIT.get(name.rsplit(".", 1)[-1], "")
+            value = raw[k] if len(raw) == len(self.equations) else math.nan
+            raise ArgumentError(f"{where}: at radius = {r:g} m and web_speed = {v:g} m/s "
+                                f"{nips} carry the roll's torque and weight: no operating "
+                                f"point (the equation of d({name})/dt did not converge: "
+                                f"residual {value:.3g}{unit}{saturated}); valid: a "
+                                "lower web speed or a smaller radius")
+        sw = sys_.switches(self.t, y)
+        names = self.machine.switch_names
+        for n in self.machine.nips:
+            g = sw[names.index(f"{n.name}.contact")]
+            over = sw[names.index(f"{n.name}.overlap")]  # δ − min(r_a, r_b), as the guard
+            if not g > 0.0:
+                raise ArgumentError(f"{where}: at radius = {r:g} m nip {n.name!r} opens at "
+                                    "the operating point (no normal force): no bounce mode "
+                                    "about a lasting contact there")
+            if not over < 0.0:
+                delta = over + min(self._radius_of(y, n.a.name), self._radius_of(y, n.b.name))
+                raise ArgumentError(f"{where}: at radius = {r:g} m the load compresses nip "
+                                    f"{n.name!r} by {delta:.4g} m, more than a radius (one "
+                                    "axis would lie inside the other body); valid: a smaller "
+                                    f"radius or a stiffer nip ({nip_key(self.machine, n)})")
+        return y
+
+    def _saturated(self, y: np.ndarray) -> str:
+        """``; nip 'N' slips at v_s …`` for each nip whose friction is saturated at the
+        last iterate ``y`` (``|v_s| > 2 v_ref``: ``tanh > 0.96``), else ``""``."""
+        try:
+            with np.errstate(all="ignore"):
+                modes = self.system.modes.copy()
+                modes[self.contact] = IN_CONTACT  # as solved
+                ev = self.system.evaluate_numeric(self.t, y, modes, outputs=False)
+        except Exception:  # noqa: BLE001 - only a diagnosis: the error is raised anyway
+            return ""
+        out = []
+        for n in self.machine.nips:
+            ns = ev.nips[n.name]
+            vs, fn = float(ns.v_s), float(ns.normal_force)
+            if np.isfinite(vs) and abs(vs) > 2 * n.part.friction.slip_velocity and fn > 0:
+                out.append(f"; nip {n.name!r} slips at v_s = {vs:.3g} m/s, its friction "
+                           f"saturated at mu F_n = {n.part.friction.mu * fn:.4g} N")
+        return "".join(out)
+
+    # ---- the modes ----------------------------------------------------------------------
+    def modes(self, y: np.ndarray) -> list[Mode]:
+        """Bounce modes (in the order of the free coordinates), then slip modes (slowest
+        first), at the operating point ``y``."""
+        from scipy.optimize import linear_sum_assignment
+
+        A = jacobian(self.system, self.t, y)[np.ix_(self.fast, self.fast)]
+        lam, vec = np.linalg.eig(A)
+        nt, ns = len(self.positions), len(self.speeds)
+        keep = [i for i in range(len(lam)) if lam[i].imag >= 0.0]  # one of each pair
+        # kinetic energy of each eigenvector: ½ m |ẋ|² per free coordinate, ½ J |θ̇|² per
+        # turning body; a coordinate's share of it names the bounce mode
+        ev = self.system.evaluate_numeric(self.t, y, outputs=False)
+        mass = np.array([float(ev.bodies[c.rsplit(".", 1)[0]].mass) for c in self.coords])
+        inertia = np.array([float(ev.bodies[b.name].inertia)
+                            for b in self.machine.bodies if not b.prescribed])
+        V = vec[:, keep]
+        kin = np.vstack([mass[:, None] * np.abs(V[nt:2 * nt]) ** 2,
+                         inertia[:, None] * np.abs(V[2 * nt:2 * nt + ns]) ** 2])
+        share = kin[:nt] / np.maximum(kin.sum(axis=0), 1e-300)
+        # each coordinate takes the eigenpair in which it has the largest share, an
+        # oscillating one first (its share >= 1/4), every pair at most once
+        oscillating = np.array([lam[i].imag > 0.0 for i in keep])
+        score = share + (oscillating[None, :] & (share >= 0.25))
+        rows, cols = linear_sum_assignment(-score)
+        bounce = {int(r): keep[int(c)] for r, c in zip(rows, cols, strict=True)}
+        names = [self.machine.state_names[i] for i in self.fast]
+        out = [Mode(complex(lam[bounce[c]]), "bounce", self.coords[c]) for c in range(nt)]
+        slips = sorted((i for i in keep if i not in bounce.values()), key=lambda i: abs(lam[i]))
+        return out + [Mode(complex(lam[i]), "slip",
+                           names[2 * nt + int(np.argmax(np.abs(vec[2 * nt:, i])))])
+                      for i in slips]
+
+
+def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: bool
+                   ) -> _Linearisation:
+    _check_scene(scene, where)
+    return _Linearisation(scene, _web_speed(where, scene, web_speed, lo_open=lo_open))
+
+
+def _core_key(lin: _Linearisation) -> str:
+    """The scene key of the wound roll's core radius, the smallest radius of a map."""
+    return "[roll] core_radius" if lin.scene.legacy else \
+        f"[[roll]] {lin.roll.name!r} core_radius"
+
+
+def _radius(where: str, lin: _Linearisation, radius: float) -> float:
+    key = _core_key(lin)
+    return number(where, "radius", radius, lo=lin.rc, unit="m",
+                  valid=f"a finite radius >= {key} = {lin.rc:g} m")
+
+
+def operating_point(scene: Scene, radius: float, *, web_speed: float | None = None
+                    ) -> tuple[MachineSystem, float, np.ndarray]:
+    """``(system, t, y)`` of the quasi-steady operating point (module docstring) at
+    ``radius`` [m] of the wound roll (``>=`` its core radius) and ``web_speed`` [m/s]
+    (``>= 0``; default the scene's). ``system.params`` hold the drums at full speed and the
+    imbalance off.
+
+    Raises
+    ------
+    ArgumentError: a radius or web speed out of range, a scene without a winding operating
+        point (no nip, no web, no weight, no friction, a torque drive), or a radius and
+        speed at which the nips cannot carry the rolls' torques or weights.
+    """
+    where = "operating_point"
+    lin = _linearisation(scene, where, web_speed, lo_open=False)
+    r = _radius(where, lin, radius)
+    return lin.system, lin.t, lin.solve(r, where)
