@@ -15,6 +15,9 @@ from collections.abc import Iterable
 from types import SimpleNamespace as NS
 from typing import Any
 
+from winder.forces import force_elements
+from winder.parts import body_elements
+
 __all__ = ["EFFECTS", "effects", "contact", "friction", "speed_profile", "torque_drive",
            "drum", "wound_roll", "rider", "nip", "machine_scene", "override", "two_drum",
            "single_drum", "free_roll"]
@@ -91,10 +94,19 @@ def nip(name: str, a: str, b: str, law: str = "linear", **kw: Any) -> NS:
 def machine_scene(name: str, *, drums: Iterable[NS] = (), rolls: Iterable[NS] = (),
                   riders: Iterable[NS] = (), nips: Iterable[NS] = (),
                   web: NS | None = None, fx: NS | None = None, gravity: float = 9.81) -> NS:
-    """A scene object with parts (what ``Machine(scene)`` reads)."""
-    return NS(name=name, scene=NS(name=name, gravity=gravity, duration=10.0, output_step=0.01),
-              effects=fx if fx is not None else effects(), drums=tuple(drums),
-              rolls=tuple(rolls), riders=tuple(riders), nips=tuple(nips), web=web)
+    """A scene object with parts (what ``Machine(scene)`` reads; ``elements()`` as a
+    :class:`winder.Scene`'s)."""
+    sc = NS(name=name, scene=NS(name=name, gravity=gravity, duration=10.0, output_step=0.01),
+            effects=fx if fx is not None else effects(), drums=tuple(drums),
+            rolls=tuple(rolls), riders=tuple(riders), nips=tuple(nips), web=web)
+    sc.elements = lambda: elements(sc)
+    return sc
+
+
+def elements(scene: Any) -> tuple[list[Any], list[Any]]:
+    """The body and force elements of ``scene`` (as :meth:`winder.Scene.elements`)."""
+    bodies = body_elements(scene)
+    return bodies, force_elements(scene.effects, bodies)
 
 
 def override(scene: NS, values: dict[str, Any]) -> NS:

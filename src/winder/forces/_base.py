@@ -29,11 +29,11 @@ class ForceElement(ABC):
        needs: run-time parameters (``machine.parameter(name, value)``, values from the
        scene's parts), states (``machine.state(name, initial)``), result channels
        (``machine.channel(name)``).
-    3. In :meth:`apply`, read the :class:`~winder.model.machine.Evaluation` (``ev.M`` is
+    3. In :meth:`apply`, read the :class:`~winder.model.machine.Evaluation` (``ev.mathns`` is
        the math namespace; ``ev.p(name)`` a parameter, ``ev.x(name)`` a state,
        ``ev.bodies``/``ev.nips`` the kinematics), add forces with ``ev.add_force``, write
        state derivatives with ``ev.set_rate`` and channels with ``ev.set_channel``. Branch
-       on states only through ``ev.M.if_else``/``fmax`` (the generated code is
+       on states only through ``ev.mathns.if_else``/``fmax`` (the generated code is
        branch-free).
     4. Register the class in ``winder/forces/__init__.py`` (``FORCES``, one line) and add
        the key to ``[effects]`` in the scene schema.
@@ -42,7 +42,13 @@ class ForceElement(ABC):
     """
 
     name: ClassVar[str]
-    order: ClassVar[int] = 50
+
+    #: quantities it writes for other elements and the machine
+    provides: ClassVar[frozenset[str]] = frozenset()
+    #: quantities it reads, which some element must provide
+    requires: ClassVar[frozenset[str]] = frozenset()
+    #: quantities it reads where some element provides them (else a default)
+    uses: ClassVar[frozenset[str]] = frozenset()
 
     def declare(self, machine: Machine) -> None:  # noqa: B027 - optional hook
         """Register parameters, states and channels (once, when the machine is built)."""

@@ -20,10 +20,20 @@ import pinocchio as pin
 
 from winder._args import number
 from winder._errors import ArgumentError, ModelError
-from winder.scene.load import max_com_offset
 
 __all__ = ["MassLaw", "MassProperties", "FunctionMassLaw", "PaperRollLaw", "paper_roll_mass",
+           "max_com_offset",
            "skew"]
+
+
+def max_com_offset(core_radius: float, core_mass: float, core_inertia: float) -> float:
+    """Bound ``e_max`` [m] of a roll's centre-of-mass offset, ``0 <= e < e_max``.
+
+    The centre of mass lies inside the core (``e < r_c``) and the core's inertia about it,
+    ``J_core − m_core e²``, is positive (``e < √(J_core/m_core)``). Then the roll's inertia
+    about its centre of mass ``J(r) − m(r) e²`` stays positive at every radius: the paper
+    adds ``b(r)(½(r² + r_c²) − e²) > 0`` with ``b`` its mass."""
+    return min(core_radius, math.sqrt(core_inertia / core_mass))
 
 
 def paper_roll_mass(r: Any, core_radius: Any, core_mass: Any, core_inertia: Any,
@@ -140,7 +150,7 @@ class PaperRollLaw(MassLaw):
     ----------
     core_radius: ``r_c`` > 0 [m]; core_mass: > 0 [kg]; core_inertia: ``J_core`` > 0
     [kg·m²]; width: ``L`` > 0 [m]; density: ``ρ`` >= 0 [kg/m³]; com_offset: ``e`` [m],
-    ``0 <= e < min(r_c, √(J_core/m_core))`` (:func:`winder.scene.load.max_com_offset`: the
+    ``0 <= e < min(r_c, √(J_core/m_core))`` (:func:`max_com_offset`: the
     centre of mass inside the core, the inertia about it positive). All finite.
 
     The laws are defined for ``r >= r_c`` (finite): :meth:`mass`, :meth:`polar_inertia`,

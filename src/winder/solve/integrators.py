@@ -44,7 +44,7 @@ import math
 import numpy as np
 
 from winder.model.ccall import call
-from winder.model.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
+from winder.model.locked_modes import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING, ModeKind
 from winder.solve._jit import njit
 
 __all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "switch_buffer", "first_step",
@@ -54,7 +54,7 @@ __all__ = ["dopri5", "rk4", "modes_of", "evaluate", "switches", "switch_buffer",
            "K_CONTACT", "K_CORE", "K_END"]
 
 DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE, EXHAUSTED, PENETRATED = 0, 1, 2, 3, 4, 5
-K_CONTACT, K_CORE, K_END = 0, 1, 2
+K_CONTACT, K_CORE, K_END = int(ModeKind.CONTACT), int(ModeKind.CORE), int(ModeKind.END)
 #: The mode a :data:`K_END` slot switches to: the run ends (an unwinding roll at its core).
 END = 9
 #: The slot :func:`sample_and_switch` returns where a nip crossed its penetration bound.

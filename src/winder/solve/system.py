@@ -97,29 +97,13 @@ class MachineSystem:
                 self.backend = "pinocchio"
         self._numeric = NumericBackend(m.model) if self.generated is None else None
         self.fns = self.generated.addresses if self.generated is not None else None
-        rows = []
-        for name in m.mode_names:
-            if name.endswith(".contact"):
-                nip = name[:-len(".contact")]
-                rows.append((integ.K_CONTACT, *(m.switch_names.index(f"{nip}.{g}") for g in
-                                                ("contact", "overlap", "dx", "dz"))))
-            elif name.endswith(".end"):
-                roll = name[:-len(".end")]
-                rows.append((integ.K_END, m.switch_names.index(f"{roll}.exhausted"), 0,
-                             m.index(f"{roll}.radius"), m.param_index(f"{roll}.core_radius")))
-            else:
-                roll = name[:-len(".core")]
-                rows.append((integ.K_CORE, m.switch_names.index(f"{roll}.unwound"),
-                             m.switch_names.index(f"{roll}.forward"),
-                             m.index(f"{roll}.radius"), m.param_index(f"{roll}.core_radius")))
+        rows = [mode.table_row(m) for mode in m.modes]
         self.table = np.array(rows, dtype=np.int64).reshape(len(rows), 5)
-        self.modes = np.array([AUTO if r[0] == integ.K_CONTACT else
-                               CORE_AUTO if r[0] == integ.K_CORE else 0.0 for r in rows],
-                              dtype=float)
-        self.radii = [(m.index(f"{b.name}.radius"), b.part.core_radius) for b in m.rolls]
-        self.breakpoints = sorted({b.part.drive.web_speed / b.part.drive.web_acceleration
-                                   for b in m.bodies if b.prescribed
-                                   and b.part.drive.web_acceleration > 0})
+        self.modes = np.array([mode.kind.automatic for mode in m.modes], dtype=float)
+        #: ``(state index, least value [m])`` of every radius an event stops at its core
+        self.radii = [(m.index(mode.state), m.param_values[m.param_index(mode.param)])
+                      for mode in m.modes if mode.state is not None]
+        self.breakpoints = sorted({t for b in m.bodies for t in b.breakpoints()})
         self.nfev = 0
         self._tb = np.empty(1)
         self._eq: Equilibrium | None = None
@@ -153,7 +137,7 @@ class MachineSystem:
     def torque_inputs(self) -> list[str]:
         """Names of the torque inputs (``BODY.torque``, one per torque-driven drum or
         unwinding roll)."""
-        return [f"{b.name}.torque" for b in self.machine.bodies if b.torque_input]
+        return [name for b in self.machine.bodies for name in b.torque_inputs]
 
     def set_drum_torque(self, torque: float) -> None:
         """Input torque [N·m] of the torque-driven drum (scenes with exactly one)."""
