@@ -43,7 +43,7 @@ import numpy as np
 from winder._args import integer, number, show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.linearise import jacobian
-from winder.model.machine import AUTO, IN_CONTACT
+from winder.model.locked_modes import AUTO, IN_CONTACT, ModeKind
 from winder.scene.load import _MAX, Scene
 from winder.solve.equilibrium import EquilibriumError, nip_key, resting_state
 from winder.solve.system import MachineSystem
@@ -185,7 +185,7 @@ class _Linearisation:
         self._speed_slots = np.arange(len(self.positions),
                                       len(self.positions) + len(self.speeds))
         self.v_ref = min(n.part.friction.slip_velocity for n in m.nips)
-        self.contact = np.array([n.endswith(".contact") for n in m.mode_names])
+        self.contact = np.array([mode.kind is ModeKind.CONTACT for mode in m.modes])
         self.idle: list[str] = []  # states without dynamics, found at the first solve
         self._idle_checked = False
 

@@ -25,7 +25,7 @@ from winder.solve import integrators as integ
 from winder.solve._jit import njit
 from winder.solve.equilibrium import Equilibrium, static_state
 
-__all__ = ["MachineSystem", "LEGACY_CHANNELS", "CHANNELS", "EXTRA_CHANNELS",
+__all__ = ["MachineSystem", "LEGACY_CHANNELS", "LEGACY_UNITS", "CHANNELS", "EXTRA_CHANNELS",
            "NoCompilerWarning"]
 
 #: Channel names of a scene in the single-drum format (winder-model §8 and winder's
@@ -39,6 +39,17 @@ LEGACY_CHANNELS = {
     "slip_velocity": "nip_slip_velocity", "drum_angle": "drum_angle",
     "web_speed": "web_speed", "z_accel": "roll_z_accel", "web_force": "web_force",
     "penetration": "nip_penetration",
+}
+
+#: Units of the channels of a single-drum scene (those its machine lacks with an effect
+#: off, e.g. ``web_force``, are zeros in these units).
+LEGACY_UNITS = {
+    "drum_speed": "rad/s", "drum_torque": "N·m", "roll_speed": "rad/s",
+    "roll_accel": "rad/s²", "roll_angle": "rad", "radius": "m", "mass": "kg",
+    "inertia": "kg·m²", "mass_rate": "kg/s", "inertia_rate": "kg·m²/s", "z": "m",
+    "z_dot": "m/s", "normal_force": "N", "friction_force": "N", "slip_velocity": "m/s",
+    "drum_angle": "rad", "web_speed": "m/s", "z_accel": "m/s²", "web_force": "N",
+    "penetration": "m",
 }
 
 #: Result channels of a single-drum scene (winder-model §8), in order (first column ``t``).
@@ -279,6 +290,15 @@ class MachineSystem:
             "The state was " + state_text(state) + ".", time=t, state=state)
 
     # ---- outputs ----------------------------------------------------------------------------
+    @property
+    def channel_units(self) -> dict[str, str]:
+        """The unit of every channel :meth:`channels` returns, in its order: ``t`` [s],
+        then the machine's (:attr:`Machine.channel_units`), or a single-drum scene's
+        names of winder-model §8 (:data:`LEGACY_UNITS`)."""
+        if getattr(self.scene, "legacy", False):
+            return {"t": "s", **LEGACY_UNITS}
+        return {"t": "s", **self.machine.channel_units}
+
     def channels(self, t: np.ndarray, Y: np.ndarray) -> dict[str, np.ndarray]:
         """All result channels at times ``t`` for states ``Y`` (``(n_states, len(t))``):
         machines.md §9 names, or winder-model §8 names for a single-drum scene."""
