@@ -8,10 +8,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import machines as mc
 import numpy as np
 import pytest
 
-import machines as mc
 import winder
 from winder.forces import FORCES, ForceElement
 from winder.model.element_order import ElementOrderError, order_elements
