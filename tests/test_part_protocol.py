@@ -214,4 +214,4 @@ def test_mode_kinds_are_typed() -> None:
                          m.param_index("set.core_radius")]
     assert core.owner == "set"
     with pytest.raises(TypeError, match="ModeKind"):
-        m.mode("x.contact", ("x.g",), "contact")  # type: ignore[arg-type]
+        m.mode("x.contact", ("x.g",), "contact", owner="x")  # type: ignore[arg-type]

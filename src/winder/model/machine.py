@@ -212,13 +212,11 @@ class Machine:
             self.channel_names.append(name)
             self.channel_units[name] = unit
 
-    def mode(self, name: str, switches: tuple[str, ...], kind: ModeKind, *,
-             owner: str | None = None, state: str | None = None,
-             param: str | None = None) -> None:
-        """Register a locked mode slot of ``kind`` and its switching functions (see
-        :class:`~winder.model.locked_modes.Mode`)."""
-        mode = Mode(name, kind, owner if owner is not None else name.rsplit(".", 1)[0],
-                    tuple(switches), state, param)
+    def mode(self, name: str, switches: tuple[str, ...], kind: ModeKind, *, owner: str,
+             state: str | None = None, param: str | None = None) -> None:
+        """Register a locked mode slot of ``kind`` belonging to the part ``owner`` and its
+        switching functions (see :class:`~winder.model.locked_modes.Mode`)."""
+        mode = Mode(name, kind, owner, tuple(switches), state, param)
         self.modes.append(mode)
         self.mode_names.append(name)
         self.switch_names.extend(switches)

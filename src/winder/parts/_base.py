@@ -29,8 +29,9 @@ class BodyElement(ABC):
     ``NAME_angle`` [rad], ``NAME_torque`` [N·m], ``NAME_accel`` [rad/s²], ``NAME_x``
     [m], ...) and the dynamics (Pinocchio's ABA). The element says everything else.
 
-    To add a body type (nothing else is touched: not the machine, the solver, the
-    generated code, the FMU, the viewer or the figures):
+    To add a body type (nothing else is touched: not the machine, the solvers, the
+    generated code, the static balance or the viewer; the scene's schema declares its
+    table and keys, the part's frozen dataclass beside the element):
 
     1. Subclass :class:`BodyElement` (or :class:`RigidDisc` for a body of constant radius,
        mass and inertia) in the part's module under ``winder/parts/``; set the class
@@ -54,7 +55,7 @@ class BodyElement(ABC):
     3. :meth:`declare`: its run-time parameters (``machine.parameter(name, value)``),
        the states beyond its joint coordinates with their initial values (spec §7,
        ``machine.state``), its locked modes (``machine.mode(name, switches,
-       kind=ModeKind...)``); :meth:`declare_channels` its own channels with their units
+       ModeKind..., owner=NAME)``); :meth:`declare_channels` its own channels with their units
        (``machine.channel(name, unit)``); :meth:`initial_rate` the initial rate of a
        joint coordinate (spec §7).
     4. :meth:`kinematics`: over the math namespace ``ev.mathns`` (floats or CasADi
@@ -93,7 +94,7 @@ class BodyElement(ABC):
             def drive_torque(self, ev):
                 return ev.p(f"{self.name}.torque")
 
-    It then runs in every solver, the generated code and the FMU:
+    It then runs in every solver and in the generated code:
     ``θ̇(t) = τ t / J`` [rad/s] (``tests/test_part_protocol.py``).
     """
 
