@@ -159,10 +159,8 @@ class _Linearisation:
         for b in m.rolls:
             if f"{b.name}.com_offset" in m.param_names:
                 p[m.param_index(f"{b.name}.com_offset")] = 0.0
-        for b in m.bodies:
-            if b.prescribed:  # full speed from t = 0
-                p[m.param_index(f"{b.name}.ramp_time")] = 0.0
-                p[m.param_index(f"{b.name}.web_speed")] = v
+        for b in m.bodies:  # the prescribed ones at full speed from t = 0
+            b.hold_operating_speed(m, p, v)
         self.t = 0.0
         self.roll = m.entry.b
         self.i_r = m.index(f"{self.roll.name}.radius")
@@ -232,7 +230,7 @@ class _Linearisation:
         y = np.array(m.state_initial, dtype=float)
         y[self.i_r] = r
         # no slip, θ̇_b = −θ̇_a r_a / r_b across each nip, from the drums
-        omega = {b.name: b.sense * b.part.drive.ratio * self.v / b.part.radius
+        omega = {b.name: b.sense * b.operating_speed(self.v)
                  for b in m.bodies if b.prescribed}
         for _ in m.nips:
             for n in m.nips:
@@ -754,7 +752,7 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
             natural[j, i] = m.natural_frequency
         if len(ms) > nt:
             slip[:, i] = ms[nt].natural_frequency, ms[nt].damping_ratio
-    drums = {b.name: b.part.drive.ratio * v / (2 * math.pi * b.part.radius)
+    drums = {b.name: b.operating_speed(v) / (2 * math.pi)
              for b in lin.machine.bodies if b.prescribed}
     ratio = _entry_drum(scene).drive.ratio  # the roll's surface runs at ratio · v
     return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),

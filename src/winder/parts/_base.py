@@ -69,7 +69,9 @@ class BodyElement(ABC):
        :meth:`drive_torque` (an input torque [N·m], operation sense),
        :meth:`outputs` (its channels, ``ev.set_channel``), :meth:`fixed_at_rest`
        (coordinates the static balance does not solve for), :meth:`breakpoints` (times
-       [s] where its prescribed motion has a kink), :meth:`structure_tag`
+       [s] where its prescribed motion has a kink), :meth:`operating_speed` and
+       :meth:`hold_operating_speed` (a prescribed drive at a given web speed, for the
+       resonance map), :meth:`structure_tag`
        (what changes its generated code beyond its names).
     6. Register it: one line in :data:`winder.parts.PARTS` (scene attribute → class).
 
@@ -158,6 +160,17 @@ class BodyElement(ABC):
     def breakpoints(self) -> tuple[float, ...]:
         """Times [s] where its prescribed motion has a kink (the integrators stop there)."""
         return ()
+
+    def operating_speed(self, web_speed: float) -> float:
+        """Its speed [rad/s] (operation sense) once a prescribed drive runs at
+        ``web_speed`` [m/s] (the operating point of the resonance map); only where
+        :attr:`prescribed`."""
+        raise NotImplementedError(f"{self!r} has no prescribed operating speed")
+
+    def hold_operating_speed(  # noqa: B027 - optional hook
+            self, machine: Machine, params: Any, web_speed: float) -> None:
+        """Set its run-time parameters in ``params`` so that a prescribed drive runs at
+        ``web_speed`` [m/s] from ``t = 0`` (default: nothing to set)."""
 
     def radius_of(self, y: Any, machine: Machine) -> float:
         """Its radius [m] in state ``y``."""

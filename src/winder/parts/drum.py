@@ -95,6 +95,16 @@ class DrumBody(RigidDisc):
         return (dr.web_speed / dr.web_acceleration,) \
             if self.prescribed and dr.web_acceleration > 0 else ()
 
+    def operating_speed(self, web_speed: float) -> float:
+        """``ratio · v / R`` [rad/s]."""
+        return self.part.drive.ratio * web_speed / self.part.radius
+
+    def hold_operating_speed(self, machine: Machine, params: Any, web_speed: float) -> None:
+        """No ramp: ``ramp_time = 0``, ``web_speed = v``."""
+        if self.prescribed:
+            params[machine.param_index(f"{self.name}.ramp_time")] = 0.0
+            params[machine.param_index(f"{self.name}.web_speed")] = web_speed
+
     def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
         n, mathns, t = self.name, ev.mathns, ev.t
         if self.prescribed:  # machines.md §6: Ω = ratio·min(a_w t, v_w)/R
