@@ -15,6 +15,9 @@ from collections.abc import Iterable
 from types import SimpleNamespace as NS
 from typing import Any
 
+from winder.forces import force_elements
+from winder.parts import body_elements
+
 __all__ = ["EFFECTS", "effects", "contact", "friction", "speed_profile", "torque_drive",
            "drum", "wound_roll", "rider", "nip", "machine_scene", "override", "two_drum",
            "single_drum", "free_roll"]
@@ -90,11 +93,22 @@ def nip(name: str, a: str, b: str, law: str = "linear", **kw: Any) -> NS:
 
 def machine_scene(name: str, *, drums: Iterable[NS] = (), rolls: Iterable[NS] = (),
                   riders: Iterable[NS] = (), nips: Iterable[NS] = (),
-                  web: NS | None = None, fx: NS | None = None, gravity: float = 9.81) -> NS:
-    """A scene object with parts (what ``Machine(scene)`` reads)."""
-    return NS(name=name, scene=NS(name=name, gravity=gravity, duration=10.0, output_step=0.01),
-              effects=fx if fx is not None else effects(), drums=tuple(drums),
-              rolls=tuple(rolls), riders=tuple(riders), nips=tuple(nips), web=web)
+                  web: NS | None = None, effect_flags: NS | None = None,
+                  gravity: float = 9.81) -> NS:
+    """A scene object with parts (what ``Machine(scene)`` reads; ``elements()`` as a
+    :class:`winder.Scene`'s)."""
+    sc = NS(name=name, scene=NS(name=name, gravity=gravity, duration=10.0, output_step=0.01),
+            effects=effect_flags if effect_flags is not None else effects(),
+            drums=tuple(drums), rolls=tuple(rolls), riders=tuple(riders), nips=tuple(nips),
+            web=web)
+    sc.elements = lambda: elements(sc)
+    return sc
+
+
+def elements(scene: Any) -> tuple[list[Any], list[Any]]:
+    """The body and force elements of ``scene`` (as :meth:`winder.Scene.elements`)."""
+    bodies = body_elements(scene)
+    return bodies, force_elements(scene.effects, bodies)
 
 
 def override(scene: NS, values: dict[str, Any]) -> NS:
@@ -141,7 +155,8 @@ def two_drum(*, drive: str = "speed_profile", law: str = "linear", rider_roll: b
         riders = (rider("rider", "set"),)
         nips.append(nip("rider_nip", "set", "rider", law))
     sc = machine_scene("two_drum", drums=drums, rolls=rolls, riders=riders, nips=nips,
-                       web=NS(entry_nip="rear_nip", tension=1000.0), fx=effects(**flags))
+                       web=NS(entry_nip="rear_nip", tension=1000.0),
+                       effect_flags=effects(**flags))
     return override(sc, values or {})
 
 
@@ -155,7 +170,7 @@ def single_drum(*, drive: str = "speed_profile", law: str = "linear",
     r = wound_roll("roll", (0.0, 0.55), free)
     sc = machine_scene("single_drum", drums=(d,), rolls=(r,),
                        nips=(nip("nip", "drum", "roll", law),),
-                       web=NS(entry_nip="nip", tension=200.0), fx=effects(**flags))
+                       web=NS(entry_nip="nip", tension=200.0), effect_flags=effects(**flags))
     return override(sc, values or {})
 
 
@@ -163,5 +178,5 @@ def free_roll(*, free: Iterable[str] = ("x", "z"), values: dict[str, Any] | None
               **flags: bool) -> NS:
     """One wound roll ``roll`` alone (no drum, no nip, no web): a free-flying body."""
     sc = machine_scene("free_roll", rolls=(wound_roll("roll", (0.0, 1.0), free),),
-                       fx=effects(**flags))
+                       effect_flags=effects(**flags))
     return override(sc, values or {})

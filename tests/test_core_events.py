@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import winder
-from winder.model.machine import AT_CORE, WINDING
+from winder.model.locked_modes import AT_CORE, WINDING
 from winder.solve import integrators as integ
 from winder.solve.dopri5 import dopri5
 from winder.solve.rk4 import rk4

@@ -22,7 +22,8 @@ import numpy as np
 from winder._errors import WinderError
 from winder.forces.web_tension import exit_point
 from winder.io.result import Result
-from winder.model.machine import Body, Machine, Web
+from winder.model.machine import Machine, Web
+from winder.parts import BodyElement as Body
 from winder.scene.load import Scene
 
 __all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
@@ -43,6 +44,8 @@ _LEGACY = {"drum": {"angle": "drum_angle", "speed": "drum_speed"},
            "roll": {"z": "z", "angle": "roll_angle", "speed": "roll_speed",
                     "radius": "radius"}}
 _LEGACY_NIP = "normal_force"
+#: (body, role) of the single-drum format whose channel may be missing (drawn still)
+_LEGACY_OPTIONAL = {("drum", "angle")}
 
 
 def scene_of(result: Result, scene: Scene | None = None) -> Scene | None:
@@ -67,8 +70,8 @@ def body_channels(scene: Scene | None, body: Body) -> dict[str, str]:
     that the result carries; a role without a channel is constant (fixed coordinate,
     constant radius)."""
     if _legacy(scene):
-        return dict(_LEGACY[body.kind])
-    roles = [*body.free, "angle", "speed", *(("radius",) if body.kind == "roll" else ())]
+        return dict(_LEGACY[body.name])
+    roles = [*body.free, "angle", "speed", *(("radius",) if body.radius_state else ())]
     return {role: f"{body.name}_{role}" for role in roles}
 
 
@@ -81,7 +84,7 @@ def nip_channels(scene: Scene | None, machine: Machine) -> dict[str, str]:
 
 def _optional(scene: Scene | None, role: str, body: Body) -> bool:
     # the old format's drum angle is optional (the drum is then drawn still)
-    return _legacy(scene) and body.kind == "drum" and role == "angle"
+    return _legacy(scene) and (body.name, role) in _LEGACY_OPTIONAL
 
 
 def drawn_channels(scene: Scene | None, machine: Machine) -> list[str]:
@@ -110,7 +113,7 @@ def check_drawable(result: Result, where: str = "result", scene: Scene | None = 
     else:
         m = Machine(scene)
         required = drawn_channels(scene, m)
-        radii = [body_channels(scene, b)["radius"] for b in m.bodies if b.kind == "roll"]
+        radii = [body_channels(scene, b)["radius"] for b in m.bodies if b.radius_state]
     missing = [c for c in required if c not in result]
     if missing:
         raise WinderError(f"{where}: no channel {', '.join(missing)} (the viewer draws "
@@ -132,16 +135,18 @@ def check_drawable(result: Result, where: str = "result", scene: Scene | None = 
 class BodyMotion:
     """One body at the sample times: centre ``x``, ``z`` [m], model angle ``theta`` about
     ``+y`` [rad] (``sense · angle``), ``radius`` [m], ``speed`` [rad/s] (operation
-    sense)."""
+    sense); ``role`` how it is drawn (:attr:`winder.parts.BodyElement.role`),
+    ``radius_state`` whether its radius changes (a channel of its own)."""
 
     name: str
-    kind: str
+    role: str
     sense: int
     x: np.ndarray
     z: np.ndarray
     theta: np.ndarray
     radius: np.ndarray
     speed: np.ndarray
+    radius_state: bool = False
 
 
 @dataclass(frozen=True)
@@ -221,15 +226,15 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
     for b in m.bodies:
         ch = body_channels(scene, b)
         const = {"x": b.centre[0], "z": b.centre[1], "angle": 0.0, "speed": 0.0,
-                 "radius": b.part.radius if b.kind != "roll" else math.nan}
+                 "radius": math.nan if b.radius_state else b.part.radius}
 
         def get(role: str, ch: dict = ch, const: dict = const) -> np.ndarray:
             if role in ch and ch[role] in result:
                 return sample(ch[role])
             return np.full_like(times, const[role])
-        bodies[b.name] = BodyMotion(b.name, b.kind, b.sense, get("x"), get("z"),
+        bodies[b.name] = BodyMotion(b.name, b.role, b.sense, get("x"), get("z"),
                                     b.sense * get("angle") * spin_gain, get("radius"),
-                                    get("speed"))
+                                    get("speed"), b.radius_state)
     forces = {n: (sample(c) if c in result else None)
               for n, c in nip_channels(scene, m).items()}
     webs = []
@@ -262,7 +267,7 @@ def exit_points(machine: Machine, bodies: dict[str, BodyMotion], web: Web | None
     if web is None:
         web = next(w for w in machine.webs if w.unwind is not None)
     u, a = web.unwind, web.entry.a
-    ev = SimpleNamespace(machine=machine, M=np, bodies={
+    ev = SimpleNamespace(machine=machine, mathns=np, bodies={
         u.name: kin(bodies[u.name], u), a.name: kin(bodies[a.name], a)})
     _, _, ox, oz = exit_point(ev, web)
     return np.column_stack([bodies[u.name].x + ox, bodies[u.name].z + oz])

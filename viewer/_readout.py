@@ -35,7 +35,7 @@ def readout_text(m: Motion, k: int) -> str:
     labels = ["span" if len(spans) == 1 else f"{w.name} span" for w in spans]
     width = max(len(n) for n in (*m.bodies, *m.normal_forces, "span", *labels))
     for b in m.bodies.values():
-        if b.kind == "roll":
+        if b.radius_state:
             lines.append(f"{b.name:<{width}}  r {b.radius[k]:8.4f} m")
     for b in m.bodies.values():
         w = b.speed[k]

@@ -61,13 +61,13 @@ class WinderGraph:
         self.machine = Machine(self.scene)
         self.model = self.machine.model
         self.data = self.model.createData()
-        rolls = [b.part for b in self.machine.bodies if b.kind == "roll"]
+        rolls = [b.part for b in self.machine.bodies if b.role == "roll"]
         #: Length of the drums [m]: the widest roll's width.
         self.length = max((r.width for r in rolls), default=1.0)
         #: Bodies on stands (drums and unwinding rolls: fixed centres) or, without any,
         #: every body: the floor spans them and each stand gets a far side frame.
-        self.stands = [b for b in self.machine.bodies
-                       if b.kind == "drum" or b.unwinding] or self.machine.bodies
+        self.fixed = [b for b in self.machine.bodies if not b.free]
+        self.stands = self.fixed or self.machine.bodies
         #: Height of the floor [m]: 0.35 m below the lowest stand.
         self.floor_z = min(b.centre[1] - _radius0(b) for b in self.stands) - 0.35
         entry = self.machine.entry
@@ -83,11 +83,11 @@ class WinderGraph:
         on the machine's initial layout."""
         root, L = vis[self.root], self.length
         lam = g.MeshLambertMaterial
-        width = {b.name: b.part.width for b in self.machine.bodies if b.kind == "roll"}
+        width = {b.name: b.part.width for b in self.machine.bodies if b.role == "roll"}
         # meshcat cylinders lie along their local y axis: the machine's cross axis
         for b in self.machine.bodies:
             node = root[b.name]
-            if b.kind == "roll":
+            if b.role == "roll":
                 w, rc = b.part.width, b.part.core_radius
                 node["core"].set_object(g.Cylinder(1.08 * w, rc), lam(color=COLOURS["core"]))
                 node["paper"].set_object(g.Cylinder(w, 1.0), lam(color=COLOURS["paper"]))
@@ -100,8 +100,8 @@ class WinderGraph:
                 node["com"].set_transform(_translation([COM_MARKER_GAIN * e, -0.56 * w, 0.0]))
                 continue
             R = b.part.radius
-            length = 1.05 * L if b.kind == "drum" else width.get(b.part.rides, L)
-            colour = COLOURS["drum"] if b.kind == "drum" else COLOURS["rider"]
+            length = 1.05 * L if b.role == "drum" else width.get(b.rides, L)
+            colour = COLOURS[b.role]
             node["shell"].set_object(g.Cylinder(length, R), lam(color=colour))
             node["mark"].set_object(g.Box([0.9 * R, 1.01 * length + 0.01, 0.04 * R]),
                                     lam(color=COLOURS["frame"]))
@@ -118,13 +118,12 @@ class WinderGraph:
         root["floor"].set_object(g.Box([x1 - x0, 1.2 * L, 0.05]),
                                  lam(color=COLOURS["floor"]))
         root["floor"].set_transform(_translation([0.5 * (x0 + x1), 0.0, self.floor_z]))
-        for b in self.machine.bodies:
-            if b.kind == "drum" or b.unwinding:
-                h = b.centre[1] - self.floor_z
-                root["frame"][b.name].set_object(g.Box([0.25, 0.08, h]),
-                                                 lam(color=COLOURS["frame"]))
-                root["frame"][b.name].set_transform(
-                    _translation([b.centre[0], 0.62 * L, self.floor_z + 0.5 * h]))
+        for b in self.fixed:
+            h = b.centre[1] - self.floor_z
+            root["frame"][b.name].set_object(g.Box([0.25, 0.08, h]),
+                                             lam(color=COLOURS["frame"]))
+            root["frame"][b.name].set_transform(
+                _translation([b.centre[0], 0.62 * L, self.floor_z + 0.5 * h]))
         vis["/Grid"].set_property("visible", False)
         vis["/Axes"].set_property("visible", False)
         self.set_camera(vis, self.initial_extent())
@@ -181,7 +180,7 @@ class WinderGraph:
         out: list[Pose] = []
         for b in self.machine.bodies:
             out.append(("transform", (b.name,), T[b.name]))
-            if b.kind == "roll":
+            if b.radius_state:
                 r = float(bodies[b.name].radius[k])
                 out.append(("scale", (b.name, "paper"), [r, 1.0, r]))
         for (node, _), path in zip(self.web_nodes, m.web_paths(k), strict=True):
@@ -214,7 +213,7 @@ def apply_poses(root, commands: list[Pose], scale: Callable[[object, list], None
 
 
 def _radius0(b) -> float:
-    return b.part.initial_radius if b.kind == "roll" else b.part.radius
+    return b.initial_radius
 
 
 def _translation(p: list[float]) -> np.ndarray:

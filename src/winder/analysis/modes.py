@@ -284,7 +284,7 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
             natural[j, i] = m.natural_frequency
         if len(ms) > nt:
             slip[:, i] = ms[nt].natural_frequency, ms[nt].damping_ratio
-    drums = {b.name: b.part.drive.ratio * v / (2 * math.pi * b.part.radius)
+    drums = {b.name: b.operating_speed(v) / (2 * math.pi)
              for b in lin.machine.bodies if b.prescribed}
     ratio = _entry_drum(scene).drive.ratio  # the roll's surface runs at ratio · v
     return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),

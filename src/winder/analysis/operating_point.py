@@ -39,7 +39,7 @@ import numpy as np
 from winder._args import number, show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.linearise import jacobian
-from winder.model.machine import AUTO, IN_CONTACT
+from winder.model.locked_modes import AUTO, IN_CONTACT, ModeKind
 from winder.scene.load import _MAX, Scene
 from winder.solve.equilibrium import EquilibriumError, nip_key, resting_state
 from winder.solve.system import MachineSystem
@@ -149,10 +149,8 @@ class _Linearisation:
         for b in m.rolls:
             if f"{b.name}.com_offset" in m.param_names:
                 p[m.param_index(f"{b.name}.com_offset")] = 0.0
-        for b in m.bodies:
-            if b.prescribed:  # full speed from t = 0
-                p[m.param_index(f"{b.name}.ramp_time")] = 0.0
-                p[m.param_index(f"{b.name}.web_speed")] = v
+        for b in m.bodies:  # the prescribed ones at full speed from t = 0
+            b.hold_operating_speed(m, p, v)
         self.t = 0.0
         self.roll = m.entry.b
         self.i_r = m.index(f"{self.roll.name}.radius")
@@ -175,7 +173,7 @@ class _Linearisation:
         self._speed_slots = np.arange(len(self.positions),
                                       len(self.positions) + len(self.speeds))
         self.v_ref = min(n.part.friction.slip_velocity for n in m.nips)
-        self.contact = np.array([n.endswith(".contact") for n in m.mode_names])
+        self.contact = np.array([mode.kind is ModeKind.CONTACT for mode in m.modes])
         self.idle: list[str] = []  # states without dynamics, found at the first solve
         self._idle_checked = False
 
@@ -222,7 +220,7 @@ class _Linearisation:
         y = np.array(m.state_initial, dtype=float)
         y[self.i_r] = r
         # no slip, θ̇_b = −θ̇_a r_a / r_b across each nip, from the drums
-        omega = {b.name: b.sense * b.part.drive.ratio * self.v / b.part.radius
+        omega = {b.name: b.sense * b.operating_speed(self.v)
                  for b in m.bodies if b.prescribed}
         for _ in m.nips:
             for n in m.nips:

@@ -23,26 +23,44 @@ class ForceElement(ABC):
     the channels or the CLI):
 
     1. Subclass :class:`ForceElement` in its own module under ``winder/forces/``; set
-       ``name`` (the ``[effects]`` key) and ``order`` (lower runs first; an effect that
-       reads what another wrote runs after it).
-    2. In :meth:`declare`, register with the :class:`~winder.model.machine.Machine` what it
+       ``name`` (the ``[effects]`` key).
+    2. Declare the quantities it writes for others (``provides``) and reads from others
+       (``requires``: some element must provide it; ``uses``: read where provided, else a
+       default), as frozensets of names. The machine runs every provider before its
+       readers (:func:`~winder.model.element_order.order_elements`; ties in registration
+       order; a missing provider or a cycle is an
+       :class:`~winder.model.element_order.ElementOrderError`). The quantities:
+       ``"gravity"`` [m/s²] (ABA's gravity), ``"drive_torque"`` [N·m] by body (operation
+       sense), ``"spatial_force"`` by body (``[f; τ]`` in its joint frame, through
+       ``ev.add_spatial_force``), ``"span_rate"`` [N/s] by web, ``"com_offset"`` [m]
+       (``BodyState.com_offset``), ``"steady_friction"`` [N] (``NipState``).
+    3. In :meth:`declare`, register with the :class:`~winder.model.machine.Machine` what it
        needs: run-time parameters (``machine.parameter(name, value)``, values from the
-       scene's parts), states (``machine.state(name, initial)``), result channels
-       (``machine.channel(name)``).
-    3. In :meth:`apply`, read the :class:`~winder.model.machine.Evaluation` (``ev.M`` is
-       the math namespace; ``ev.p(name)`` a parameter, ``ev.x(name)`` a state,
-       ``ev.bodies``/``ev.nips`` the kinematics), add forces with ``ev.add_force``, write
-       state derivatives with ``ev.set_rate`` and channels with ``ev.set_channel``. Branch
-       on states only through ``ev.M.if_else``/``fmax`` (the generated code is
-       branch-free).
-    4. Register the class in ``winder/forces/__init__.py`` (``FORCES``, one line) and add
-       the key to ``[effects]`` in the scene schema.
+       scene's parts), states (``machine.state(name, initial)``), result channels with
+       their units (``machine.channel(name, unit)``), locked modes
+       (``machine.mode(name, switches, ModeKind..., owner=part)``).
+    4. In :meth:`apply`, read the :class:`~winder.model.machine.Evaluation`
+       (``ev.mathns`` is the math namespace; ``ev.p(name)`` a parameter, ``ev.x(name)`` a
+       state, ``ev.bodies``/``ev.nips`` the kinematics, ``ev.provided(quantity, key)``
+       what another element provides), add forces with ``ev.add_force``, write state
+       derivatives with ``ev.set_rate``, channels with ``ev.set_channel`` and what it
+       provides with ``ev.provide(quantity, key, value)``. Branch on states only through
+       ``ev.mathns.if_else``/``fmax`` (the generated code is branch-free).
+    5. Register the class in ``winder/forces/__init__.py`` (``FORCES``, one line; one that
+       a body's drive calls for, by its ``drives``, in ``DRIVES``) and add the key to
+       ``[effects]`` in the scene schema.
 
     An effect that is off is never instantiated, so it costs nothing.
     """
 
     name: ClassVar[str]
-    order: ClassVar[int] = 50
+
+    #: quantities it writes for other elements and the machine
+    provides: ClassVar[frozenset[str]] = frozenset()
+    #: quantities it reads, which some element must provide
+    requires: ClassVar[frozenset[str]] = frozenset()
+    #: quantities it reads where some element provides them (else a default)
+    uses: ClassVar[frozenset[str]] = frozenset()
 
     def declare(self, machine: Machine) -> None:  # noqa: B027 - optional hook
         """Register parameters, states and channels (once, when the machine is built)."""

@@ -23,7 +23,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from winder.forces._base import ForceElement
-from winder.model.machine import FREE, IN_CONTACT
+from winder.model.locked_modes import FREE, IN_CONTACT, ModeKind
 
 if TYPE_CHECKING:
     from winder.model.machine import Evaluation, Machine, NipState
@@ -32,26 +32,26 @@ __all__ = ["Contact", "unclamped_force", "normal_force", "push",
            "rest_penetration"]
 
 
-def unclamped_force(M: Any, law: str, par: Any, delta: Any, delta_dot: Any) -> Any:
+def unclamped_force(mathns: Any, law: str, par: Any, delta: Any, delta_dot: Any) -> Any:
     """The contact law without its clamp [N]; ``par(key)`` reads the nip's parameters."""
     if law == "linear":
         return par("stiffness") * delta + par("damping") * delta_dot
-    return par("stiffness") * delta * M.power_abs(delta, par("exponent") - 1.0) \
+    return par("stiffness") * delta * mathns.power_abs(delta, par("exponent") - 1.0) \
         * (1.0 + par("hc_damping") * delta_dot)
 
 
-def normal_force(M: Any, mode: Any, delta: Any, f_unclamped: Any) -> Any:
+def normal_force(mathns: Any, mode: Any, delta: Any, f_unclamped: Any) -> Any:
     """``F_n`` [N] in the locked ``mode``."""
-    auto = M.if_else(delta > 0.0, M.fmax(f_unclamped, 0.0), 0.0)
-    return M.if_else(mode == IN_CONTACT, f_unclamped,
-                     M.if_else(mode == FREE, 0.0, auto))
+    auto = mathns.if_else(delta > 0.0, mathns.fmax(f_unclamped, 0.0), 0.0)
+    return mathns.if_else(mode == IN_CONTACT, f_unclamped,
+                     mathns.if_else(mode == FREE, 0.0, auto))
 
 
 class Contact(ForceElement):
     """Normal force and slip friction at every nip."""
 
     name = "contact"
-    order = 20
+    provides = frozenset({"steady_friction"})
     relaxed = False
 
     def declare(self, machine: Machine) -> None:
@@ -65,10 +65,11 @@ class Contact(ForceElement):
             machine.parameter(f"{nip.name}.mu", f.mu)
             machine.parameter(f"{nip.name}.slip_velocity", f.slip_velocity)
             machine.mode(f"{nip.name}.contact", tuple(
-                f"{nip.name}.{g}" for g in ("contact", "overlap", "dx", "dz")))
+                f"{nip.name}.{g}" for g in ("contact", "overlap", "dx", "dz")),
+                ModeKind.CONTACT, owner=nip.name)
 
     def apply(self, ev: Evaluation) -> None:
-        M = ev.M
+        mathns = ev.mathns
         for ns in ev.nips.values():
             nip = ns.nip
             law = nip.part.contact.law
@@ -76,15 +77,15 @@ class Contact(ForceElement):
             def par(key: str, nip: Any = nip) -> Any:
                 return ev.p(f"{nip.name}.{key}")
 
-            fu = unclamped_force(M, law, par, ns.delta, ns.delta_dot)
-            ev.switches[f"{nip.name}.contact"] = M.fmin(ns.delta, fu / par("stiffness"))
+            fu = unclamped_force(mathns, law, par, ns.delta, ns.delta_dot)
+            ev.switches[f"{nip.name}.contact"] = mathns.fmin(ns.delta, fu / par("stiffness"))
             a, b = ev.bodies[nip.a.name], ev.bodies[nip.b.name]
-            ev.switches[f"{nip.name}.overlap"] = ns.delta - M.fmin(a.r, b.r)
+            ev.switches[f"{nip.name}.overlap"] = ns.delta - mathns.fmin(a.r, b.r)
             ev.switches[f"{nip.name}.dx"] = b.cx - a.cx
             ev.switches[f"{nip.name}.dz"] = b.cz - a.cz
-            fn = normal_force(M, ev.mode(f"{nip.name}.contact"), ns.delta, fu)
+            fn = normal_force(mathns, ev.mode(f"{nip.name}.contact"), ns.delta, fu)
             ns.normal_force = fn
-            ns.steady_friction = par("mu") * fn * M.tanh(ns.v_s / par("slip_velocity"))
+            ns.steady_friction = par("mu") * fn * mathns.tanh(ns.v_s / par("slip_velocity"))
             push(ev, ns, fn, 0.0)
             if not self.relaxed:
                 ns.friction_force = ns.steady_friction

@@ -16,13 +16,13 @@ class Gravity(ForceElement):
     """Sets the gravity of ABA/RNEA; in the static balance, each body's weight."""
 
     name = "gravity"
-    order = 0
+    provides = frozenset({"gravity"})
 
     def declare(self, machine: Machine) -> None:
         machine.parameter("gravity", machine.scene.scene.gravity)
 
     def apply(self, ev: Evaluation) -> None:
-        ev.gravity = ev.p("gravity")
+        ev.provide("gravity", "", ev.p("gravity"))
 
     def static(self, ev: Evaluation) -> None:
         g = ev.p("gravity")

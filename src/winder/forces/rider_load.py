@@ -14,37 +14,38 @@ if TYPE_CHECKING:
 __all__ = ["RiderLoad", "line_load"]
 
 
-def line_load(M: Any, r: Any, points: list[tuple[Any, Any]]) -> Any:
+def line_load(mathns: Any, r: Any, points: list[tuple[Any, Any]]) -> Any:
     """``q(r)`` [N/m]: piecewise linear through ``points`` ``(radius, load)``, held
     constant beyond the first and the last."""
     q = points[-1][1]
     for (r0, q0), (r1, q1) in reversed(list(zip(points[:-1], points[1:], strict=True))):
-        q = M.if_else(r < r1, q0 + (q1 - q0) * (r - r0) / (r1 - r0), q)
-    return M.if_else(r < points[0][0], points[0][1], q)
+        q = mathns.if_else(r < r1, q0 + (q1 - q0) * (r - r0) / (r1 - r0), q)
+    return mathns.if_else(r < points[0][0], points[0][1], q)
 
 
 class RiderLoad(ForceElement):
     """The applied load of every rider roll with a load schedule."""
 
     name = "rider_load"
-    order = 40
 
     def declare(self, machine: Machine) -> None:
-        for b in machine.bodies:
-            if b.kind == "rider":
-                for i, (r, q) in enumerate(b.part.load):
-                    machine.parameter(f"{b.name}.load_radius_{i}", r)
-                    machine.parameter(f"{b.name}.line_load_{i}", q)
-                machine.channel(f"{b.name}_load")
+        for b in _riders(machine):
+            for i, (r, q) in enumerate(b.load):
+                machine.parameter(f"{b.name}.load_radius_{i}", r)
+                machine.parameter(f"{b.name}.line_load_{i}", q)
+            machine.channel(f"{b.name}_load", "N")
 
     def apply(self, ev: Evaluation) -> None:
-        for b in ev.machine.bodies:
-            if b.kind != "rider":
-                continue
+        for b in _riders(ev.machine):
             n = b.name
             pts = [(ev.p(f"{n}.load_radius_{i}"), ev.p(f"{n}.line_load_{i}"))
-                   for i in range(len(b.part.load))]
-            roll = ev.bodies[b.part.rides]
-            f = ev.p(f"{roll.body.name}.width") * line_load(ev.M, roll.r, pts) if pts else 0.0
+                   for i in range(len(b.load))]
+            roll = ev.bodies[b.rides]
+            f = ev.p(f"{roll.body.name}.width") * line_load(ev.mathns, roll.r, pts) if pts else 0.0
             ev.add_force(n, 0.0, -f)
             ev.set_channel(f"{n}_load", f)
+
+
+def _riders(machine: Machine) -> list[Any]:
+    """The bodies that ride another under a line-load schedule (``rides``, ``load``)."""
+    return [b for b in machine.bodies if getattr(b, "rides", None) is not None]

@@ -19,7 +19,7 @@ class SlipRelaxation(ForceElement):
     """One friction state ``NIP.friction`` [N] per nip."""
 
     name = "slip_relaxation"
-    order = 30
+    uses = frozenset({"steady_friction"})
 
     def declare(self, machine: Machine) -> None:
         for nip in machine.nips:
@@ -29,11 +29,11 @@ class SlipRelaxation(ForceElement):
             machine.state(f"{nip.name}.friction", 0.0)
 
     def apply(self, ev: Evaluation) -> None:
-        M = ev.M
+        mathns = ev.mathns
         for ns in ev.nips.values():
             n = ns.nip.name
             ft = ev.x(f"{n}.friction")
             ns.friction_force = ft
-            ev.set_rate(f"{n}.friction", (M.fabs(ns.u_a) + ev.p(f"{n}.min_speed"))
+            ev.set_rate(f"{n}.friction", (mathns.fabs(ns.u_a) + ev.p(f"{n}.min_speed"))
                         / ev.p(f"{n}.relaxation_length") * (ns.steady_friction - ft))
             push(ev, ns, 0.0, ft)

@@ -37,21 +37,22 @@ class TensionController(ForceElement):
     span of its web); state ``ROLL.tension_integral`` [N·s]."""
 
     name = "tension_control"
-    order = 45  # after web_tension (the span's tension and its rate)
+    requires = frozenset({"span_rate"})
+    provides = frozenset({"drive_torque"})
 
     def declare(self, machine: Machine) -> None:
         for w in machine.webs:
             b = w.unwind
-            if b is None or not b.controlled:
+            if b is None or self.name not in b.drives:
                 continue
             machine.parameter(f"{b.name}.tension_setpoint", b.part.drive.tension)
             machine.parameter(f"{b.name}.bandwidth", b.part.drive.bandwidth)
             machine.state(f"{b.name}.tension_integral", 0.0)
-            machine.channel(f"{w.span_channel}tension_error")
+            machine.channel(f"{w.span_channel}tension_error", "N")
 
     def apply(self, ev: Evaluation) -> None:
         for w in ev.machine.webs:
-            if w.unwind is not None and w.unwind.controlled:
+            if w.unwind is not None and self.name in w.unwind.drives:
                 self._control(ev, w)
 
     @staticmethod
@@ -72,6 +73,6 @@ class TensionController(ForceElement):
         v2_dot = a_dot * a.r * a.body.sense
         w_ref_dot = (v2_dot * r - v2 * u.r_dot) / (r * r)
         tau = (J * w_ref_dot - r * T_set - kp * e
-               - ki * ev.x(f"{n}.tension_integral") + kd * ev.span_rates[w.name])
-        ev.drive_torques[n] = tau
+               - ki * ev.x(f"{n}.tension_integral") + kd * ev.provided("span_rate", w.name))
+        ev.provide("drive_torque", n, tau)
         ev.set_channel(f"{w.span_channel}tension_error", e)

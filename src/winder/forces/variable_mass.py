@@ -32,7 +32,8 @@ class VariableMass(ForceElement):
     """``fext −= Ẏ v`` on every paper roll, ``Ẏ = dY/dr · ṙ``."""
 
     name = "variable_mass"
-    order = 10
+    uses = frozenset({"com_offset"})
+    provides = frozenset({"spatial_force"})
 
     def apply(self, ev: Evaluation) -> None:
         for b in ev.machine.rolls:

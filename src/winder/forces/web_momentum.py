@@ -22,11 +22,10 @@ class WebMomentum(ForceElement):
     point; channel ``web_force`` [N] (at the entry; ``WEB_web_force`` with several webs)."""
 
     name = "web_momentum"
-    order = 40
 
     def declare(self, machine: Machine) -> None:
         for w in machine.webs:
-            machine.channel(f"{w.channel}web_force")
+            machine.channel(f"{w.channel}web_force", "N")
 
     def apply(self, ev: Evaluation) -> None:
         m = ev.machine

@@ -26,10 +26,10 @@ def exit_point(ev: Evaluation, web: Web) -> tuple[Any, Any, Any, Any]:
     unwinding roll (towards its entry drum's centre) and the exit point ``p_u − c_u``
     [m], on the side where the roll's surface moves along ``+t_u`` when it turns in its
     operation sense."""
-    M = ev.M
+    mathns = ev.mathns
     u, a = ev.bodies[web.unwind.name], ev.bodies[web.entry.a.name]
     dx, dz = a.cx - u.cx, a.cz - u.cz
-    d = M.sqrt(dx * dx + dz * dz)
+    d = mathns.sqrt(dx * dx + dz * dz)
     tx, tz = dx / d, dz / d
     s = u.body.sense
     return tx, tz, -s * tz * u.r, s * tx * u.r
@@ -39,7 +39,7 @@ class WebTension(ForceElement):
     """Each web's tension on its wound roll (and on the unwinding roll of its span)."""
 
     name = "web_tension"
-    order = 40
+    provides = frozenset({"span_rate"})
 
     def declare(self, machine: Machine) -> None:
         for w in machine.webs:
@@ -50,7 +50,7 @@ class WebTension(ForceElement):
                 machine.parameter(f"{k}span.length", span.length)
                 machine.parameter(f"{k}span.EA", span.EA)
                 machine.parameter(f"{k}span.T_in", span.T_in)
-                machine.channel(f"{w.span_channel}span_tension")
+                machine.channel(f"{w.span_channel}span_tension", "N")
             else:
                 machine.parameter(f"{w.key}web.tension", w.part.tension)
 
@@ -70,10 +70,10 @@ class WebTension(ForceElement):
             v1, v2 = u.r * u.speed, ns.u_a
             rate = (ev.p(f"{k}span.EA") * (v2 - v1) + v1 * ev.p(f"{k}span.T_in")
                     - v2 * state) / ev.p(f"{k}span.length")
-            ev.span_rates[w.name] = rate
+            ev.provide("span_rate", w.name, rate)
             ev.set_rate(f"{k}span.tension", rate)
             ev.set_channel(f"{w.span_channel}span_tension", state)
-            T = ev.M.fmax(state, 0.0)
+            T = ev.mathns.fmax(state, 0.0)
             tx, tz, ox, oz = exit_point(ev, w)
             ev.add_force(u.body.name, T * tx, T * tz, ox, oz)
         ev.add_force(b.body.name, -T * ns.tx, -T * ns.tz, -b.r * ns.nx, -b.r * ns.nz)

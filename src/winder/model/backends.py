@@ -19,7 +19,7 @@ class NumericBackend:
     Pinocchio path: the cross-check of the generated code, and the fallback without a C
     compiler)."""
 
-    M: MathNamespace = NUMERIC
+    mathns: MathNamespace = NUMERIC
 
     def __init__(self, model: pin.Model) -> None:
         self.model = model
@@ -107,7 +107,7 @@ class SymbolicBackend:
 
         if route not in ROUTES:
             raise ArgumentError(f"route = {route!r} is unknown; valid: {', '.join(ROUTES)}")
-        self.M = SYMBOLIC
+        self.mathns = SYMBOLIC
         self.route = route
         self.f: Any = _CppRoute(model) if route == "cpp" else SpatialFunctions(model)
         self._vel: Any = None

@@ -1,64 +1,64 @@
 """A machine built from parts: one Pinocchio model, a named state layout, run-time
 parameters, and its dynamics written once over a math namespace.
 
-``Machine(scene)`` reads the scene's parts (machines.md §1–§8):
+``Machine(scene)`` assembles the scene's body elements (:mod:`winder.parts`: drums, paper
+rolls, riders, ...) and force elements (:mod:`winder.forces`), which the scene gives
+(``scene.elements()``), and knows no kind of body (machines.md §1–§8):
 
-- every body (drum, roll, rider) gets its own joints to the world in one ``pin.Model``:
-  prismatic ``x`` and/or ``z`` where it is free, then a revolute joint about ``+y``; the
-  first joint's placement holds the fixed coordinates of its centre;
+- every body gets its joints in one ``pin.Model``, hung off its parent (the world unless
+  the body declares another body): prismatic ``x`` and/or ``z`` where it is free, then a
+  revolute joint about ``+y``; the first joint's placement holds the fixed coordinates of
+  its centre;
 - the state vector is named (:attr:`Machine.state_names`): ``BODY.x``, ``BODY.z``,
   ``BODY.theta`` for the joint coordinates, ``BODY.x_dot``, ``BODY.z_dot``,
-  ``BODY.theta_dot`` for their rates, ``ROLL.radius`` for paper rolls and what the force
-  elements add (``NIP.friction`` for slip relaxation); a drum with a speed profile is
-  prescribed and has no state;
+  ``BODY.theta_dot`` for their rates, then what the bodies (``ROLL.radius``) and the
+  force elements (``NIP.friction`` for slip relaxation) add; a body whose rotation is
+  prescribed has no ``θ`` state;
 - every scene number the dynamics reads is a named run-time parameter
   (:attr:`Machine.param_names`), so one compiled model serves every value of them;
-- :meth:`Machine.evaluate` is the dynamics: kinematics of bodies and nips, the force
-  elements of :mod:`winder.forces`, the variable-mass ``−Ẏv``, and Pinocchio's ABA (and
-  RNEA for the drive torques) through a backend: numeric (``pin.aba``) or symbolic
-  (CasADi, for the generated code).
+- every result channel has a unit (:attr:`Machine.channel_units`);
+- :meth:`Machine.evaluate` is the dynamics: the bodies' kinematics and the nips', the
+  force elements in the order their declarations give (:mod:`winder.model.element_order`),
+  the variable-mass ``−Ẏv``, and Pinocchio's ABA (and RNEA for the drive torques) through a
+  backend: numeric (``pin.aba``) or symbolic (CasADi, for the generated code).
 
-Locked modes (the integrators lock them within a step and switch at located events):
-per nip the contact mode (:data:`AUTO`, :data:`FREE`, :data:`IN_CONTACT`), per wound
-roll the core mode of spec §2 (:data:`CORE_AUTO`, :data:`WINDING`, :data:`AT_CORE`).
+Locked modes (:mod:`winder.model.locked_modes`): the integrators lock them within a step
+and switch at located events.
 """
 
 from __future__ import annotations
 
 import hashlib
-import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from winder.model.element_order import order_elements
+from winder.model.locked_modes import (
+    AT_CORE,
+    AUTO,
+    CORE_AUTO,
+    FREE,
+    IN_CONTACT,
+    WINDING,
+    Mode,
+    ModeKind,
+)
 from winder.model.mass_law import paper_roll_mass
 
-__all__ = ["Machine", "Body", "Nip", "Web", "Evaluation", "AUTO", "FREE", "IN_CONTACT", "CORE_AUTO",
-           "WINDING", "AT_CORE"]
+__all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState", "AUTO", "FREE",
+           "IN_CONTACT", "CORE_AUTO", "WINDING", "AT_CORE", "Mode", "ModeKind",
+           "paper_roll_mass"]
 
-AUTO, FREE, IN_CONTACT = -1, 0, 1
-CORE_AUTO, WINDING, AT_CORE = -1, 0, 1
 _COORDS = ("x", "z")
-
-
-@dataclass
-class Body:
-    """A body of the machine (machines.md §1). ``joints`` maps ``x``/``z``/``theta`` to
-    Pinocchio joint ids; ``kind`` is ``drum``, ``roll`` or ``rider``."""
-
-    name: str
-    kind: str
-    sense: int
-    free: tuple[str, ...]
-    centre: tuple[float, float]
-    part: Any
-    joints: dict[str, int] = field(default_factory=dict)
-    prescribed: bool = False  # a drum with a speed profile
-    torque_input: bool = False  # a drum or an unwinding roll with a torque drive
-    unwinding: bool = False  # a paper roll that pays off its web (machines.md §1)
-    controlled: bool = False  # an unwinding roll under tension control
+#: Units of the generic channels of every body (machines.md §9) by suffix.
+_BODY_CHANNELS = (("speed", "rad/s"), ("angle", "rad"), ("torque", "N·m"),
+                  ("accel", "rad/s²"))
+_COORD_CHANNELS = (("", "m"), ("_dot", "m/s"), ("_accel", "m/s²"))
+_NIP_CHANNELS = (("normal_force", "N"), ("friction_force", "N"), ("slip_velocity", "m/s"),
+                 ("penetration", "m"))
 
 
 @dataclass
@@ -66,8 +66,8 @@ class Nip:
     """A nip between bodies ``a`` and ``b`` (machines.md §2)."""
 
     name: str
-    a: Body
-    b: Body
+    a: Any
+    b: Any
     part: Any
     index: int
 
@@ -86,7 +86,7 @@ class Web:
     part: Any
     entry: Nip
     span: Any = None
-    unwind: Body | None = None
+    unwind: Any = None
     key: str = ""
     channel: str = ""
     span_key: str = ""
@@ -99,38 +99,54 @@ class Machine:
     Parameters
     ----------
     scene: a :class:`~winder.Scene` (its parts: ``drums``, ``rolls``, ``riders``,
-        ``nips``, ``webs``; an object with only ``web`` is read as that one web).
+        ``nips``, ``webs``; an object with only ``web`` is read as that one web); its
+        ``elements()`` gives the body elements and the force elements.
+    bodies, forces: the body elements (:class:`winder.parts.BodyElement`) and force
+        elements (:class:`winder.forces.ForceElement`) instead of the scene's.
 
-    ``webs`` lists the :class:`Web` s; ``web``, ``entry`` are the first web's part and
-    entry nip, ``span``, ``unwind`` the first span and its unwinding roll (None without).
+    ``bodies`` lists the body elements; ``webs`` the :class:`Web` s; ``web``, ``entry`` are
+    the first web's part and entry nip, ``span``, ``unwind`` the first span and its
+    unwinding roll (None without).
     """
 
-    def __init__(self, scene: Any) -> None:
-        from winder.forces import DRIVES, FORCES
-
+    def __init__(self, scene: Any, *, bodies: Any = None, forces: Any = None) -> None:
         self.scene = scene
-        fx = scene.effects
-        self.bodies: list[Body] = []
-        for d in scene.drums:
-            self.bodies.append(Body(d.name, "drum", int(d.sense), (), tuple(d.centre), d,
-                                    prescribed=d.drive.kind == "speed_profile",
-                                    torque_input=d.drive.kind == "torque"))
-        for r in scene.rolls:
-            drive = getattr(r, "drive", None)
-            kind = drive.kind if drive is not None else None
-            self.bodies.append(Body(r.name, "roll", int(r.sense), tuple(r.free),
-                                    tuple(r.centre), r, torque_input=kind == "torque",
-                                    unwinding=r.kind == "unwinding",
-                                    controlled=kind == "tension_control"))
-        self.body = {b.name: b for b in self.bodies}
-        for x in scene.riders:  # initial guess: on top of the roll it rides
-            ridden = self.body[x.rides]
-            z = ridden.centre[1] + ridden.part.initial_radius + x.radius
-            self.bodies.append(Body(x.name, "rider", 1, ("z",), (float(x.x), z), x))
+        effects = scene.effects
+        if bodies is None or forces is None:
+            own_bodies, own_forces = scene.elements()
+            bodies = own_bodies if bodies is None else bodies
+            forces = own_forces if forces is None else forces
+        self.bodies: list[Any] = list(bodies)
         self.body = {b.name: b for b in self.bodies}
         self.nips = [Nip(n.name, self.body[n.a], self.body[n.b], n, i)
                      for i, n in enumerate(scene.nips)]
         self.nip = {n.name: n for n in self.nips}
+        self._assemble_webs(scene)
+        self.rolls = [b for b in self.bodies if b.variable_mass]
+        if self.span is not None and not effects.web_tension:
+            from winder._errors import ModelError
+
+            raise ModelError(f"{scene.source}: [effects] web_tension = false with a "
+                             "[web.span]: the span's tension is the web_tension effect; "
+                             "valid: web_tension = true, or no [web.span]")
+        self.model = self._build_model()
+        self.param_names: list[str] = []
+        self.param_values: list[float] = []
+        self.state_names: list[str] = []
+        self.state_initial: list[float] = []
+        self.channel_names: list[str] = []
+        self.channel_units: dict[str, str] = {}
+        self.modes: list[Mode] = []
+        self.mode_names: list[str] = []
+        self.switch_names: list[str] = []
+        self._declare_base()
+        self.forces = order_elements(list(forces))
+        for f in self.forces:
+            f.declare(self)
+        self._index = {n: i for i, n in enumerate(self.state_names)}
+        self._pindex = {n: i for i, n in enumerate(self.param_names)}
+
+    def _assemble_webs(self, scene: Any) -> None:
         parts = tuple(getattr(scene, "webs", None) or ()) or \
             ((scene.web,) if getattr(scene, "web", None) is not None else ())
         spans = sum(getattr(w, "span", None) is not None for w in parts)
@@ -146,39 +162,18 @@ class Machine:
         first = self.webs[0] if self.webs else None
         self.web = first.part if first is not None else None
         self.entry = first.entry if first is not None else None
-        self.rolls = [b for b in self.bodies if b.kind == "roll"]
-        spanned = next((w for w in self.webs if w.span is not None), None)
-        self.span = spanned.span if spanned is not None else None
-        self.unwind = spanned.unwind if spanned is not None else None
-        if self.span is not None and not fx.web_tension:
-            from winder._errors import ModelError
-
-            raise ModelError(f"{scene.source}: [effects] web_tension = false with a "
-                             "[web.span]: the span's tension is the web_tension effect; "
-                             "valid: web_tension = true, or no [web.span]")
-        self.model = self._build_model()
-        self.param_names: list[str] = []
-        self.param_values: list[float] = []
-        self.state_names: list[str] = []
-        self.state_initial: list[float] = []
-        self.channel_names: list[str] = []
-        self.mode_names: list[str] = []
-        self.switch_names: list[str] = []
-        self._declare_base()
-        drives = {b.part.drive.kind for b in self.bodies if b.controlled}
-        self.forces = sorted([*(FORCES[n]() for n in fx.enabled() if n in FORCES),
-                              *(DRIVES[k]() for k in sorted(drives))], key=lambda f: f.order)
-        for f in self.forces:
-            f.declare(self)
-        self._index = {n: i for i, n in enumerate(self.state_names)}
-        self._pindex = {n: i for i, n in enumerate(self.param_names)}
+        spanned_web = next((w for w in self.webs if w.span is not None), None)
+        self.span = spanned_web.span if spanned_web is not None else None
+        self.unwind = spanned_web.unwind if spanned_web is not None else None
 
     # ---- structure --------------------------------------------------------------------
     def _build_model(self) -> pin.Model:
+        """One ``pin.Model``: each body's joints hung off its parent's last joint (the
+        world for ``parent = None``), its centre in the parent's joint frame."""
         model = pin.Model()
         model.name = self.scene.name
         for b in self.bodies:
-            parent = 0
+            parent = 0 if b.parent is None else self.body[b.parent].joints["theta"]
             cx, cz = b.centre
             placement = pin.SE3(np.eye(3), np.array([0.0 if "x" in b.free else cx, 0.0,
                                                      0.0 if "z" in b.free else cz]))
@@ -207,15 +202,28 @@ class Machine:
         self.state_names.append(name)
         self.state_initial.append(float(initial))
 
-    def channel(self, name: str) -> None:
-        """Register a result channel ``name``."""
+    def channel(self, name: str, unit: str) -> None:
+        """Register a result channel ``name`` in ``unit`` (SI, machines.md §9: ``rad/s``,
+        ``N·m``, ``m``, ``kg·m²``, ... ``-`` for a pure number)."""
+        if not isinstance(unit, str) or not unit:
+            raise TypeError(f"channel {name!r}: unit must be a non-empty string such as "
+                            f"'m' or '-', got {unit!r}")
         if name not in self.channel_names:
             self.channel_names.append(name)
+            self.channel_units[name] = unit
 
-    def mode(self, name: str, switches: tuple[str, ...]) -> None:
-        """Register a locked mode slot and its switching functions."""
+    def mode(self, name: str, switches: tuple[str, ...], kind: ModeKind, *, owner: str,
+             state: str | None = None, param: str | None = None) -> None:
+        """Register a locked mode slot of ``kind`` belonging to the part ``owner`` and its
+        switching functions (see :class:`~winder.model.locked_modes.Mode`)."""
+        mode = Mode(name, kind, owner, tuple(switches), state, param)
+        self.modes.append(mode)
         self.mode_names.append(name)
         self.switch_names.extend(switches)
+
+    def mode_slots(self, kind: ModeKind) -> list[int]:
+        """Positions of the mode slots of ``kind``."""
+        return [i for i, m in enumerate(self.modes) if m.kind is kind]
 
     def _declare_base(self) -> None:
         # joint coordinates, then their rates
@@ -225,65 +233,21 @@ class Machine:
             init = 0.0 if c == "theta" else (b.centre[0] if c == "x" else b.centre[1])
             self.state(f"{b.name}.{c}", init)
         for b, c in qs:
-            self.state(f"{b.name}.{c}_dot", self._initial_rate(b, c))
+            self.state(f"{b.name}.{c}_dot", b.initial_rate(c))
         for b in self.bodies:
-            part = b.part
-            if b.kind == "drum":
-                self.parameter(f"{b.name}.radius", part.radius)
-                self.parameter(f"{b.name}.inertia", part.inertia)
-                self.parameter(f"{b.name}.mass", part.mass)
-                dr = part.drive
-                if b.prescribed:
-                    aw, vw = dr.web_acceleration, dr.web_speed
-                    self.parameter(f"{b.name}.web_acceleration", aw)
-                    self.parameter(f"{b.name}.web_speed", vw)
-                    self.parameter(f"{b.name}.ratio", dr.ratio)
-                    self.parameter(f"{b.name}.ramp_time", vw / aw if aw > 0 else 0.0)
-                else:
-                    self.parameter(f"{b.name}.torque", dr.torque)
-            elif b.kind == "roll":
-                self.state(f"{b.name}.radius", part.initial_radius)
-                self.parameter(f"{b.name}.core_radius", part.core_radius)
-                self.parameter(f"{b.name}.core_mass", part.core_mass)
-                self.parameter(f"{b.name}.core_inertia", part.core_inertia)
-                self.parameter(f"{b.name}.width", part.width)
-                self.parameter(f"{b.name}.density", part.density)
-                self.parameter(f"{b.name}.caliper", part.caliper)
-                if b.unwinding:  # the run ends where it reaches its core
-                    self.mode(f"{b.name}.end", (f"{b.name}.exhausted",))
-                else:
-                    self.mode(f"{b.name}.core", (f"{b.name}.unwound", f"{b.name}.forward"))
-                if b.torque_input:
-                    self.parameter(f"{b.name}.torque", part.drive.torque)
-            else:
-                self.parameter(f"{b.name}.radius", part.radius)
-                self.parameter(f"{b.name}.inertia", part.inertia)
-                self.parameter(f"{b.name}.mass", part.mass)
+            b.declare(self)
         for b in self.bodies:
-            for ch in ("speed", "angle", "torque", "accel"):
-                self.channel(f"{b.name}_{ch}")
+            for ch, unit in _BODY_CHANNELS:
+                self.channel(f"{b.name}_{ch}", unit)
             for c in b.free:
-                for ch in ("", "_dot", "_accel"):
-                    self.channel(f"{b.name}_{c}{ch}")
-            if b.kind == "roll":
-                for ch in ("radius", "mass", "inertia", "mass_rate", "inertia_rate"):
-                    self.channel(f"{b.name}_{ch}")
+                for ch, unit in _COORD_CHANNELS:
+                    self.channel(f"{b.name}_{c}{ch}", unit)
+            b.declare_channels(self)
         for n in self.nips:
-            for ch in ("normal_force", "friction_force", "slip_velocity", "penetration"):
-                self.channel(f"{n.name}_{ch}")
+            for ch, unit in _NIP_CHANNELS:
+                self.channel(f"{n.name}_{ch}", unit)
         for w in self.webs:
-            self.channel(f"{w.channel}web_speed")
-
-    def _initial_rate(self, b: Body, c: str) -> float:
-        """Spec §7: translational velocities 0; a roll its initial speed, a torque-driven
-        drum ``web_speed / R``, a rider 0 (joint rate ``θ̇ = s · speed``)."""
-        if c != "theta":
-            return 0.0
-        if b.kind == "roll":
-            return b.sense * b.part.initial_speed
-        if b.kind == "drum":
-            return b.sense * b.part.drive.web_speed / b.part.radius
-        return 0.0
+            self.channel(f"{w.channel}web_speed", "m/s")
 
     # ---- names ------------------------------------------------------------------------
     @property
@@ -298,11 +262,9 @@ class Machine:
             raise KeyError(f"no state {name!r}; states: {', '.join(self.state_names)}") \
                 from None
 
-    def radius(self, y: Any, body: Body) -> float:
-        """Radius [m] of ``body`` in state ``y``: a roll's is a state, a drum's or a
-        rider's its part's."""
-        return float(y[self.index(f"{body.name}.radius")]) if body.kind == "roll" \
-            else float(body.part.radius)
+    def radius(self, y: Any, body: Any) -> float:
+        """Radius [m] of ``body`` in state ``y`` (a state, or its part's)."""
+        return body.radius_of(y, self)
 
     def param_index(self, name: str) -> int:
         """Position of parameter ``name`` in the parameter vector."""
@@ -318,25 +280,22 @@ class Machine:
 
     def structure_key(self) -> str:
         """A hash of everything that changes the generated code: the model, the layout,
-        the parameter, mode, switch and channel names and the force elements."""
+        the parameter, mode, switch and channel names, the bodies and force elements."""
         h = hashlib.sha256()
         for i in range(1, self.model.njoints):
-            M = self.model.jointPlacements[i]
+            placement = self.model.jointPlacements[i]
             h.update(f"{self.model.names[i]}:{self.model.joints[i].shortname()}:"
-                     f"{self.model.parents[i]}:{M.translation.tolist()}".encode())
+                     f"{self.model.parents[i]}:{placement.translation.tolist()}".encode())
         for group in (self.state_names, self.param_names, self.mode_names,
                       self.switch_names, self.channel_names,
                       [f.name for f in self.forces],
-                      [f"{b.name}:{b.kind}:{b.sense}:{b.prescribed}:{b.torque_input}:"
-                       f"{b.unwinding}:{b.controlled}" for b in self.bodies],
+                      [f"{b.name}:{b.structure_tag()}" for b in self.bodies],
                       [self.span.source if self.span is not None else ""],
                       [f"{n.name}:{n.a.name}:{n.b.name}:{n.part.contact.law}"
                        for n in self.nips],
                       [self.entry.name if self.entry else ""],
                       *([f"{w.name}:{w.entry.name}:{w.unwind.name if w.unwind else ''}"
-                         for w in self.webs],) * (len(self.webs) > 1),
-                      [f"{x.name}:{len(x.part.load)}" for x in self.bodies
-                       if x.kind == "rider"]):
+                         for w in self.webs],) * (len(self.webs) > 1)):
             h.update(("|".join(group) + "#").encode())
         return h.hexdigest()[:16]
 
@@ -352,18 +311,18 @@ class Machine:
 class BodyState:
     """Kinematics of one body in one evaluation [SI, world frame]: centre ``cx, cz`` and
     velocity ``vx, vz``; joint angle ``theta`` and rate ``omega`` (about ``+y``); radius
-    ``r`` and rate ``r_dot``; paper rolls: ``mass, inertia, dm_dr, dJ_dr``; force
-    accumulators ``fx, fz`` [N] and ``ty`` (about ``+y`` through the centre) [N·m];
-    ``t_contact`` the part of ``ty`` reported as its torque channel."""
+    ``r`` and rate ``r_dot``; ``mass, inertia, dm_dr, dJ_dr``; the centre-of-mass offset
+    ``com_offset`` [m] on its own ``x`` axis; force accumulators ``fx, fz`` [N] and ``ty``
+    (about ``+y`` through the centre) [N·m]."""
 
     __slots__ = ("body", "cx", "cz", "vx", "vz", "theta", "omega", "alpha_prescribed", "r",
-                 "r_dot", "mass", "inertia", "dm_dr", "dJ_dr", "fx", "fz", "ty", "e")
+                 "r_dot", "mass", "inertia", "dm_dr", "dJ_dr", "fx", "fz", "ty", "com_offset")
 
-    def __init__(self, body: Body) -> None:
+    def __init__(self, body: Any) -> None:
         self.body = body
         self.fx = self.fz = self.ty = 0.0
         self.alpha_prescribed = None
-        self.e = 0.0
+        self.com_offset = 0.0
 
     @property
     def speed(self) -> Any:
@@ -394,16 +353,20 @@ class NipState:
 
 
 class Evaluation:
-    """Everything one evaluation of the machine computes, shared by the force elements.
+    """Everything one evaluation of the machine computes, shared by the body and force
+    elements.
 
-    ``M`` the math namespace; ``bodies``/``nips`` the kinematics by name; ``rates`` the
-    state derivatives; ``channels`` the result channels; ``switches`` the switching
-    functions (> 0: the other side of the mode).
+    ``mathns`` the math namespace (:mod:`winder.model.mathns`); ``bodies``/``nips`` the
+    kinematics by name; ``rates`` the state derivatives; ``channels`` the result channels;
+    ``switches`` the switching functions (> 0: the other side of the mode). The quantities
+    the force elements declare they provide (``"gravity"``, ``"drive_torque"``,
+    ``"span_rate"``, ``"spatial_force"``, ...) go through :meth:`provide` and
+    :meth:`provided`.
     """
 
     def __init__(self, machine: Machine, backend: Any, t: Any, x: Any, p: Any, modes: Any,
                  *, static: bool) -> None:
-        self.machine, self.backend, self.M = machine, backend, backend.M
+        self.machine, self.backend, self.mathns = machine, backend, backend.mathns
         self.t, self._x, self._p, self.modes = t, x, p, modes
         self.static = static
         self.rates: dict[str, Any] = {}
@@ -411,12 +374,7 @@ class Evaluation:
         self.switches: dict[str, Any] = {}
         self.bodies: dict[str, BodyState] = {}
         self.nips: dict[str, NipState] = {}
-        self.fext_extra: dict[str, list[Any]] = {}  # local-frame spatial forces by body
-        #: actuator torques about the bodies' axes [N·m], operation sense (drives)
-        self.drive_torques: dict[str, Any] = {}
-        #: dT/dt of each web's span [N/s] by web name (web_tension sets it)
-        self.span_rates: dict[str, Any] = {}
-        self.gravity: Any = 0.0  # [m/s²], set by the gravity effect
+        self._provided: dict[str, dict[str, Any]] = {}
 
     # access by name
     def x(self, name: str) -> Any:
@@ -434,6 +392,15 @@ class Evaluation:
     def set_channel(self, name: str, value: Any) -> None:
         self.channels[name] = value
 
+    def provide(self, quantity: str, key: str, value: Any) -> None:
+        """Write ``quantity`` of ``key`` (a body's, a web's; ``""`` for the machine's), as
+        the element declared in its ``provides``."""
+        self._provided.setdefault(quantity, {})[key] = value
+
+    def provided(self, quantity: str, key: str = "", default: Any = None) -> Any:
+        """``quantity`` of ``key`` as some element provided it, else ``default``."""
+        return self._provided.get(quantity, {}).get(key, default)
+
     def add_force(self, body: str, fx: Any, fz: Any, px: Any = 0.0, pz: Any = 0.0) -> None:
         """World force ``(fx, fz)`` [N] on ``body`` at ``(px, pz)`` relative to its centre
         [m]."""
@@ -443,9 +410,11 @@ class Evaluation:
         bs.ty = bs.ty + (pz * fx - px * fz)
 
     def add_spatial_force(self, body: str, f: list[Any]) -> None:
-        """A spatial force ``[f; τ]`` in the body's joint frame (e.g. ``−Ẏv``)."""
-        old = self.fext_extra.get(body)
-        self.fext_extra[body] = f if old is None else [a + b for a, b in zip(old, f, strict=True)]
+        """Add to the ``"spatial_force"`` of ``body``: ``[f; τ]`` in its joint frame (e.g.
+        ``−Ẏv``)."""
+        old = self.provided("spatial_force", body)
+        self.provide("spatial_force", body,
+                     f if old is None else [a + b for a, b in zip(old, f, strict=True)])
 
     # ---- the steps ----------------------------------------------------------------------
     def run(self, *, outputs: bool) -> None:
@@ -462,62 +431,26 @@ class Evaluation:
         self._dynamics(outputs)
 
     def _kinematics(self) -> None:
-        m, M, t = self.machine, self.M, self.t
-        for b in m.bodies:
+        for b in self.machine.bodies:
             bs = BodyState(b)
             n = b.name
             bs.cx = self.x(f"{n}.x") if "x" in b.free else b.centre[0]
             bs.cz = self.x(f"{n}.z") if "z" in b.free else b.centre[1]
             bs.vx = self.x(f"{n}.x_dot") if "x" in b.free else 0.0
             bs.vz = self.x(f"{n}.z_dot") if "z" in b.free else 0.0
-            if b.prescribed:  # machines.md §6: Ω = ratio·min(a_w t, v_w)/R
-                R, k = self.p(f"{n}.radius"), self.p(f"{n}.ratio")
-                aw, vw, tr = (self.p(f"{n}.web_acceleration"), self.p(f"{n}.web_speed"),
-                              self.p(f"{n}.ramp_time"))
-                ramp = t < tr
-                s = b.sense
-                bs.theta = s * k / R * M.if_else(ramp, 0.5 * aw * t * t,
-                                                 0.5 * aw * tr * tr + vw * (t - tr))
-                bs.omega = s * k / R * M.if_else(ramp, aw * t, vw)
-                bs.alpha_prescribed = s * k / R * M.if_else(ramp, aw, 0.0)
-            else:
+            if not b.prescribed:  # else the body's kinematics sets them
                 bs.theta = self.x(f"{n}.theta")
                 bs.omega = self.x(f"{n}.theta_dot")
-            if b.kind == "roll":
-                r = self.x(f"{n}.radius")
-                rc = self.p(f"{n}.core_radius")
-                k = math.pi * self.p(f"{n}.density") * self.p(f"{n}.width")
-                bs.mass, bs.inertia, bs.dm_dr, bs.dJ_dr = paper_roll_mass(
-                    r, rc, self.p(f"{n}.core_mass"), self.p(f"{n}.core_inertia"), k)
-                h2pi = self.p(f"{n}.caliper") / (2.0 * math.pi)
-                speed = bs.speed
-                bs.r = r
-                if b.unwinding:  # machines.md §1: ṙ = −h·speed/2π, down to the core
-                    bs.r_dot = -h2pi * speed
-                    self.switches[f"{n}.exhausted"] = rc - r
-                else:
-                    core = self.mode(f"{n}.core")
-                    at_core = M.logic_or(core == AT_CORE, M.logic_and(
-                        core == CORE_AUTO, M.logic_and(r <= rc, speed < 0.0)))
-                    bs.r_dot = M.if_else(at_core, 0.0, h2pi * speed)
-                    self.switches[f"{n}.unwound"] = rc - r
-                    self.switches[f"{n}.forward"] = speed
-                self.set_rate(f"{n}.radius", bs.r_dot)
-            else:
-                bs.r = self.p(f"{n}.radius")
-                bs.r_dot = 0.0
-                bs.mass = self.p(f"{n}.mass")
-                bs.inertia = self.p(f"{n}.inertia")
-                bs.dm_dr = bs.dJ_dr = 0.0
+            b.kinematics(self, bs)
             self.bodies[n] = bs
 
     def _nip_kinematics(self) -> None:
-        M = self.M
+        mathns = self.mathns
         for nip in self.machine.nips:
             a, b = self.bodies[nip.a.name], self.bodies[nip.b.name]
             ns = NipState(nip)
             dx, dz = b.cx - a.cx, b.cz - a.cz
-            dist = M.sqrt(dx * dx + dz * dz)
+            dist = mathns.sqrt(dx * dx + dz * dz)
             ns.nx, ns.nz = dx / dist, dz / dist
             ns.tx, ns.tz = ns.nz, -ns.nx
             ns.delta = a.r + b.r - dist
@@ -532,18 +465,15 @@ class Evaluation:
 
     def inertia_parameters(self, bs: BodyState, *, rate: bool = False) -> list[Any]:
         """The 10 dynamic parameters of the body (about its joint origin; ``rate``: their
-        time derivative ``dY/dr · ṙ``). Centre of mass at ``(e, 0, 0)`` in the body frame
-        (imbalance); the polar inertia ``J`` is about the axis."""
+        time derivative ``dY/dr · ṙ``). Centre of mass at ``(com_offset, 0, 0)`` in the
+        body frame (imbalance); the polar inertia ``J`` is about the axis, the transverse
+        one the body's (:meth:`~winder.parts.BodyElement.transverse_inertia`)."""
         if rate:
             m, J = bs.mass_rate, bs.inertia_rate
         else:
             m, J = bs.mass, bs.inertia
-        if bs.body.kind == "roll":
-            L = self.p(f"{bs.body.name}.width")
-            it = 0.5 * J + m * L * L / 12.0
-        else:
-            it = 0.5 * J
-        return [m, m * bs.e, 0.0, 0.0, it, 0.0, J, 0.0, 0.0, it]
+        it = bs.body.transverse_inertia(self, m, J)
+        return [m, m * bs.com_offset, 0.0, 0.0, it, 0.0, J, 0.0, 0.0, it]
 
     def _joint_vectors(self) -> None:
         """``q, v`` of the Pinocchio model from the body kinematics."""
@@ -559,7 +489,7 @@ class Evaluation:
             self.q[j], self.v[j] = bs.theta, bs.omega
 
     def _dynamics(self, outputs: bool) -> None:
-        mach, M, be = self.machine, self.M, self.backend
+        mach, mathns, be = self.machine, self.mathns, self.backend
         model = mach.model
         nj = model.njoints - 1
         q, v = self.q, self.v
@@ -569,18 +499,20 @@ class Evaluation:
         for b in mach.bodies:
             bs = self.bodies[b.name]
             j = b.joints["theta"] - 1
-            if b.torque_input:
-                self.drive_torques[b.name] = self.p(f"{b.name}.torque")
-            if b.name in self.drive_torques:
-                tau[j] = b.sense * self.drive_torques[b.name]
+            own = b.drive_torque(self)
+            if own is not None:
+                self.provide("drive_torque", b.name, own)
+            drive = self.provided("drive_torque", b.name)
+            if drive is not None:
+                tau[j] = b.sense * drive
             dyn[10 * j:10 * j + 10] = self.inertia_parameters(bs)
-            co, si = M.cos(bs.theta), M.sin(bs.theta)
+            co, si = mathns.cos(bs.theta), mathns.sin(bs.theta)
             f6 = [co * bs.fx - si * bs.fz, 0.0, si * bs.fx + co * bs.fz, 0.0, bs.ty, 0.0]
-            extra = self.fext_extra.get(b.name)
+            extra = self.provided("spatial_force", b.name)
             if extra is not None:
                 f6 = [a + e for a, e in zip(f6, extra, strict=True)]
             fext[6 * j:6 * j + 6] = f6
-        g = [0.0, 0.0, -self.gravity]
+        g = [0.0, 0.0, -self.provided("gravity", default=0.0)]
         self.dyn, self.fext, self.g = dyn, fext, g
         ddq = be.aba(q, v, tau, dyn, fext, g)
         for b in mach.bodies:
@@ -613,10 +545,11 @@ class Evaluation:
             ch(f"{n}_speed", s * bs.omega)
             ch(f"{n}_angle", s * bs.theta)
             ch(f"{n}_accel", s * acc[j])
+            drive = self.provided("drive_torque", b.name)
             if b.prescribed:
                 ch(f"{n}_torque", s * tau[j])  # inverse dynamics (RNEA)
-            elif b.name in self.drive_torques:
-                ch(f"{n}_torque", self.drive_torques[b.name])  # the input or the controller
+            elif drive is not None:
+                ch(f"{n}_torque", drive)  # the input or the controller
             else:
                 ch(f"{n}_torque", s * bs.ty)
             for c in b.free:
@@ -624,12 +557,7 @@ class Evaluation:
                 ch(f"{n}_{c}", self.q[jc])
                 ch(f"{n}_{c}_dot", self.v[jc])
                 ch(f"{n}_{c}_accel", acc[jc])
-            if b.kind == "roll":
-                ch(f"{n}_radius", bs.r)
-                ch(f"{n}_mass", bs.mass)
-                ch(f"{n}_inertia", bs.inertia)
-                ch(f"{n}_mass_rate", bs.mass_rate)
-                ch(f"{n}_inertia_rate", bs.inertia_rate)
+            b.outputs(self, bs)
         for nip in mach.nips:
             ns = self.nips[nip.name]
             ch(f"{nip.name}_normal_force", ns.normal_force)

@@ -1,9 +1,9 @@
 """Math namespaces: the same force and mass-law code runs on floats and on CasADi symbols.
 
 Every piece of physics in :mod:`winder.forces` and :mod:`winder.core` is written once over
-a namespace ``M`` with the functions below; :data:`NUMERIC` evaluates it on floats (the
+a namespace ``mathns`` with the functions below; :data:`NUMERIC` evaluates it on floats (the
 numeric Pinocchio path), :data:`SYMBOLIC` builds CasADi ``SX`` expressions (the generated
-code). Branches on states must go through ``M.if_else`` / ``M.fmax`` so that the
+code). Branches on states must go through ``mathns.if_else`` / ``mathns.fmax`` so that the
 generated code stays branch-free.
 """
 

@@ -45,3 +45,79 @@ class DrumPart:
     centre: tuple[float, float]
     sense: int = 1
     drive: SpeedProfileDrive | TorqueDrive = SpeedProfileDrive()
+
+
+# ---- behaviour (the part protocol, :class:`~winder.parts._base.BodyElement`) -------------
+from typing import TYPE_CHECKING, Any  # noqa: E402
+
+from winder.parts._base import RigidDisc  # noqa: E402
+
+if TYPE_CHECKING:
+    from winder.model.machine import BodyState, Evaluation, Machine
+
+
+class DrumBody(RigidDisc):
+    """A drum: fixed centre, constant radius, mass and inertia; driven by a speed profile
+    (prescribed, machines.md §6: ``Ω = ratio · min(a_w t, v_w) / R`` [rad/s], no ``θ``
+    state) or by an input torque ``NAME.torque`` [N·m]."""
+
+    table = "drum"
+    role = "drum"
+    legacy_place_key = "[drum] radius"
+
+    def __init__(self, part: Any, placed: Any = None) -> None:
+        super().__init__(part)
+        self.centre = tuple(part.centre)
+        self.prescribed = part.drive.kind == "speed_profile"
+        self.torque_inputs = () if self.prescribed else (f"{self.name}.torque",)
+
+    def declare(self, machine: Machine) -> None:
+        super().declare(machine)
+        n, dr = self.name, self.part.drive
+        if self.prescribed:
+            aw, vw = dr.web_acceleration, dr.web_speed
+            machine.parameter(f"{n}.web_acceleration", aw)
+            machine.parameter(f"{n}.web_speed", vw)
+            machine.parameter(f"{n}.ratio", dr.ratio)
+            machine.parameter(f"{n}.ramp_time", vw / aw if aw > 0 else 0.0)
+        else:
+            machine.parameter(f"{n}.torque", dr.torque)
+
+    def initial_rate(self, coord: str) -> float:
+        """Spec §7: ``θ̇ = s · web_speed / R`` (a torque drive's initial web speed)."""
+        if coord != "theta":
+            return 0.0
+        return self.sense * self.part.drive.web_speed / self.part.radius
+
+    def breakpoints(self) -> tuple[float, ...]:
+        """The end of the speed ramp ``v_w / a_w`` [s] (a kink of the prescribed speed)."""
+        dr = self.part.drive
+        return (dr.web_speed / dr.web_acceleration,) \
+            if self.prescribed and dr.web_acceleration > 0 else ()
+
+    def operating_speed(self, web_speed: float) -> float:
+        """``ratio · v / R`` [rad/s]."""
+        return self.part.drive.ratio * web_speed / self.part.radius
+
+    def hold_operating_speed(self, machine: Machine, params: Any, web_speed: float) -> None:
+        """No ramp: ``ramp_time = 0``, ``web_speed = v``."""
+        if self.prescribed:
+            params[machine.param_index(f"{self.name}.ramp_time")] = 0.0
+            params[machine.param_index(f"{self.name}.web_speed")] = web_speed
+
+    def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
+        n, mathns, t = self.name, ev.mathns, ev.t
+        if self.prescribed:  # machines.md §6: Ω = ratio·min(a_w t, v_w)/R
+            R, k = ev.p(f"{n}.radius"), ev.p(f"{n}.ratio")
+            aw, vw, tr = (ev.p(f"{n}.web_acceleration"), ev.p(f"{n}.web_speed"),
+                          ev.p(f"{n}.ramp_time"))
+            ramp = t < tr
+            s = self.sense
+            bs.theta = s * k / R * mathns.if_else(ramp, 0.5 * aw * t * t,
+                                                  0.5 * aw * tr * tr + vw * (t - tr))
+            bs.omega = s * k / R * mathns.if_else(ramp, aw * t, vw)
+            bs.alpha_prescribed = s * k / R * mathns.if_else(ramp, aw, 0.0)
+        super().kinematics(ev, bs)
+
+    def drive_torque(self, ev: Evaluation) -> Any:
+        return None if self.prescribed else ev.p(f"{self.name}.torque")

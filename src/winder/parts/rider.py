@@ -23,3 +23,33 @@ class RiderPart:
     inertia: float
     x: float
     load: tuple[tuple[float, float], ...] = ()
+
+
+# ---- behaviour (the part protocol, :class:`~winder.parts._base.BodyElement`) -------------
+from typing import Any  # noqa: E402
+
+from winder.parts._base import RigidDisc  # noqa: E402
+
+
+class RiderBody(RigidDisc):
+    """A rider roll: free along ``z``, sense +1, its centre first guessed on top of the
+    roll it rides; ``rides`` and its line-load schedule ``load`` are read by the
+    ``rider_load`` effect."""
+
+    table = "rider"
+    role = "rider"
+    place_key = "x"
+
+    def __init__(self, part: Any, placed: Any) -> None:
+        super().__init__(part)
+        self.sense = 1
+        ridden = placed[part.rides]
+        self.free = ("z",)
+        self.centre = (float(part.x), ridden.centre[1] + ridden.initial_radius + part.radius)
+        #: the name of the body it rests on
+        self.rides: str = part.rides
+        #: the line-load schedule ``((radius [m], line load [N/m]), ...)``
+        self.load: tuple[tuple[float, float], ...] = tuple(part.load)
+
+    def structure_tag(self) -> str:
+        return f"{super().structure_tag()}:{len(self.load)}"

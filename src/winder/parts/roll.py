@@ -72,3 +72,125 @@ class RollPart:
     caliper: float
     initial_height: float | None = None
     drive: UnwindTorqueDrive | TensionControl | None = None
+
+
+# ---- behaviour (the part protocol, :class:`~winder.parts._base.BodyElement`) -------------
+import math  # noqa: E402
+from collections.abc import Mapping  # noqa: E402
+from typing import TYPE_CHECKING, Any  # noqa: E402
+
+from winder.model.locked_modes import AT_CORE, CORE_AUTO, ModeKind  # noqa: E402
+from winder.model.mass_law import paper_roll_mass  # noqa: E402
+from winder.parts._base import BodyElement  # noqa: E402
+
+if TYPE_CHECKING:
+    from winder.model.machine import BodyState, Evaluation, Machine
+
+
+class RollBody(BodyElement):
+    """A paper roll: its radius is a state that grows (``wound``) or shrinks
+    (``unwinding``) as paper is wound on or paid off, ``ṙ = ±h · speed / 2π`` [m/s]
+    (machines.md §1), its mass and inertia follow the mass law of winder-model §2.
+
+    A wound roll has the core mode of spec §2 (``ROLL.core``: at the core its radius
+    stops shrinking); an unwinding roll the end mode (``ROLL.end``: the run ends where it
+    reaches its core). Its drive: an input torque ``ROLL.torque`` [N·m] or the
+    ``tension_control`` force element.
+    """
+
+    table = "roll"
+    role = "roll"
+    legacy_place_key = "[roll] initial_radius"
+    radius_state = True
+    variable_mass = True
+
+    def __init__(self, part: Any, placed: Any = None) -> None:
+        super().__init__(part)
+        self.free = tuple(part.free)
+        self.centre = tuple(part.centre)
+        drive = getattr(part, "drive", None)
+        kind = drive.kind if drive is not None else None
+        n = self.name
+        #: it pays off its web (machines.md §1): fixed centre, shrinking radius
+        self.unwinding = part.kind == "unwinding"
+        self.torque_inputs = (f"{n}.torque",) if kind == "torque" else ()
+        self.drives = ("tension_control",) if kind == "tension_control" else ()
+        self.setpoint_inputs = (f"{n}.tension_setpoint",) if self.drives else ()
+        self.com_offset = part.com_offset
+
+    @property
+    def initial_radius(self) -> float:
+        return float(self.part.initial_radius)
+
+    def declare(self, machine: Machine) -> None:
+        n, part = self.name, self.part
+        machine.state(f"{n}.radius", part.initial_radius)
+        machine.parameter(f"{n}.core_radius", part.core_radius)
+        machine.parameter(f"{n}.core_mass", part.core_mass)
+        machine.parameter(f"{n}.core_inertia", part.core_inertia)
+        machine.parameter(f"{n}.width", part.width)
+        machine.parameter(f"{n}.density", part.density)
+        machine.parameter(f"{n}.caliper", part.caliper)
+        if self.unwinding:  # the run ends where it reaches its core
+            machine.mode(f"{n}.end", (f"{n}.exhausted",), ModeKind.END, owner=n,
+                         state=f"{n}.radius", param=f"{n}.core_radius")
+        else:
+            machine.mode(f"{n}.core", (f"{n}.unwound", f"{n}.forward"), ModeKind.CORE,
+                         owner=n, state=f"{n}.radius", param=f"{n}.core_radius")
+        if self.torque_inputs:
+            machine.parameter(f"{n}.torque", part.drive.torque)
+
+    def declare_channels(self, machine: Machine) -> None:
+        for ch, unit in (("radius", "m"), ("mass", "kg"), ("inertia", "kg·m²"),
+                         ("mass_rate", "kg/s"), ("inertia_rate", "kg·m²/s")):
+            machine.channel(f"{self.name}_{ch}", unit)
+
+    def initial_rate(self, coord: str) -> float:
+        """Spec §7: ``θ̇ = s · initial_speed``; the centre at rest."""
+        return self.sense * self.part.initial_speed if coord == "theta" else 0.0
+
+    def fixed_at_rest(self) -> Mapping[str, float]:
+        """The single-drum format's ``[roll] initial_height``: a given centre ``z``."""
+        h = getattr(self.part, "initial_height", None)
+        return {} if h is None else {"z": h}
+
+    def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
+        n, mathns = self.name, ev.mathns
+        r = ev.x(f"{n}.radius")
+        rc = ev.p(f"{n}.core_radius")
+        k = math.pi * ev.p(f"{n}.density") * ev.p(f"{n}.width")
+        bs.mass, bs.inertia, bs.dm_dr, bs.dJ_dr = paper_roll_mass(
+            r, rc, ev.p(f"{n}.core_mass"), ev.p(f"{n}.core_inertia"), k)
+        h2pi = ev.p(f"{n}.caliper") / (2.0 * math.pi)
+        speed = bs.speed
+        bs.r = r
+        if self.unwinding:  # machines.md §1: ṙ = −h·speed/2π, down to the core
+            bs.r_dot = -h2pi * speed
+            ev.switches[f"{n}.exhausted"] = rc - r
+        else:
+            core = ev.mode(f"{n}.core")
+            at_core = mathns.logic_or(core == AT_CORE, mathns.logic_and(
+                core == CORE_AUTO, mathns.logic_and(r <= rc, speed < 0.0)))
+            bs.r_dot = mathns.if_else(at_core, 0.0, h2pi * speed)
+            ev.switches[f"{n}.unwound"] = rc - r
+            ev.switches[f"{n}.forward"] = speed
+        ev.set_rate(f"{n}.radius", bs.r_dot)
+
+    def transverse_inertia(self, ev: Evaluation, mass: Any, inertia: Any) -> Any:
+        """A cylinder of width ``L``: ``J/2 + m L²/12`` [kg·m²]."""
+        L = ev.p(f"{self.name}.width")
+        return 0.5 * inertia + mass * L * L / 12.0
+
+    def drive_torque(self, ev: Evaluation) -> Any:
+        return ev.p(f"{self.name}.torque") if self.torque_inputs else None
+
+    def outputs(self, ev: Evaluation, bs: BodyState) -> None:
+        n, ch = self.name, ev.set_channel
+        ch(f"{n}_radius", bs.r)
+        ch(f"{n}_mass", bs.mass)
+        ch(f"{n}_inertia", bs.inertia)
+        ch(f"{n}_mass_rate", bs.mass_rate)
+        ch(f"{n}_inertia_rate", bs.inertia_rate)
+
+    def structure_tag(self) -> str:
+        return f"{super().structure_tag()}:{self.unwinding}"

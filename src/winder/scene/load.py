@@ -299,6 +299,16 @@ class Scene:
         out["solver"] = _table_dict(self.solver)
         return out
 
+    def elements(self) -> tuple[list[Any], list[Any]]:
+        """What :class:`~winder.model.machine.Machine` assembles: the body elements of the
+        parts (:func:`winder.parts.body_elements`) and the force elements of the effects
+        and drives (:func:`winder.forces.force_elements`)."""
+        from winder.forces import force_elements
+        from winder.parts import body_elements
+
+        bodies = body_elements(self)
+        return bodies, force_elements(self.effects, bodies)
+
 
 def _web_dict(web: WebPart, *, named: bool = False) -> dict[str, Any]:
     """``[web]`` as a TOML table: with a span, ``[web.span]`` (its roll under the key

@@ -26,7 +26,9 @@ import numpy as np
 from winder._errors import WinderError
 from winder.forces.contact import rest_penetration
 from winder.model.backends import NumericBackend
-from winder.model.machine import AUTO, CORE_AUTO, FREE, IN_CONTACT, Body, Machine, Nip
+from winder.model.locked_modes import AUTO, CORE_AUTO, FREE, IN_CONTACT, ModeKind
+from winder.model.machine import Machine, Nip
+from winder.parts import BodyElement as Body
 
 __all__ = ["static_state", "resting_state", "Resting", "Equilibrium", "EquilibriumError",
            "RESIDUAL_LIMIT", "balance_keys", "body_key", "nip_key"]
@@ -65,10 +67,9 @@ def body_key(machine: Machine, body: Body) -> str:
     """The scene key that places ``body`` (``[[drum]] 'front' centre``, ``[[roll]] 'set'
     centre``, ``[[rider]] 'rider' x``; the single-drum format: ``[drum] radius``,
     ``[roll] initial_radius``)."""
-    if machine.scene.legacy:
-        return "[drum] radius" if body.kind == "drum" else "[roll] initial_radius"
-    key = "x" if body.kind == "rider" else "centre"
-    return f"[[{body.kind}]] {body.name!r} {key}"
+    if machine.scene.legacy and body.legacy_place_key is not None:
+        return body.legacy_place_key
+    return f"[[{body.table}]] {body.name!r} {body.place_key}"
 
 
 def nip_key(machine: Machine, nip: Nip, key: str = "stiffness") -> str:
@@ -99,8 +100,7 @@ def _law(machine: Machine, p: np.ndarray, nip: Nip) -> Callable[[str], float]:
 
 def _free_modes(machine: Machine) -> np.ndarray:
     """Every nip open (``FREE``), the core modes automatic: the applied forces alone."""
-    return np.array([FREE if n.endswith(".contact") else CORE_AUTO if n.endswith(".core")
-                     else 0.0 for n in machine.mode_names], dtype=float)
+    return np.array([mode.kind.unloaded for mode in machine.modes], dtype=float)
 
 
 @dataclass(frozen=True)
@@ -207,7 +207,7 @@ def _place(machine: Machine, b: Body, sup: list[Nip], x: np.ndarray,
         if not (base > abs(d1 - d2) and base < d1 + d2):
             a1, a2 = sup[0].a, sup[1].a
             raise EquilibriumError(
-                f"{b.kind} {b.name!r} cannot rest on both {a1.name!r} and {a2.name!r}: their "
+                f"{b.table} {b.name!r} cannot rest on both {a1.name!r} and {a2.name!r}: their "
                 f"centres are {base:.4g} m apart, but {b.name!r} reaches {d1:.4g} m from "
                 f"{a1.name!r} and {d2:.4g} m from {a2.name!r} (their radii plus its own); "
                 f"check {body_key(machine, a1)} and {body_key(machine, a2)} (in metres) "
@@ -227,7 +227,7 @@ def _place(machine: Machine, b: Body, sup: list[Nip], x: np.ndarray,
             a = sup[0].a
             ca = centre(a)
             raise EquilibriumError(
-                f"{b.kind} {b.name!r} at x = {cx:.6g} m does not reach {a.kind} {a.name!r} it "
+                f"{b.table} {b.name!r} at x = {cx:.6g} m does not reach {a.table} {a.name!r} it "
                 f"rests on (centre x = {ca[0]:.6g} m; in contact the centres are at most "
                 f"{dist[0]:.4g} m apart, the sum of the two radii); check "
                 f"{body_key(machine, b)}; valid: x between {ca[0] - dist[0]:.6g} and "
@@ -279,17 +279,17 @@ def static_state(machine: Machine, p: np.ndarray | None = None) -> Equilibrium:
     x = np.array(machine.state_initial, dtype=float)
     # every nip touching, its law extended smoothly to δ < 0 (so the balance is smooth);
     # a nip that would pull is opened and the balance solved again (an active set)
-    contact = [i for i, n in enumerate(machine.mode_names) if n.endswith(".contact")]
+    contact = machine.mode_slots(ModeKind.CONTACT)
     modes = np.full(len(machine.mode_names), float(CORE_AUTO))
     modes[contact] = IN_CONTACT
     unknowns = []
     resting = bool(machine.scene.effects.contact)  # without contact, free bodies start
     movable = set()
     for b in machine.bodies:  # at their centres (§7)
-        fixed_z = b.kind == "roll" and getattr(b.part, "initial_height", None) is not None
+        fixed = b.fixed_at_rest()
         for c in b.free:
-            if c == "z" and fixed_z:
-                x[machine.index(f"{b.name}.z")] = b.part.initial_height
+            if c in fixed:
+                x[machine.index(f"{b.name}.{c}")] = fixed[c]
             elif resting:
                 unknowns.append((b.name, c, machine.index(f"{b.name}.{c}")))
                 movable.add(b.name)
@@ -310,7 +310,7 @@ def static_state(machine: Machine, p: np.ndarray | None = None) -> Equilibrium:
             x[idx] = sol.x
             ev = machine.evaluate(be, 0.0, x, p, modes, static=True)
             pulling = [i for i in contact if modes[i] == IN_CONTACT
-                       and ev.nips[machine.mode_names[i][:-len(".contact")]].normal_force
+                       and ev.nips[machine.modes[i].owner].normal_force
                        < 0.0]
             if not pulling:
                 break

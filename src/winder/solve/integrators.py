@@ -46,7 +46,7 @@ import math
 import numpy as np
 
 from winder.model.ccall import call
-from winder.model.machine import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING
+from winder.model.locked_modes import AT_CORE, AUTO, FREE, IN_CONTACT, WINDING, ModeKind
 from winder.solve._jit import njit
 
 __all__ = ["modes_of", "evaluate", "switches", "switch_buffer", "first_step",
@@ -56,7 +56,7 @@ __all__ = ["modes_of", "evaluate", "switches", "switch_buffer", "first_step",
            "K_CONTACT", "K_CORE", "K_END"]
 
 DONE, PAUSED, STEP_UNDERFLOW, NON_FINITE, EXHAUSTED, PENETRATED = 0, 1, 2, 3, 4, 5
-K_CONTACT, K_CORE, K_END = 0, 1, 2
+K_CONTACT, K_CORE, K_END = int(ModeKind.CONTACT), int(ModeKind.CORE), int(ModeKind.END)
 #: The mode a :data:`K_END` slot switches to: the run ends (an unwinding roll at its core).
 END = 9
 #: The slot :func:`sample_and_switch` returns where a nip crossed its penetration bound.

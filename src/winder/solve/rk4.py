@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from winder.model.machine import AT_CORE
+from winder.model.locked_modes import AT_CORE
 from winder.solve._jit import njit
 from winder.solve.integrators import (
     DONE,

@@ -14,7 +14,7 @@ import numpy as np
 from winder._args import real_argument
 from winder._errors import ArgumentError, ArgumentTypeError, SimulationError
 from winder.io.result import Result
-from winder.model.machine import CORE_AUTO
+from winder.model.locked_modes import CORE_AUTO
 from winder.scene.load import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
 from winder.solve import integrators as integ
 from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances

@@ -34,8 +34,8 @@ def inputs_of(system: MachineSystem) -> dict[str, str]:
     tension-controlled unwind."""
     if getattr(system.scene, "legacy", False):
         return {"drum_torque": "drum.torque"}
-    names = system.torque_inputs() + [f"{b.name}.tension_setpoint"
-                                      for b in system.machine.bodies if b.controlled]
+    names = system.torque_inputs() + [name for b in system.machine.bodies
+                                      for name in b.setpoint_inputs]
     return {n.replace(".", "_"): n for n in names}
 
 

@@ -13,7 +13,7 @@ import numpy as np
 from scipy.integrate import BDF, DOP853, LSODA, RK23, RK45, DenseOutput, OdeSolver, Radau
 from scipy.optimize import brentq
 
-from winder.model.machine import AT_CORE, WINDING
+from winder.model.locked_modes import AT_CORE, WINDING
 from winder.solve import integrators as integ
 from winder.solve.budgets import _STEP_OVER, _WALL_EVERY, _Guards, _Stop
 from winder.solve.system import MachineSystem

@@ -25,7 +25,7 @@ from winder.solve import integrators as integ
 from winder.solve._jit import njit
 from winder.solve.equilibrium import Equilibrium, static_state
 
-__all__ = ["MachineSystem", "LEGACY_CHANNELS", "CHANNELS", "EXTRA_CHANNELS",
+__all__ = ["MachineSystem", "LEGACY_CHANNELS", "LEGACY_UNITS", "CHANNELS", "EXTRA_CHANNELS",
            "NoCompilerWarning"]
 
 #: Channel names of a scene in the single-drum format (winder-model §8 and winder's
@@ -41,6 +41,17 @@ LEGACY_CHANNELS = {
     "penetration": "nip_penetration",
 }
 
+#: Units of the channels of a single-drum scene (those its machine lacks with an effect
+#: off, e.g. ``web_force``, are zeros in these units).
+LEGACY_UNITS = {
+    "drum_speed": "rad/s", "drum_torque": "N·m", "roll_speed": "rad/s",
+    "roll_accel": "rad/s²", "roll_angle": "rad", "radius": "m", "mass": "kg",
+    "inertia": "kg·m²", "mass_rate": "kg/s", "inertia_rate": "kg·m²/s", "z": "m",
+    "z_dot": "m/s", "normal_force": "N", "friction_force": "N", "slip_velocity": "m/s",
+    "drum_angle": "rad", "web_speed": "m/s", "z_accel": "m/s²", "web_force": "N",
+    "penetration": "m",
+}
+
 #: Result channels of a single-drum scene (winder-model §8), in order (first column ``t``).
 CHANNELS = ("t", *list(LEGACY_CHANNELS)[:15])
 #: Its extra channels (winder's own): drum angle, web speed, roll vertical acceleration,
@@ -48,28 +59,6 @@ CHANNELS = ("t", *list(LEGACY_CHANNELS)[:15])
 EXTRA_CHANNELS = tuple(list(LEGACY_CHANNELS)[15:])
 
 
-# provisional: replaced by the parts' declarations at merge ---------------------------------
-#: Unit of a result channel by the ending of its name (machines.md §9, winder-model §8),
-#: the longest ending first: ``NAME_x_dot`` [m/s] before ``NAME_x`` [m], ``web_speed``
-#: [m/s] before ``NAME_speed`` [rad/s].
-_UNIT_BY_SUFFIX = (
-    ("x_accel", "m/s²"), ("z_accel", "m/s²"), ("x_dot", "m/s"), ("z_dot", "m/s"),
-    ("inertia_rate", "kg·m²/s"), ("mass_rate", "kg/s"), ("normal_force", "N"),
-    ("friction_force", "N"), ("slip_velocity", "m/s"), ("penetration", "m"),
-    ("span_tension", "N"), ("tension_error", "N"), ("web_speed", "m/s"), ("web_force", "N"),
-    ("accel", "rad/s²"), ("speed", "rad/s"), ("angle", "rad"), ("torque", "N·m"),
-    ("radius", "m"), ("mass", "kg"), ("inertia", "kg·m²"), ("load", "N"), ("x", "m"),
-    ("z", "m"), ("t", "s"),
-)
-
-
-def _channel_unit(name: str) -> str:
-    """The unit of result channel ``name`` from the ending of its name."""
-    for suffix, unit in _UNIT_BY_SUFFIX:
-        if name == suffix or name.endswith("_" + suffix):
-            return unit
-    raise SimulationError(f"internal error: no unit for result channel {name!r}")
-# end provisional ------------------------------------------------------------------------------
 
 
 class NoCompilerWarning(UserWarning):
@@ -121,29 +110,13 @@ class MachineSystem:
                 self.backend = "pinocchio"
         self._numeric = NumericBackend(m.model) if self.generated is None else None
         self.fns = self.generated.addresses if self.generated is not None else None
-        rows = []
-        for name in m.mode_names:
-            if name.endswith(".contact"):
-                nip = name[:-len(".contact")]
-                rows.append((integ.K_CONTACT, *(m.switch_names.index(f"{nip}.{g}") for g in
-                                                ("contact", "overlap", "dx", "dz"))))
-            elif name.endswith(".end"):
-                roll = name[:-len(".end")]
-                rows.append((integ.K_END, m.switch_names.index(f"{roll}.exhausted"), 0,
-                             m.index(f"{roll}.radius"), m.param_index(f"{roll}.core_radius")))
-            else:
-                roll = name[:-len(".core")]
-                rows.append((integ.K_CORE, m.switch_names.index(f"{roll}.unwound"),
-                             m.switch_names.index(f"{roll}.forward"),
-                             m.index(f"{roll}.radius"), m.param_index(f"{roll}.core_radius")))
+        rows = [mode.table_row(m) for mode in m.modes]
         self.table = np.array(rows, dtype=np.int64).reshape(len(rows), 5)
-        self.modes = np.array([AUTO if r[0] == integ.K_CONTACT else
-                               CORE_AUTO if r[0] == integ.K_CORE else 0.0 for r in rows],
-                              dtype=float)
-        self.radii = [(m.index(f"{b.name}.radius"), b.part.core_radius) for b in m.rolls]
-        self.breakpoints = sorted({b.part.drive.web_speed / b.part.drive.web_acceleration
-                                   for b in m.bodies if b.prescribed
-                                   and b.part.drive.web_acceleration > 0})
+        self.modes = np.array([mode.kind.automatic for mode in m.modes], dtype=float)
+        #: ``(state index, least value [m])`` of every radius an event stops at its core
+        self.radii = [(m.index(mode.state), m.param_values[m.param_index(mode.param)])
+                      for mode in m.modes if mode.state is not None]
+        self.breakpoints = sorted({t for b in m.bodies for t in b.breakpoints()})
         self.nfev = 0
         self._tb = np.empty(1)
         self._eq: Equilibrium | None = None
@@ -177,7 +150,7 @@ class MachineSystem:
     def torque_inputs(self) -> list[str]:
         """Names of the torque inputs (``BODY.torque``, one per torque-driven drum or
         unwinding roll)."""
-        return [f"{b.name}.torque" for b in self.machine.bodies if b.torque_input]
+        return [name for b in self.machine.bodies for name in b.torque_inputs]
 
     def set_drum_torque(self, torque: float) -> None:
         """Input torque [N·m] of the torque-driven drum (scenes with exactly one)."""
@@ -319,14 +292,14 @@ class MachineSystem:
             "The state was " + state_text(state) + ".", time=t, state=state)
 
     # ---- outputs ----------------------------------------------------------------------------
-    # provisional: replaced by the parts' declarations at merge
     @property
     def channel_units(self) -> dict[str, str]:
-        """Unit of every result channel of :meth:`channels` (``t`` [s] first; SI units,
-        ``rad`` for angles): ``{"t": "s", "drum_speed": "rad/s", ...}``."""
-        names = list(LEGACY_CHANNELS) if getattr(self.scene, "legacy", False) else \
-            self.machine.channel_names
-        return {"t": "s", **{n: _channel_unit(n) for n in names}}
+        """The unit of every channel :meth:`channels` returns, in its order: ``t`` [s],
+        then the machine's (:attr:`Machine.channel_units`), or a single-drum scene's
+        names of winder-model §8 (:data:`LEGACY_UNITS`)."""
+        if getattr(self.scene, "legacy", False):
+            return {"t": "s", **LEGACY_UNITS}
+        return {"t": "s", **self.machine.channel_units}
 
     def channels(self, t: np.ndarray, Y: np.ndarray) -> dict[str, np.ndarray]:
         """All result channels at times ``t`` for states ``Y`` (``(n_states, len(t))``):

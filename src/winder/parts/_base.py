@@ -1,0 +1,230 @@
+"""The part protocol: what one body of the machine brings to it.
+
+A scene's part (the frozen dataclass read from its table, e.g. :class:`DrumPart`) is data;
+its behaviour is a :class:`BodyElement` beside it in the same module (``DrumBody`` for
+``[[drum]]``). :class:`~winder.model.machine.Machine` assembles the body elements and the
+force elements of :mod:`winder.forces` without knowing which kinds there are: a new body
+type is its module plus one line in :data:`winder.parts.PARTS`.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, ClassVar
+
+if TYPE_CHECKING:
+    from winder.model.machine import BodyState, Evaluation, Machine
+
+__all__ = ["BodyElement", "RigidDisc"]
+
+
+class BodyElement(ABC):
+    """Base class of the bodies of a machine (drums, paper rolls, riders, ...).
+
+    A body is a disc in the ``x``–``z`` plane turning about ``+y`` (machines.md §1). The
+    machine gives it its joints (prismatic ``x``/``z`` where :attr:`free`, then a revolute
+    ``θ``), its joint-coordinate states ``NAME.x``, ``NAME.z``, ``NAME.theta`` and their
+    rates ``NAME.x_dot``, ..., the generic channels (``NAME_speed`` [rad/s],
+    ``NAME_angle`` [rad], ``NAME_torque`` [N·m], ``NAME_accel`` [rad/s²], ``NAME_x``
+    [m], ...) and the dynamics (Pinocchio's ABA). The element says everything else.
+
+    To add a body type (nothing else is touched: not the machine, the solvers, the
+    generated code, the static balance or the viewer; the scene's schema declares its
+    table and keys, the part's frozen dataclass beside the element):
+
+    1. Subclass :class:`BodyElement` (or :class:`RigidDisc` for a body of constant radius,
+       mass and inertia) in the part's module under ``winder/parts/``; set the class
+       variables :attr:`table` (the scene's array of tables: messages name its keys as
+       ``[[drum]] 'front' centre``), :attr:`role` (how the viewer and the figures draw it:
+       ``"drum"``, ``"roll"`` or ``"rider"``), :attr:`place_key` (the key that places
+       it) and, where they apply, :attr:`radius_state` (its radius is a state and a
+       ``NAME_radius`` channel) and :attr:`variable_mass` (its mass properties change:
+       the ``variable_mass`` effect adds ``−Ẏv``).
+    2. In ``__init__(part, placed)`` (``placed``: the bodies built before it, by name)
+       call ``super().__init__(part)`` and set :attr:`free` (the translational axes
+       among ``("x", "z")``, in that order), :attr:`centre` [m] (the fixed coordinates,
+       and the initial guess of the free ones), :attr:`parent` (the name of an earlier
+       body it hangs off, whose joint frame its centre is then given in; ``None``: the
+       world) and :attr:`prescribed` (its rotation is a function of time: no ``θ``
+       state). :attr:`drives` names the force elements its drive calls for
+       (``("tension_control",)``); :attr:`torque_inputs` and :attr:`setpoint_inputs`
+       its run-time parameters that are inputs of a co-simulation (``NAME.torque``,
+       ``NAME.tension_setpoint``); :attr:`com_offset` [m] its centre-of-mass offset for
+       the ``imbalance`` effect (None: none).
+    3. :meth:`declare`: its run-time parameters (``machine.parameter(name, value)``),
+       the states beyond its joint coordinates with their initial values (spec §7,
+       ``machine.state``), its locked modes (``machine.mode(name, switches,
+       ModeKind..., owner=NAME)``); :meth:`declare_channels` its own channels with their units
+       (``machine.channel(name, unit)``); :meth:`initial_rate` the initial rate of a
+       joint coordinate (spec §7).
+    4. :meth:`kinematics`: over the math namespace ``ev.mathns`` (floats or CasADi
+       symbols: branch on states only with ``if_else``/``fmax``) its radius ``r`` [m]
+       and rate ``r_dot`` [m/s], ``mass`` [kg], ``inertia`` [kg·m²] and their
+       derivatives ``dm_dr`` [kg/m], ``dJ_dr`` [kg·m]; with :attr:`prescribed` also
+       ``theta`` [rad], ``omega`` [rad/s] and ``alpha_prescribed`` [rad/s²]; the rates
+       of its own states (``ev.set_rate``) and its switching functions
+       (``ev.switches[name]``).
+    5. Optional: :meth:`transverse_inertia` (default ``J/2``, a thin disc),
+       :meth:`drive_torque` (an input torque [N·m], operation sense),
+       :meth:`outputs` (its channels, ``ev.set_channel``), :meth:`fixed_at_rest`
+       (coordinates the static balance does not solve for), :meth:`breakpoints` (times
+       [s] where its prescribed motion has a kink), :meth:`operating_speed` and
+       :meth:`hold_operating_speed` (a prescribed drive at a given web speed, for the
+       resonance map), :meth:`structure_tag`
+       (what changes its generated code beyond its names).
+    6. Register it: one line in :data:`winder.parts.PARTS` (scene attribute → class).
+
+    Example: a free disc of constant radius under a constant torque, as a scene's
+    ``discs`` (in ``winder/parts/disc.py``, plus ``PARTS["discs"] = DiscBody``)::
+
+        class DiscBody(RigidDisc):
+            table, role = "disc", "drum"
+
+            def __init__(self, part, placed):
+                super().__init__(part)
+                self.free, self.centre = (), tuple(part.centre)
+                self.torque_inputs = (f"{self.name}.torque",)
+
+            def declare(self, machine):
+                super().declare(machine)          # radius, inertia, mass
+                machine.parameter(f"{self.name}.torque", self.part.torque)
+
+            def initial_rate(self, coord):
+                return 0.0
+
+            def drive_torque(self, ev):
+                return ev.p(f"{self.name}.torque")
+
+    It then runs in every solver and in the generated code:
+    ``θ̇(t) = τ t / J`` [rad/s] (``tests/test_part_protocol.py``).
+    """
+
+    #: the scene's array of tables (``[[drum]]``): error messages name keys by it
+    table: ClassVar[str]
+    #: how the viewer and the figures draw it: ``"drum"``, ``"roll"`` or ``"rider"``
+    role: ClassVar[str]
+    #: the scene key that places it (``centre``; a rider: ``x``)
+    place_key: ClassVar[str] = "centre"
+    #: that key in the single-drum format (None: not in that format)
+    legacy_place_key: ClassVar[str | None] = None
+    #: its radius is the state ``NAME.radius`` and the channel ``NAME_radius`` [m]
+    radius_state: ClassVar[bool] = False
+    #: its mass properties change in time (the ``variable_mass`` effect applies)
+    variable_mass: ClassVar[bool] = False
+
+    def __init__(self, part: Any) -> None:
+        self.part = part
+        self.name: str = part.name
+        self.sense: int = int(getattr(part, "sense", 1))
+        self.free: tuple[str, ...] = ()
+        self.centre: tuple[float, float] = (0.0, 0.0)
+        self.parent: str | None = None
+        self.prescribed = False
+        self.drives: tuple[str, ...] = ()
+        self.torque_inputs: tuple[str, ...] = ()
+        self.setpoint_inputs: tuple[str, ...] = ()
+        #: its centre of mass offset [m] for the ``imbalance`` effect (None: no imbalance)
+        self.com_offset: float | None = None
+        #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine
+        self.joints: dict[str, int] = {}
+
+    @property
+    def kind(self) -> str:
+        """The part's table name (``drum``, ``roll``, ``rider``); for messages only."""
+        return self.table
+
+    # ---- structure ----------------------------------------------------------------------
+    @property
+    @abstractmethod
+    def initial_radius(self) -> float:
+        """Its radius [m] at ``t = 0`` (placing the bodies that rest on it)."""
+
+    @abstractmethod
+    def declare(self, machine: Machine) -> None:
+        """Register its parameters, its own states and its modes (once)."""
+
+    def declare_channels(self, machine: Machine) -> None:  # noqa: B027 - optional hook
+        """Register its own channels with their units (after the generic ones)."""
+
+    @abstractmethod
+    def initial_rate(self, coord: str) -> float:
+        """Initial rate of joint coordinate ``coord`` (``x``, ``z`` [m/s], ``theta``
+        [rad/s], the joint's sense), spec §7."""
+
+    def fixed_at_rest(self) -> Mapping[str, float]:
+        """Free coordinates held at a given value [m] in the static balance (default:
+        none, the balance solves for every free coordinate)."""
+        return {}
+
+    def breakpoints(self) -> tuple[float, ...]:
+        """Times [s] where its prescribed motion has a kink (the integrators stop there)."""
+        return ()
+
+    def operating_speed(self, web_speed: float) -> float:
+        """Its speed [rad/s] (operation sense) once a prescribed drive runs at
+        ``web_speed`` [m/s] (the operating point of the resonance map); only where
+        :attr:`prescribed`."""
+        raise NotImplementedError(f"{self!r} has no prescribed operating speed")
+
+    def hold_operating_speed(  # noqa: B027 - optional hook
+            self, machine: Machine, params: Any, web_speed: float) -> None:
+        """Set its run-time parameters in ``params`` so that a prescribed drive runs at
+        ``web_speed`` [m/s] from ``t = 0`` (default: nothing to set)."""
+
+    def radius_of(self, y: Any, machine: Machine) -> float:
+        """Its radius [m] in state ``y``."""
+        if self.radius_state:
+            return float(y[machine.index(f"{self.name}.radius")])
+        return float(self.part.radius)
+
+    def structure_tag(self) -> str:
+        """Everything about it that changes the generated code, beyond its names."""
+        return f"{type(self).__name__}:{self.sense}:{self.prescribed}:{','.join(self.drives)}" \
+            f":{','.join(self.torque_inputs)}:{self.parent}"
+
+    # ---- per evaluation -----------------------------------------------------------------
+    @abstractmethod
+    def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
+        """Its radius, mass properties (and prescribed rotation), own rates, switches."""
+
+    def transverse_inertia(self, ev: Evaluation, mass: Any, inertia: Any) -> Any:
+        """Its inertia [kg·m²] about a diameter through the centre, from its ``mass``
+        [kg] and polar ``inertia`` [kg·m²] (or their rates): a thin disc ``J/2``."""
+        return 0.5 * inertia
+
+    def drive_torque(self, ev: Evaluation) -> Any:
+        """Its input torque [N·m] (operation sense), or None (not torque-driven)."""
+        return None
+
+    def outputs(self, ev: Evaluation, bs: BodyState) -> None:  # noqa: B027 - optional
+        """Write its own channels (``ev.set_channel``)."""
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r})"
+
+
+class RigidDisc(BodyElement):
+    """A body of constant radius, mass and inertia: parameters ``NAME.radius`` [m],
+    ``NAME.inertia`` [kg·m²], ``NAME.mass`` [kg] from its part's keys."""
+
+    @property
+    def initial_radius(self) -> float:
+        return float(self.part.radius)
+
+    def declare(self, machine: Machine) -> None:
+        n, part = self.name, self.part
+        machine.parameter(f"{n}.radius", part.radius)
+        machine.parameter(f"{n}.inertia", part.inertia)
+        machine.parameter(f"{n}.mass", part.mass)
+
+    def initial_rate(self, coord: str) -> float:
+        return 0.0
+
+    def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
+        n = self.name
+        bs.r = ev.p(f"{n}.radius")
+        bs.r_dot = 0.0
+        bs.mass = ev.p(f"{n}.mass")
+        bs.inertia = ev.p(f"{n}.inertia")
+        bs.dm_dr = bs.dJ_dr = 0.0
