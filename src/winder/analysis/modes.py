@@ -44,7 +44,9 @@ from winder._args import integer, number, show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.linearise import jacobian
 from winder.model.machine import AUTO, IN_CONTACT
-from winder.scene.load import _MAX, Scene
+from winder.parts.drum import DRIVE_KEYS
+from winder.parts.roll import KEYS as ROLL_KEYS
+from winder.scene.load import Scene
 from winder.solve.equilibrium import EquilibriumError, nip_key, resting_state
 from winder.solve.system import MachineSystem
 
@@ -52,7 +54,7 @@ __all__ = ["Mode", "ModeMap", "operating_point", "modes_at", "mode_map", "MAX_PO
 
 #: Most radii of one resonance map.
 MAX_POINTS = 10_000
-WEB_SPEED_MAX = _MAX[("drum.drive", "web_speed")]  # [m/s], as in a scene
+WEB_SPEED_MAX = DRIVE_KEYS["web_speed"].hi  # [m/s], as in a scene
 #: Most Newton steps of one operating point.
 _NEWTON_STEPS = 200
 #: Largest relative change of a mode's frequency between neighbouring radii at a crossing.
@@ -674,7 +676,7 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
     roll's initial radius and its radius at the end of the scene's run."""
     roll, rc = lin.roll.part, lin.rc
     key = _core_key(lin)
-    hi = _MAX[("roll", "initial_radius")]
+    hi = ROLL_KEYS["initial_radius"].hi
     if radius_min is None:
         lo = roll.initial_radius
     else:

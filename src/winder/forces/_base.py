@@ -11,6 +11,7 @@ from abc import ABC
 from typing import TYPE_CHECKING, Any, ClassVar
 
 if TYPE_CHECKING:
+    from winder._schema import Key
     from winder.model.machine import Evaluation, Machine
 
 __all__ = ["ForceElement"]
@@ -42,6 +43,7 @@ class ForceElement(ABC):
     """
 
     name: ClassVar[str]
+    settings: ClassVar[tuple[Key, ...]] = ()  # its own keys, [effects.NAME] (scene schema)
     order: ClassVar[int] = 50
 
     def declare(self, machine: Machine) -> None:  # noqa: B027 - optional hook

@@ -20,10 +20,10 @@ import pinocchio as pin
 
 from winder._args import number
 from winder._errors import ArgumentError, ModelError
-from winder.scene.load import max_com_offset
+from winder.model.com_offset import max_com_offset
 
 __all__ = ["MassLaw", "MassProperties", "FunctionMassLaw", "PaperRollLaw", "paper_roll_mass",
-           "skew"]
+           "skew", "max_com_offset"]
 
 
 def paper_roll_mass(r: Any, core_radius: Any, core_mass: Any, core_inertia: Any,
@@ -140,7 +140,7 @@ class PaperRollLaw(MassLaw):
     ----------
     core_radius: ``r_c`` > 0 [m]; core_mass: > 0 [kg]; core_inertia: ``J_core`` > 0
     [kg·m²]; width: ``L`` > 0 [m]; density: ``ρ`` >= 0 [kg/m³]; com_offset: ``e`` [m],
-    ``0 <= e < min(r_c, √(J_core/m_core))`` (:func:`winder.scene.load.max_com_offset`: the
+    ``0 <= e < min(r_c, √(J_core/m_core))`` (:func:`max_com_offset`: the
     centre of mass inside the core, the inertia about it positive). All finite.
 
     The laws are defined for ``r >= r_c`` (finite): :meth:`mass`, :meth:`polar_inertia`,

@@ -23,7 +23,8 @@ from winder._errors import (
 )
 from winder.io.result import Result
 from winder.model.machine import CORE_AUTO
-from winder.scene.load import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
+from winder.scene.load import Scene, load_scene
+from winder.scene.schema import BACKENDS, MAX_SAMPLES, METHODS
 from winder.solve import integrators as integ
 from winder.solve.rosenbrock import ros2
 from winder.solve.system import MachineSystem
