@@ -192,6 +192,21 @@ def test_bad_setting_is_refused_naming_it(value, message):
         _two_drum({"rider_load": value})
 
 
+def test_effects_built_in_python_validate_their_settings():
+    from winder.scene import Effects
+
+    e = Effects(settings={"rider_load": {"scale": 0.5}})
+    assert e.setting("rider_load", "scale") == 0.5 and e == Effects(
+        settings=(("rider_load", (("scale", 0.5),)),))
+    assert Effects().setting("rider_load", "scale") == 1.0
+    with pytest.raises(winder.ArgumentError, match="scale"):
+        Effects(settings={"rider_load": {"scale": -2.0}})
+    with pytest.raises(winder.ArgumentError, match="not a setting of gravity; valid: \\(none\\)"):
+        Effects(settings={"gravity": {"g": 1.0}})
+    with pytest.raises(winder.ArgumentError, match="not an effect"):
+        Effects(settings={"wind": {"speed": 1.0}})
+
+
 def test_bad_setting_exits_2_naming_it(tmp_path):
     text = (MODELS / "two_drum_winder.toml").read_text(encoding="utf-8")
     bad = tmp_path / "bad.toml"

@@ -13,7 +13,7 @@ import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from winder._errors import SceneError
 from winder._schema import Key, Table
@@ -33,13 +33,10 @@ from winder.parts import roll as _roll
 from winder.scene.checks import check_roll_core
 from winder.scene.parse import fail, parse_table
 from winder.scene.schema import PAPER_KEYS, TABLES
-from winder.scene.tables import Paper
-
-if TYPE_CHECKING:
-    from winder.scene.scene import Scene
+from winder.scene.tables import Effects, Paper
 
 __all__ = ["Drive", "Drum", "Roll", "LegacyContact", "LegacyFriction", "LEGACY_TABLES",
-           "TABLE_NAMES", "is_legacy", "parse_tables", "build", "legacy_parts", "legacy_dict",
+           "TABLE_NAMES", "OWN_TABLES", "is_legacy", "parse_tables", "build", "legacy_parts",
            "check_rest_on_nip"]
 
 #: ``[drum]``: a drum's body keys.
@@ -64,6 +61,9 @@ LEGACY_TABLES: dict[str, Table] = {
 }
 #: The top-level tables of a single-drum scene.
 TABLE_NAMES = tuple(t for t in LEGACY_TABLES if t != "drum.drive")
+#: The tables of a single-drum scene that a scene of parts does not have (its
+#: :class:`~winder.scene.scene.Scene` fields).
+OWN_TABLES = ("drum", "roll", "paper", "contact", "friction")
 #: The tables a single-drum scene must have.
 REQUIRED_TABLES = ("scene", "drum", "roll", "paper")
 
@@ -126,11 +126,11 @@ class LegacyFriction(FrictionLaw):
     same keys and bounds)."""
 
 
-def legacy_parts(scene: Scene) -> dict[str, Any]:
-    """The parts of a single-drum scene (machines spec §8, last paragraph)."""
-    drum, roll, paper = scene.drum, scene.roll, scene.paper
-    assert drum is not None and roll is not None and paper is not None
-    assert scene.contact is not None and scene.friction is not None
+def legacy_parts(drum: Drum, roll: Roll, paper: Paper, contact: LegacyContact,
+                 friction: LegacyFriction) -> dict[str, Any]:
+    """The parts of a single-drum scene from its tables (machines spec §8, last
+    paragraph): the keyword arguments ``drums``, ``rolls``, ``riders``, ``nips``,
+    ``webs`` of :class:`~winder.scene.scene.Scene`."""
     d = drum.drive
     drive: SpeedProfileDrive | TorqueDrive = (
         TorqueDrive(torque=d.torque, web_speed=d.web_speed) if d.kind == "torque" else
@@ -148,8 +148,8 @@ def legacy_parts(scene: Scene) -> dict[str, Any]:
                            initial_height=roll.initial_height),),
         "riders": (),
         "nips": (NipPart(name="nip", a="drum", b="roll",
-                         contact=ContactLaw(**dataclasses.asdict(scene.contact)),
-                         friction=FrictionLaw(**dataclasses.asdict(scene.friction))),),
+                         contact=ContactLaw(**dataclasses.asdict(contact)),
+                         friction=FrictionLaw(**dataclasses.asdict(friction))),),
         "webs": (WebPart(entry_nip="nip", tension=0.0),),
     }
 
@@ -176,11 +176,11 @@ def parse_tables(source: str, data: Mapping[str, Any]) -> dict[str, dict[str, An
 
 
 def build(source: str, data: Mapping[str, Any], tables: Mapping[str, dict[str, Any]],
-          contact_on: bool) -> dict[str, Any]:
+          effects: Effects, gravity: float) -> dict[str, Any]:
     """The keyword arguments ``drum``, ``roll``, ``paper``, ``contact``, ``friction`` of
     :class:`~winder.scene.scene.Scene` from the parsed ``tables``
-    (:func:`parse_tables`), with the checks across them; ``contact_on``: whether
-    ``effects.contact`` is on."""
+    (:func:`parse_tables`), with the checks across them (the roll resting on the nip:
+    ``effects``, ``gravity`` [m/s²] of ``[scene]``)."""
     drum_raw = data["drum"]
     if "drive" not in drum_raw:
         raise SceneError(f"{source}: [drum.drive]: missing required table")
@@ -199,38 +199,33 @@ def build(source: str, data: Mapping[str, Any], tables: Mapping[str, dict[str, A
         raise fail(source, "drum.drive", "web_speed", "missing required key "
                    "(kind = 'speed_profile')")
     contact = LegacyContact(**tables["contact"])
-    if contact_on and "contact" not in data:
+    if effects.contact and "contact" not in data:
         raise SceneError(f"{source}: [contact]: missing required table (effects.contact is on)")
+    paper = Paper(**tables["paper"])
+    check_rest_on_nip(source, effects, gravity, roll, paper, contact)
     return {"drum": Drum(**tables["drum"], drive=Drive(**drive)), "roll": roll,
-            "paper": Paper(**tables["paper"]), "contact": contact,
+            "paper": paper, "contact": contact,
             "friction": LegacyFriction(**tables["friction"])}
 
 
-def legacy_dict(scene: Scene) -> dict[str, Any]:
-    """A single-drum scene's own tables as TOML tables (for :meth:`Scene.to_dict`)."""
-    return {n: dataclasses.asdict(getattr(scene, n))
-            for n in ("drum", "roll", "paper", "contact", "friction")}
-
-
-def check_rest_on_nip(scene: Scene) -> None:
+def check_rest_on_nip(source: str, effects: Effects, gravity: float, roll: Roll,
+                      paper: Paper, contact: LegacyContact) -> None:
     """Spec §6 starts the roll at rest on the nip (``F_n = m g``): the nip must carry the
     roll's weight with a compression below the roll's radius, else the roll axis would
     start inside the drum."""
-    if not scene.effects.contact or scene.roll.initial_height is not None:
+    if not effects.contact or roll.initial_height is not None:
         return
     from winder.forces.contact import rest_penetration  # (imports the Pinocchio model)
     from winder.model.mass_law import PaperRollLaw
 
-    roll = scene.roll
     r = roll.initial_radius
     weight = PaperRollLaw(roll.core_radius, roll.core_mass, roll.core_inertia, roll.width,
-                          scene.paper.density).mass(r) \
-        * (scene.scene.gravity if scene.effects.gravity else 0.0)
-    r_dot = scene.paper.caliper / (2 * math.pi) * roll.initial_speed
-    c = scene.contact
+                          paper.density).mass(r) * (gravity if effects.gravity else 0.0)
+    r_dot = paper.caliper / (2 * math.pi) * roll.initial_speed
+    c = contact
     delta = rest_penetration(c.law, lambda k: getattr(c, k), weight, r_dot)
     if not delta < r:
-        raise fail(scene.source, "contact", "stiffness",
+        raise fail(source, "contact", "stiffness",
                     f"{c.stiffness!r} ({c.law}) is too soft for the roll's weight "
                     f"{weight:.4g} N: at rest the nip would be compressed by {delta:.3g} m, "
                     f"more than the roll's radius {r!r} m, with the roll axis inside the "

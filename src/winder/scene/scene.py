@@ -12,15 +12,7 @@ from typing import Any
 from winder._args import show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.parts import DrumPart, NipPart, RiderPart, RollPart, WebPart
-from winder.scene.legacy import (
-    Drum,
-    LegacyContact,
-    LegacyFriction,
-    Roll,
-    check_rest_on_nip,
-    legacy_dict,
-    legacy_parts,
-)
+from winder.scene.legacy import OWN_TABLES, Drum, LegacyContact, LegacyFriction, Roll, legacy_parts
 from winder.scene.tables import Effects, Paper, SceneInfo, Solver
 from winder.scene.validate import scene_kwargs
 
@@ -64,7 +56,10 @@ class Scene:
         legacy = self.drum is not None
         object.__setattr__(self, "legacy", legacy)
         if legacy:  # the parts always follow the single-drum tables
-            for name, value in legacy_parts(self).items():
+            assert self.roll is not None and self.paper is not None
+            assert self.contact is not None and self.friction is not None
+            parts = legacy_parts(self.drum, self.roll, self.paper, self.contact, self.friction)
+            for name, value in parts.items():
                 object.__setattr__(self, name, value)
         # ``webs`` is every web; ``web`` the first (or only) one, kept for code that reads a
         # single web; given only ``web``, ``webs`` is that one
@@ -106,7 +101,7 @@ class Scene:
         out: dict[str, Any] = {"scene": _table_dict(self.scene),
                                "effects": self.effects.to_dict()}
         if self.legacy:
-            return {**out, **{k: _table_dict(v) for k, v in legacy_dict(self).items()},
+            return {**out, **{n: _table_dict(getattr(self, n)) for n in OWN_TABLES},
                     "solver": _table_dict(self.solver)}
         if self.paper is not None:
             out["paper"] = _table_dict(self.paper)
@@ -190,7 +185,4 @@ def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:
     """Validate nested dictionaries (as read from TOML) and build a :class:`Scene`: the
     single-drum format or a scene of parts (machines spec §8). Every error is a
     :class:`~winder.SceneError` naming the file, the table, the key and the value."""
-    scene = Scene(**scene_kwargs(data, source=source))
-    if scene.legacy:
-        check_rest_on_nip(scene)
-    return scene
+    return Scene(**scene_kwargs(data, source=source))

@@ -8,6 +8,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from winder._args import number
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.scene.schema import EFFECT_NAMES, effect_settings
 
@@ -59,11 +60,15 @@ class Effects:
                                     f"{', '.join(EFFECT_NAMES)}")
             items = tuple(values.items()) if isinstance(values, Mapping) else tuple(values)
             table = effect_settings(effect)
-            for key, _ in items:
+            for key, value in items:
                 if key not in table or key == "enabled":
                     valid = ", ".join(table.names()[1:]) or "(none)"
                     raise ArgumentError(f"Effects: {key!r} is not a setting of {effect}; "
                                         f"valid: {valid}")
+                k = table[key]
+                if k.kind == "num":
+                    number(f"Effects: settings of {effect}", key, value, lo=k.lo,
+                           lo_open=k.lo_open, hi=k.hi, unit=k.unit)
             if items:
                 out.append((effect, tuple(sorted(items))))
         object.__setattr__(self, "settings", tuple(sorted(out)))

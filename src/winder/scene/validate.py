@@ -9,9 +9,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+import winder.scene.legacy as legacy
 from winder._args import show
 from winder._errors import SceneError
-from winder.scene import legacy
 from winder.scene.parse import fail, name_text, parse_effects, parse_table
 from winder.scene.parts import parse_parts
 from winder.scene.schema import (
@@ -96,7 +96,7 @@ def scene_kwargs(data: Any, *, source: str = "<scene>") -> dict[str, Any]:
     common = {"scene": info, "effects": effects, "solver": Solver(**solver_kw),
               "source": source}
     if not parts:
-        return {**common, **legacy.build(source, data, old_tables, effects.contact)}
+        return {**common, **legacy.build(source, data, old_tables, effects, info.gravity)}
     paper = Paper(**parse_table(source, "paper", data["paper"], PAPER_KEYS)) \
         if "paper" in data else None
     return {**common, "drum": None, "roll": None, "paper": paper, "contact": None,
