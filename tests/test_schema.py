@@ -68,6 +68,25 @@ def test_no_bound_is_written_outside_the_declarations():
                 assert k.unit or (name, k.name) == ("solver", "atol"), (name, k.name)
 
 
+def test_scene_code_writes_no_bound():
+    """Outside the declarations (scene/schema.py, scene/legacy.py, the parts' KEYS) the
+    scene package writes no bound: no number in e-notation, no ``hi=`` or ``lo=`` with a number."""
+    for path in sorted((ROOT / "src" / "winder" / "scene").glob("*.py")):
+        if path.name in ("schema.py", "legacy.py", "reference.py"):
+            continue
+        code = [line.split("#")[0] for line in path.read_text(encoding="utf-8").splitlines()]
+        for i, line in enumerate(code, 1):
+            assert not re.search(r"\b\d+e\d+\b|\b(hi|lo)=\s*-?[\d.]", line) or "``" in line, \
+                (path.name, i, line)
+
+
+def test_single_drum_channels_are_documented_in_their_order():
+    from winder.scene.reference import LEGACY_CHANNEL_DOC
+    from winder.solve.system import CHANNELS, EXTRA_CHANNELS
+
+    assert tuple(LEGACY_CHANNEL_DOC) == (*CHANNELS, *EXTRA_CHANNELS)
+
+
 def test_parser_bounds_are_the_declared_ones():
     """Just past a declared bound is refused with the declared range in the message, the
     bound itself accepted: for every bounded number of a roll (both formats)."""

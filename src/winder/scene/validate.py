@@ -12,6 +12,7 @@ from typing import Any
 import winder.scene.legacy as legacy
 from winder._args import show
 from winder._errors import SceneError
+from winder._schema import format_number
 from winder.scene.parse import fail, name_text, parse_effects, parse_table
 from winder.scene.parts import parse_parts
 from winder.scene.schema import (
@@ -87,8 +88,9 @@ def scene_kwargs(data: Any, *, source: str = "<scene>") -> dict[str, Any]:
                    f"(output_step >= {info.duration / MAX_SAMPLES:.3g} s)")
     if "max_rhs" in solver_kw:
         if solver_kw["max_rhs"] != int(solver_kw["max_rhs"]):
+            hi = format_number(SOLVER_KEYS["max_rhs"].hi)
             raise fail(source, "solver", "max_rhs", f"{solver_kw['max_rhs']!r} is not a whole "
-                       "number of evaluations; valid: an integer 1 … 1e12")
+                       f"number of evaluations; valid: an integer 1 … {hi}")
         solver_kw["max_rhs"] = int(solver_kw["max_rhs"])
     if effects.slip_relaxation and not effects.contact:
         raise SceneError(f"{source}: [effects] slip_relaxation: true requires contact = true "
