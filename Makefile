@@ -72,7 +72,8 @@ bench: $(STAMP)
 peers: $(STAMP)
 	$(PY) benchmarks/peers/study.py
 
-# docs/scene-reference.md from the scene schema (src/winder/scene/load.py); a test fails when stale.
+# docs/scene-reference.md from the key declarations (parts' KEYS, scene/schema.py, the
+# effects' settings); a test fails when stale.
 scene-reference: $(STAMP)
 	$(PY) -m winder.scene.reference --out docs/scene-reference.md
 

@@ -29,13 +29,17 @@ EFFECTS = ("variable_mass", "web_momentum", "web_tension", "gravity", "imbalance
 
 def effects(**flags: bool) -> NS:
     """``[effects]``: every effect on unless ``flags`` says otherwise
-    (``effects(gravity=False)``); ``enabled()`` lists those on."""
+    (``effects(gravity=False)``); ``enabled()`` lists those on; ``setting(effect, key)``
+    is the declared default of an effect's setting."""
+    from winder.scene.schema import effect_settings
+
     unknown = set(flags) - set(EFFECTS)
     if unknown:
         raise KeyError(f"unknown effects {sorted(unknown)}")
     d = {n: bool(flags.get(n, True)) for n in EFFECTS}
     e = NS(**d)
     e.enabled = lambda: tuple(n for n in EFFECTS if getattr(e, n))
+    e.setting = lambda effect, key: effect_settings(effect)[key].default
     return e
 
 

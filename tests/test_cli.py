@@ -116,7 +116,7 @@ def test_balance_line_reports_a_solved_balance(tmp_path, models_dir, capsys) -> 
 
 def test_run_help_lists_every_method_and_backend(capsys) -> None:
     """`winder run --help` names the scene's [solver] choices, ROS2 included."""
-    from winder.scene.load import BACKENDS, METHODS
+    from winder.scene import BACKENDS, METHODS
 
     assert main(["run", "--help"]) == 0
     text = " ".join(capsys.readouterr().out.split())

@@ -26,7 +26,7 @@ from winder.parts import (
     UnwindTorqueDrive,
     WebPart,
 )
-from winder.scene.load import EFFECT_NAMES
+from winder.scene import EFFECT_NAMES
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 LINE = MODELS / "winder_line.toml"

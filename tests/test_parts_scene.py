@@ -27,7 +27,7 @@ from winder.parts import (
     TorqueDrive,
     WebPart,
 )
-from winder.scene.load import EFFECT_NAMES, Contact, Effects, Friction
+from winder.scene import EFFECT_NAMES, Effects, LegacyContact, LegacyFriction
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 TWO_DRUM = MODELS / "two_drum_winder.toml"
@@ -144,8 +144,8 @@ def test_single_drum_scene_as_parts(name) -> None:
                 assert getattr(getattr(s, table), key) == value, (table, key)
     for key, value in raw["drum"]["drive"].items():
         assert getattr(s.drum.drive, key) == value, key
-    assert s.contact == Contact(**raw.get("contact", {}))
-    assert s.friction == Friction(**raw.get("friction", {}))
+    assert s.contact == LegacyContact(**raw.get("contact", {}))
+    assert s.friction == LegacyFriction(**raw.get("friction", {}))
     # the parts (machines spec §8, last paragraph)
     d, ro, pa = s.drum, s.roll, s.paper
     drive = (TorqueDrive(torque=d.drive.torque, web_speed=d.drive.web_speed)
@@ -177,7 +177,7 @@ def test_single_drum_parts_follow_replace(paper_scene) -> None:
     assert s.drums[0].drive == TorqueDrive(torque=50.0, web_speed=3.0)
     assert s.rolls[0].initial_height == 0.7
     assert s.nips[0].contact.stiffness == 3e7
-    r = dataclasses.replace(s, friction=Friction(mu=0.5))
+    r = dataclasses.replace(s, friction=LegacyFriction(mu=0.5))
     assert r.nips[0].friction == FrictionLaw(mu=0.5) and r.legacy
 
 

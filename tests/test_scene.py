@@ -61,8 +61,8 @@ def test_paper_scene_values(paper_scene) -> None:
     assert (s.friction.mu, s.friction.slip_velocity, s.friction.relaxation_length,
             s.friction.min_speed) == (0.3, 0.05, 0.01, 0.1)
     assert s.scene.duration == 700.0
-    assert s.effects.enabled() == winder.scene.load.EFFECT_NAMES  # all on, in spec order
-    assert set(winder.FORCES) == set(winder.scene.load.EFFECT_NAMES)
+    assert s.effects.enabled() == winder.scene.EFFECT_NAMES  # all on, in spec order
+    assert set(winder.FORCES) == set(winder.scene.EFFECT_NAMES)
 
 
 def test_replace_validates(paper_scene) -> None:

@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import winder
-from winder.scene.load import _CHOICES, _MAX, _SPEC
+from winder.scene.legacy import LEGACY_TABLES
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 #: The shipped scenes in the single-drum format (the keys below are its tables).
@@ -32,8 +32,8 @@ SCENES = sorted(p for p in MODELS.glob("*.toml")
 CATEGORIES = ("missing", "wrong_type", "nan", "inf", "-inf", "zero", "negative", "huge",
               "too_long")
 #: (table, key, kind) of every scene key; kind "num", "bool" or "str".
-KEYS = tuple((table, key, spec[0]) for table, keys in _SPEC.items()
-             for key, spec in keys.items())
+KEYS = tuple((table, key.name, key.kind) for table, keys in LEGACY_TABLES.items()
+             for key in keys)
 LONG = 100_000  # characters of a "too long" string
 T_SHORT = 2e-3  # [s] the short run of a scene that loads
 
@@ -181,13 +181,13 @@ def test_bad_scene_key_gives_clean_error_or_sane_run(case) -> None:
 
 def _in_range(table: str, key: str) -> st.SearchStrategy:
     """Any value a scene accepts for ``[table] key`` on its own (log-uniform in its range)."""
-    kind, _, bound = _SPEC[table][key]
-    if kind == "bool":
+    spec = LEGACY_TABLES[table][key]
+    if spec.kind == "bool":
         return st.booleans()
-    if kind == "str":
-        return st.sampled_from(_CHOICES.get((table, key), ("a scene",)))
-    hi = _MAX.get((table, key), 1e3)
-    lo = bound[0] if bound else None
+    if spec.kind == "str":
+        return st.sampled_from(spec.choices or ("a scene",))
+    hi = spec.hi if spec.hi is not None else 1e3
+    lo = spec.lo
     exp = st.floats(min_value=math.log10(max(lo or 0.0, 1e-9 * hi)), max_value=math.log10(hi))
     if lo is None:
         values = st.tuples(exp, st.sampled_from((-1.0, 1.0))).map(lambda p: p[1] * 10 ** p[0])

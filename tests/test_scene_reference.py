@@ -10,11 +10,11 @@ from pathlib import Path
 import pytest
 
 import winder
-import winder.scene.load as sc
+from winder._schema import format_number as _num
+from winder.scene.keys import ALL_TABLES
 from winder.scene.reference import (
     CHANNEL_DOC,
     LEGACY_CHANNEL_DOC,
-    _num,
     channel_pattern,
     main,
     reference,
@@ -62,22 +62,22 @@ def test_every_schema_key_is_listed_once_with_unit_and_meaning():
     heads = {"scene": "[scene]", "effects": "[effects]", "solver": "[solver]",
              "paper": "[paper]", "drum": "[drum]", "drum.drive": "[drum.drive]",
              "roll": "[roll]", "contact": "[contact]", "friction": "[friction]"}
-    tables = [(heads[t], t, spec) for t, spec in sc._SPEC.items()]
-    tables += [(h, t, sc._PART_SPEC[t]) for t, h in (
+    tables = [(heads[t], t, ALL_TABLES[t]) for t in heads]
+    tables += [(h, t, ALL_TABLES[t]) for t, h in (
         ("drum[]", "[[drum]]"), ("drum[].drive", "[[drum]] drive"), ("roll[]", "[[roll]]"),
         ("roll[].drive", "[[roll]] drive (unwinding rolls)"), ("rider[]", "[[rider]]"),
         ("nip[]", "[[nip]]"), ("nip[].contact", "[[nip]] contact"),
         ("nip[].friction", "[[nip]] friction"), ("web", WEB),
         ("web.span", "[web.span]"))]
-    for head, table, spec in tables:
-        assert set(rows[head]) == set(spec), head
+    for head, _table, spec in tables:
+        assert list(rows[head]) == list(spec.names()), head
         for key, cells in rows[head].items():
             kind, unit, rng, default, meaning = cells
             assert unit and meaning and default, (head, key)
-            if spec[key][1]:
+            if spec[key].required:
                 assert default.startswith("required"), (head, key, default)
-            if spec[key][0] == "num":
-                hi = sc._MAX.get((table, key))
+            if spec[key].kind == "num":
+                hi = spec[key].hi
                 if hi is not None:  # the upper bound the parser enforces is the one shown
                     assert _num(hi) in rng, (head, key, rng)
 

@@ -143,7 +143,7 @@ def test_integer_beyond_the_float_range_is_named(paper_scene, kwargs) -> None:
 def test_scene_and_simulate_count_samples_alike(paper_scene) -> None:
     """duration / output_step + 1 samples (both ends): one more than the limit is refused by
     the scene already, not first by simulate after the scene loaded."""
-    from winder.scene.load import MAX_SAMPLES
+    from winder.scene import MAX_SAMPLES
 
     with pytest.raises(winder.SceneError, match="output_step"):
         paper_scene.replace(scene={"duration": 1e6, "output_step": 1e6 / MAX_SAMPLES})

@@ -28,7 +28,7 @@ from winder.analysis.sweep_summary import BAND_COLUMNS, SCALAR_COLUMNS, default_
 from winder.analysis.sweep_table import SweepTable
 from winder.cli import main
 from winder.plots.sweep import axis_label
-from winder.scene.load import key_unit
+from winder.scene import key_unit
 
 # Short runs of the paper scene (web speed reached after 6-12 s, 30 s each, ~0.1 s of
 # integration): bouncing at the higher speeds and the larger imbalance, none at 12 m/s
@@ -454,13 +454,12 @@ def test_tied_keys_in_the_grid(two_drum) -> None:
 def test_units_come_from_the_key_declarations() -> None:
     """Every numeric key of both scene formats has a unit; paths of both formats map to
     the same unit; words and unknown paths have none."""
-    import winder.scene.load as _scene
+    from winder.scene.keys import ALL_TABLES
 
-    for specs in (_scene._SPEC, _scene._PART_SPEC):
-        for table, keys in specs.items():
-            for key, (kind, _, _) in keys.items():
-                if kind == "num":
-                    assert (table, key) in _scene._UNITS, (table, key)
+    for table, keys in ALL_TABLES.items():
+        for key in keys:
+            if key.kind == "num":
+                assert key.unit or (table, key.name) == ("solver", "atol"), (table, key)
     for path, unit in (("drum.drive.web_speed", "m/s"), ("drum.front.drive.web_speed", "m/s"),
                        ("roll.com_offset", "m"), ("roll.set.com_offset", "m"),
                        ("roll.set.density", "kg/m³"), ("contact.stiffness", "N/m"),

@@ -25,7 +25,7 @@ _LAZY = {
     **dict.fromkeys(("Mode", "ModeMap", "mode_map", "modes_at"), ".analysis.modes"),
     **dict.fromkeys(("Result", "load_result", "ResultFileError"), ".io.result"),
     **dict.fromkeys(("OutputError",), ".io.files"),
-    **dict.fromkeys(("Scene", "load_scene", "scene_from_dict"), ".scene.load"),
+    **dict.fromkeys(("Scene", "load_scene", "scene_from_dict"), ".scene"),
     **dict.fromkeys(("DEFAULT_METHOD", "simulate"), ".solve.simulate"),
     **dict.fromkeys(("Stepper",), ".solve.stepper"),
     **dict.fromkeys(("CHANNELS", "EXTRA_CHANNELS", "MachineSystem"), ".solve.system"),
@@ -48,7 +48,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from winder.model.machine import Machine
     from winder.model.mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
     from winder.model.variable_body import VariableMassModel
-    from winder.scene.load import Scene, load_scene, scene_from_dict
+    from winder.scene import Scene, load_scene, scene_from_dict
     from winder.solve.simulate import DEFAULT_METHOD, simulate
     from winder.solve.stepper import Stepper
     from winder.solve.system import CHANNELS, EXTRA_CHANNELS, MachineSystem

@@ -435,7 +435,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _build_parser() -> argparse.ArgumentParser:
-    from winder.scene.load import BACKENDS, METHODS  # the scene's [solver] choices: one list
+    from winder.scene.schema import BACKENDS, METHODS  # the scene's [solver] choices: one list
 
     parser = _Parser(prog="winder", description="Paper winder simulation.",
                      epilog="Exit status: 0 done; 2 bad input or failed run (a message names "

@@ -34,7 +34,8 @@ from winder.analysis.operating_point import (
     _radius,
     operating_point,
 )
-from winder.scene.load import _MAX, Scene
+from winder.parts.roll import KEYS as ROLL_KEYS
+from winder.scene.load import Scene
 
 __all__ = ["Mode", "ModeMap", "operating_point", "modes_at", "mode_map", "MAX_POINTS"]
 
@@ -204,7 +205,7 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
     roll's initial radius and its radius at the end of the scene's run."""
     roll, rc = lin.roll.part, lin.rc
     key = _core_key(lin)
-    hi = _MAX[("roll", "initial_radius")]
+    hi = ROLL_KEYS["initial_radius"].hi
     if radius_min is None:
         lo = roll.initial_radius
     else:

@@ -40,13 +40,14 @@ from winder._args import number, show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.linearise import jacobian
 from winder.model.locked_modes import AUTO, IN_CONTACT, ModeKind
-from winder.scene.load import _MAX, Scene
+from winder.parts.drum import DRIVE_KEYS
+from winder.scene.load import Scene
 from winder.solve.equilibrium import EquilibriumError, nip_key, resting_state
 from winder.solve.system import MachineSystem
 
 __all__ = ["Mode", "operating_point", "WEB_SPEED_MAX"]
 
-WEB_SPEED_MAX = _MAX[("drum.drive", "web_speed")]  # [m/s], as in a scene
+WEB_SPEED_MAX = DRIVE_KEYS["web_speed"].hi  # [m/s], as in a scene
 #: Most Newton steps of one operating point.
 _NEWTON_STEPS = 200
 #: A scaled residual (each equation over its largest Jacobian entry: a step in the unknowns'

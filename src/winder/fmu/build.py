@@ -49,26 +49,35 @@ from pathlib import Path
 from typing import Any
 
 from winder._errors import WinderError
+from winder.scene.keys import find_key, key_unit
 from winder.scene.load import Scene, load_scene
 
-__all__ = ["build_fmu", "FMU_PARAMETERS", "fmu_parameters", "parameter_value",
-           "scene_with_parameters", "FmuError"]
+__all__ = ["build_fmu", "FMU_PARAMETERS", "fmu_parameters", "parameter_units",
+           "parameter_value", "scene_with_parameters", "FmuError"]
 
-#: FMU parameter name → (scene table, key, description with unit).
+def _text(table: str, key: str, unit: str | None = None) -> str:
+    """A parameter's description: its scene key's meaning and unit (``unit`` where given,
+    else the declared one; :func:`winder.scene.keys.find_key`)."""
+    k = find_key(table, key)
+    return f"{k.doc} [{k.unit if unit is None else unit}]"
+
+
+#: FMU parameter name → (scene table, key, description with unit) of a single-drum scene;
+#: the description and unit are the key's declaration.
 FMU_PARAMETERS: dict[str, tuple[str, str, str]] = {
-    "profile_web_speed": ("drum.drive", "web_speed", "final web speed of the profile [m/s]"),
-    "web_acceleration": ("drum.drive", "web_acceleration", "web acceleration [m/s2]"),
-    "com_offset": ("roll", "com_offset", "centre of mass offset e [m]"),
-    "contact_stiffness": ("contact", "stiffness", "nip stiffness k [N/m]"),
-    "contact_damping": ("contact", "damping", "nip damping c [N s/m]"),
-    "mu": ("friction", "mu", "friction coefficient [-]"),
-    "slip_reference_velocity": ("friction", "slip_velocity",
-                                "slip regularisation v_ref [m/s]"),
-    "relaxation_length": ("friction", "relaxation_length", "relaxation length [m]"),
-    "caliper": ("paper", "caliper", "paper thickness h [m]"),
-    "density": ("paper", "density", "paper density [kg/m3]"),
-    "width": ("roll", "width", "roll width L [m]"),
-}
+    name: (table, key, _text(table, key)) for name, (table, key) in {
+        "profile_web_speed": ("drum.drive", "web_speed"),
+        "web_acceleration": ("drum.drive", "web_acceleration"),
+        "com_offset": ("roll", "com_offset"),
+        "contact_stiffness": ("contact", "stiffness"),
+        "contact_damping": ("contact", "damping"),
+        "mu": ("friction", "mu"),
+        "slip_reference_velocity": ("friction", "slip_velocity"),
+        "relaxation_length": ("friction", "relaxation_length"),
+        "caliper": ("paper", "caliper"),
+        "density": ("paper", "density"),
+        "width": ("roll", "width"),
+    }.items()}
 
 # pythonfmu's binary finds the class by the pattern ``class X(Fmi2Slave):`` in this file,
 # hence the alias.
@@ -88,22 +97,14 @@ class FmuError(WinderError):
 
 
 #: Parameters of a machine from parts, per part kind: FMU name suffix → key path in
-#: the part's table, description with unit.
-_PART_PARAMETERS: dict[str, dict[str, tuple[tuple[str, ...], str]]] = {
-    "roll": {
-        "com_offset": (("com_offset",), "centre of mass offset e [m]"),
-        "width": (("width",), "roll width L [m]"),
-        "density": (("density",), "paper density [kg/m3]"),
-        "caliper": (("caliper",), "paper thickness h [m]"),
-    },
-    "nip": {
-        "contact_stiffness": (("contact", "stiffness"), "nip stiffness k [N/m]"),
-        "contact_damping": (("contact", "damping"), "nip damping c [N s/m]"),
-        "mu": (("friction", "mu"), "friction coefficient [-]"),
-        "slip_reference_velocity": (("friction", "slip_velocity"),
-                                    "slip regularisation v_ref [m/s]"),
-        "relaxation_length": (("friction", "relaxation_length"), "relaxation length [m]"),
-    },
+#: the part's table (its declaration gives the description and unit).
+_PART_PARAMETERS: dict[str, dict[str, tuple[str, ...]]] = {
+    "roll": {"com_offset": ("com_offset",), "width": ("width",), "density": ("density",),
+             "caliper": ("caliper",)},
+    "nip": {"contact_stiffness": ("contact", "stiffness"),
+            "contact_damping": ("contact", "damping"), "mu": ("friction", "mu"),
+            "slip_reference_velocity": ("friction", "slip_velocity"),
+            "relaxation_length": ("friction", "relaxation_length")},
 }
 
 #: A parameter's place in the scene: the table, the element name for an array of tables
@@ -111,44 +112,62 @@ _PART_PARAMETERS: dict[str, dict[str, tuple[tuple[str, ...], str]]] = {
 ParameterPath = tuple[str, "str | None", tuple[str, ...]]
 
 
-def fmu_parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
-    """The FMU parameters of ``scene`` (besides ``rtol`` and, single-drum only,
-    ``speed_profile``): FMU name → (place in the scene, description with unit)."""
+def _schema_key(place: ParameterPath) -> tuple[str, str]:
+    """``(schema table, key)`` of a parameter's place: ``("nip", "rear", ("contact",
+    "stiffness"))`` is ``("nip[].contact", "stiffness")``."""
+    table, element, path = place
+    head = table + ("[]" if element is not None else "")
+    return ".".join((head, *path[:-1])), path[-1]
+
+
+def _parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
+    """FMU name → (place in the scene, what it is for, before the key's meaning)."""
     if scene.legacy:
         out: dict[str, tuple[ParameterPath, str]] = {}
-        for name, (table, key, text) in FMU_PARAMETERS.items():
+        for name, (table, key, _) in FMU_PARAMETERS.items():
             top, *sub = table.split(".")
-            out[name] = ((top, None, (*sub, key)), text)
+            out[name] = ((top, None, (*sub, key)), "")
         return out
     out = {}
     for drum in scene.drums:
         if drum.drive.kind == "speed_profile":
             out[f"{drum.name}_web_acceleration"] = (
-                ("drum", drum.name, ("drive", "web_acceleration")),
-                f"web acceleration of drum {drum.name}'s profile [m/s2]")
-            text = f"final web speed of drum {drum.name}'s profile [m/s]"
-        else:
-            text = f"initial surface speed of drum {drum.name} [m/s]"
-        out[f"{drum.name}_web_speed"] = (("drum", drum.name, ("drive", "web_speed")), text)
+                ("drum", drum.name, ("drive", "web_acceleration")), f"drum {drum.name}: ")
+        out[f"{drum.name}_web_speed"] = (("drum", drum.name, ("drive", "web_speed")),
+                                         f"drum {drum.name}: ")
     for kind, parts in (("roll", scene.rolls), ("nip", scene.nips)):
         for part in parts:
-            for suffix, (path, text) in _PART_PARAMETERS[kind].items():
-                out[f"{part.name}_{suffix}"] = ((kind, part.name, path),
-                                                f"{kind} {part.name}: {text}")
+            for suffix, path in _PART_PARAMETERS[kind].items():
+                out[f"{part.name}_{suffix}"] = ((kind, part.name, path), f"{kind} {part.name}: ")
     for roll in scene.rolls:
         if getattr(roll.drive, "kind", None) == "tension_control":
-            out[f"{roll.name}_bandwidth"] = (
-                ("roll", roll.name, ("drive", "bandwidth")),
-                f"roll {roll.name}: tension controller's bandwidth ω_c [rad/s]")
+            out[f"{roll.name}_bandwidth"] = (("roll", roll.name, ("drive", "bandwidth")),
+                                             f"roll {roll.name}: ")
     span = scene.web.span if scene.web is not None else None
     if span is not None:  # the tension is the span's state (no web_tension)
-        for key, text in (("length", "web span length L_s [m]"),
-                          ("EA", "web span axial stiffness EA [N]"),
-                          ("T_in", "wound-in tension of the unwinding roll T_in [N]")):
-            out[f"span_{key}"] = (("web", None, ("span", key)), text)
+        for key in ("length", "EA", "T_in"):
+            out[f"span_{key}"] = (("web", None, ("span", key)), "web span: ")
     elif scene.web is not None:
-        out["web_tension"] = (("web", None, ("tension",)), "web tension T [N]")
+        out["web_tension"] = (("web", None, ("tension",)), "")
     return out
+
+
+def fmu_parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
+    """The FMU parameters of ``scene`` (besides ``rtol`` and, single-drum only,
+    ``speed_profile``): FMU name → (place in the scene, description with unit, from the
+    scene key's declaration)."""
+    units = parameter_units(scene)
+    return {name: (place, who + _text(*_schema_key(place), units[name]))
+            for name, (place, who) in _parameters(scene).items()}
+
+
+def parameter_units(scene: Scene) -> dict[str, str]:
+    """The unit of each FMU parameter of ``scene`` (:func:`fmu_parameters`): its scene
+    key's (:func:`winder.scene.key_unit`: as declared; ``N/m^p`` for a Hunt–Crossley
+    nip's stiffness; ``"-"``: dimensionless)."""
+    data = scene.to_dict()
+    return {name: key_unit(".".join(p for p in (place[0], place[1], *place[2]) if p), data)
+            for name, (place, _) in _parameters(scene).items()}
 
 
 def parameter_value(scene: Scene, place: ParameterPath) -> float:

@@ -11,6 +11,7 @@ from abc import ABC
 from typing import TYPE_CHECKING, Any, ClassVar
 
 if TYPE_CHECKING:
+    from winder._schema import Key
     from winder.model.machine import Evaluation, Machine
 
 __all__ = ["ForceElement"]
@@ -54,6 +55,7 @@ class ForceElement(ABC):
     """
 
     name: ClassVar[str]
+    settings: ClassVar[tuple[Key, ...]] = ()  # its own keys, [effects.NAME] (scene schema)
 
     #: quantities it writes for other elements and the machine
     provides: ClassVar[frozenset[str]] = frozenset()

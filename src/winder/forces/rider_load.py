@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from winder._schema import Key
 from winder.forces._base import ForceElement
 
 if TYPE_CHECKING:
@@ -27,12 +28,16 @@ class RiderLoad(ForceElement):
     """The applied load of every rider roll with a load schedule."""
 
     name = "rider_load"
+    settings = (Key(name="scale", unit="-", lo=0.0, hi=100.0, default=1.0,
+                    doc="factor on every rider's line-load schedule (1: as given; 0: only "
+                        "the riders' weight)"),)
 
     def declare(self, machine: Machine) -> None:
+        scale = machine.scene.effects.setting(self.name, "scale")
         for b in _riders(machine):
             for i, (r, q) in enumerate(b.load):
                 machine.parameter(f"{b.name}.load_radius_{i}", r)
-                machine.parameter(f"{b.name}.line_load_{i}", q)
+                machine.parameter(f"{b.name}.line_load_{i}", q * scale)
             machine.channel(f"{b.name}_load", "N")
 
     def apply(self, ev: Evaluation) -> None:

@@ -5,16 +5,56 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-__all__ = ["NipPart", "ContactLaw", "FrictionLaw", "CONTACT_LAWS"]
+from winder._schema import Key, Table
+from winder.parts.drum import NAME
+
+__all__ = ["NipPart", "ContactLaw", "FrictionLaw", "CONTACT_LAWS", "KEYS", "CONTACT_KEYS",
+           "FRICTION_KEYS"]
 
 CONTACT_LAWS = ("linear", "hunt_crossley")
+
+#: The keys of ``[[nip]]`` (its ``contact`` and ``friction``: :data:`CONTACT_KEYS`,
+#: :data:`FRICTION_KEYS`).
+KEYS = Table((
+    NAME,
+    Key(name="a", kind="ref", required=True,
+        doc="the lower or supplying body (the drum under a roll, the roll under a rider)"),
+    Key(name="b", kind="ref", required=True, doc="the other body"),
+    Key(name="contact", kind="table", default_text="required while effects.contact is on",
+        doc="the contact law, a sub-table: keys below"),
+    Key(name="friction", kind="table", doc="the friction law, a sub-table: keys below"),
+))
+
+#: The keys of a nip's contact law (and of the single-drum format's ``[contact]``).
+CONTACT_KEYS = Table((
+    Key(name="law", kind="str", choices=CONTACT_LAWS,
+        doc="linear: F_n = max(0, k δ + c δ̇); hunt_crossley: F_n = max(0, k δ^p (1 + α δ̇))"),
+    Key(name="stiffness", unit="N/m", doc_unit="N/m (N/m^p)", lo=0.0, lo_open=True, hi=1e18,
+        doc="stiffness k of the nip"),
+    Key(name="damping", unit="N·s/m", lo=0.0, hi=1e12, doc="damping c of the linear law"),
+    Key(name="exponent", unit="-", lo=1.0, hi=3.0, doc="exponent p of the Hunt–Crossley law"),
+    Key(name="hc_damping", unit="s/m", lo=0.0, hi=1e4,
+        doc="damping α of the Hunt–Crossley law"),
+))
+
+#: The keys of a nip's friction law (and of the single-drum format's ``[friction]``).
+FRICTION_KEYS = Table((
+    Key(name="mu", unit="-", lo=0.0, hi=10.0,
+        doc="friction coefficient μ: F_ss = μ F_n tanh(v_s / v_ref)"),
+    Key(name="slip_velocity", unit="m/s", lo=0.0, lo_open=True, hi=1e3,
+        doc="slip velocity scale v_ref of the tanh law"),
+    Key(name="relaxation_length", unit="m", lo=0.0, lo_open=True, hi=1e3,
+        doc="relaxation length σ: dF_t/dt = (|u_a| + v_min)/σ (F_ss − F_t)"),
+    Key(name="min_speed", unit="m/s", lo=0.0, lo_open=True, hi=1e3,
+        doc="speed v_min added in the relaxation rate (keeps it finite at standstill)"),
+))
 
 
 @dataclass(frozen=True)
 class ContactLaw:
-    """``contact``: law (``linear`` | ``hunt_crossley``), stiffness (0, 1e18] [N/m or
-    N/m^p], damping [0, 1e12] [N·s/m] (linear), exponent ``p`` [1, 3] [-] and hc_damping
-    ``α`` [0, 1e4] [s/m] (Hunt–Crossley)."""
+    """``contact``: law (``linear`` | ``hunt_crossley``), stiffness [N/m or N/m^p],
+    damping [N·s/m] (linear), exponent ``p`` [-] and hc_damping ``α`` [s/m]
+    (Hunt–Crossley); bounds and meanings: :data:`CONTACT_KEYS`."""
 
     law: str = "linear"
     stiffness: float = 1e7
@@ -25,8 +65,8 @@ class ContactLaw:
 
 @dataclass(frozen=True)
 class FrictionLaw:
-    """``friction``: mu [0, 10] [-], slip_velocity ``v_ref`` (0, 1000] [m/s],
-    relaxation_length ``σ`` (0, 1000] [m], min_speed ``v_min`` (0, 1000] [m/s]."""
+    """``friction``: mu [-], slip_velocity ``v_ref`` [m/s], relaxation_length ``σ`` [m],
+    min_speed ``v_min`` [m/s]; bounds and meanings: :data:`FRICTION_KEYS`."""
 
     mu: float = 0.3
     slip_velocity: float = 0.05
@@ -37,7 +77,8 @@ class FrictionLaw:
 @dataclass(frozen=True)
 class NipPart:
     """``[[nip]]``: name; bodies ``a`` (the lower or supplying body) and ``b`` (names of
-    two different bodies, not both with a fixed centre); contact and friction laws."""
+    two different bodies, not both with a fixed centre); contact and friction laws
+    (:data:`KEYS`)."""
 
     name: str
     a: str

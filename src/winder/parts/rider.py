@@ -5,16 +5,42 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["RiderPart"]
+from winder._schema import Key, Table
+from winder.parts.drum import MAX_COORD, NAME
+
+__all__ = ["RiderPart", "KEYS"]
+
+#: The keys of ``[[rider]]``.
+KEYS = Table((
+    NAME,
+    Key(name="rides", kind="ref", required=True,
+        doc="name of the paper roll it rests on (through a [[nip]] with a = that roll, "
+            "b = the rider)"),
+    Key(name="radius", required=True, unit="m", lo=0.0, lo_open=True, hi=10.0,
+        doc="rider radius (constant)"),
+    Key(name="mass", required=True, unit="kg", lo=0.0, lo_open=True, hi=1e6,
+        doc="rider mass"),
+    Key(name="inertia", required=True, unit="kg·m²", lo=0.0, lo_open=True, hi=1e7,
+        doc="polar inertia of the rider"),
+    Key(name="x", required=True, unit="m", hi=MAX_COORD,
+        doc="horizontal position of its axis (fixed; it moves along z)"),
+    Key(name="load", kind="load", doc_unit="m, N/m", default_text="[] (no load)",
+        doc="line-load schedule [[radius of the ridden roll, line load], ...], radii "
+            "strictly increasing, interpolated linearly, held beyond the ends; the force "
+            "is −width × load along z",
+        items=(Key(name="radius", unit="m", lo=0.0, lo_open=True, hi=10.0,
+                   doc="radius of the ridden roll"),
+               Key(name="line_load", unit="N/m", lo=0.0, hi=1e7, doc="line load"))),
+))
 
 
 @dataclass(frozen=True)
 class RiderPart:
-    """``[[rider]]``: name; rides (the name of the roll it rests on); radius (0, 10] [m],
-    mass (0, 1e6] [kg], inertia (0, 1e7] [kg·m²]; x [m] (its fixed centre ``x``,
-    ``|x| <= 1000``); load: the line-load schedule ``((radius [m], line_load [N/m]), ...)``
-    with strictly increasing radii of the ridden roll in (0, 10] and line loads
-    [0, 1e7], interpolated linearly and held beyond the ends (empty: no load)."""
+    """``[[rider]]``: name; rides (the name of the roll it rests on); radius [m], mass
+    [kg], inertia [kg·m²]; x [m] (its fixed centre ``x``); load: the line-load schedule
+    ``((radius [m], line_load [N/m]), ...)`` with strictly increasing radii of the ridden
+    roll, interpolated linearly and held beyond the ends (empty: no load); bounds and
+    meanings: :data:`KEYS`."""
 
     name: str
     rides: str

@@ -6,16 +6,45 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["WebPart", "SpanPart"]
+from winder._schema import Key, Table
+
+__all__ = ["WebPart", "SpanPart", "KEYS", "SPAN_KEYS"]
+
+#: The keys of ``[web]`` (or of each ``[[web]]``).
+KEYS = Table((
+    Key(name="name", kind="name", default_text="its entry_nip",
+        doc="the web's name, in its channels and messages where a scene has several webs "
+            "([[web]], one per wound roll)"),
+    Key(name="entry_nip", kind="ref", required=True,
+        doc="the nip where the web enters the wound roll (a: the drum it wraps, b: the "
+            "roll)"),
+    Key(name="tension", unit="N", lo=0.0, hi=1e7,
+        doc="constant web tension (not with [web.span])"),
+    Key(name="span", kind="table", default_text="none",
+        doc="an elastic span from an unwinding roll, a sub-table: keys below"),
+))
+
+#: The keys of ``[web.span]`` (``from`` is the field ``source``).
+SPAN_KEYS = Table((
+    Key(name="from", kind="ref", required=True,
+        doc="the unwinding roll that feeds the span"),
+    Key(name="length", required=True, unit="m", lo=0.0, lo_open=True, hi=1e3,
+        doc="span length L_s"),
+    Key(name="EA", required=True, unit="N", lo=0.0, lo_open=True, hi=1e12,
+        doc="axial stiffness EA of the web"),
+    Key(name="T_in", unit="N", lo=0.0, hi=1e7, doc="tension wound into the unwinding roll"),
+    Key(name="initial_tension", unit="N", lo=0.0, hi=1e7, default_text="T_in",
+        doc="span tension at t = 0"),
+))
 
 
 @dataclass(frozen=True)
 class SpanPart:
     """``[web.span]``: the elastic span from an unwinding roll to the winder's entry drum
-    (spec §5). source (TOML key ``from``): the unwinding roll's name; length ``L_s``
-    (0, 1e3] [m]; EA (0, 1e12] [N] (axial stiffness); T_in [0, 1e7] [N] (wound-in tension
-    of the unwinding roll); initial_tension [0, 1e7] [N] (None: ``T_in``, the
-    equilibrium at equal speeds)."""
+    (spec §5). source (TOML key ``from``): the unwinding roll's name; length ``L_s`` [m];
+    EA [N] (axial stiffness); T_in [N] (wound-in tension of the unwinding roll);
+    initial_tension [N] (None: ``T_in``, the equilibrium at equal speeds); bounds:
+    :data:`SPAN_KEYS`."""
 
     source: str
     length: float
@@ -27,9 +56,10 @@ class SpanPart:
 @dataclass(frozen=True)
 class WebPart:
     """``[web]`` (or one ``[[web]]`` element): entry_nip (the name of the nip where the web
-    enters its wound roll: ``a`` a drum, ``b`` a wound roll), tension [0, 1e7] [N]
-    (constant; 0 and unused with a span), span (:class:`SpanPart` or None), name (None:
-    the entry nip's name; it prefixes the web's channels in a scene of several webs)."""
+    enters its wound roll: ``a`` a drum, ``b`` a wound roll), tension [N] (constant; 0
+    and unused with a span), span (:class:`SpanPart` or None), name (None: the entry
+    nip's name; it prefixes the web's channels in a scene of several webs); bounds:
+    :data:`KEYS`."""
 
     entry_nip: str
     tension: float = 0.0

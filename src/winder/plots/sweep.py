@@ -30,7 +30,8 @@ from winder.analysis.modes import mode_map  # noqa: E402
 from winder.analysis.sweep_grid import set_path, split_keys  # noqa: E402
 from winder.analysis.sweep_table import SweepTable  # noqa: E402
 from winder.io.files import atomic_write  # noqa: E402
-from winder.scene.load import key_unit, scene_from_dict  # noqa: E402
+from winder.scene.keys import key_unit  # noqa: E402
+from winder.scene.load import scene_from_dict  # noqa: E402
 
 __all__ = ["runnability_map", "map_layout", "axis_label", "SPEED_KEY"]
 

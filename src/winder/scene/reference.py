@@ -1,9 +1,10 @@
 """The scene reference (``docs/scene-reference.md``), generated from the scene schema.
 
 Every table and key of both scene formats with its type, unit, range, default and
-meaning, joined from the declarations in :mod:`winder.scene.load` (``_SPEC``, ``_PART_SPEC``,
-``_MAX``, ``_CHOICES``, ``_KEY_DOC``) and the parts' dataclass defaults, then the result
-channels. Regenerate with ``make scene-reference`` or::
+meaning, read from each key's one declaration (:class:`~winder._schema.Key`: the parts'
+``KEYS``, the effects' ``settings``, :mod:`winder.scene.schema`,
+:mod:`winder.scene.legacy`) and, for a default the key does not declare, the dataclass
+field's; then the result channels. Regenerate with ``make scene-reference`` or::
 
     python -m winder.scene.reference [--out docs/scene-reference.md] [--check]
 
@@ -18,7 +19,8 @@ import re
 import sys
 from pathlib import Path
 
-import winder.scene.load as sc
+from winder._schema import NO_DEFAULT, Key, Table
+from winder._schema import format_number as _num
 from winder.parts import (
     ContactLaw,
     DrumPart,
@@ -33,23 +35,29 @@ from winder.parts import (
     UnwindTorqueDrive,
     WebPart,
 )
-from winder.solve.system import CHANNELS, EXTRA_CHANNELS
+from winder.parts.drum import DRIVE_KEYS as DRUM_DRIVE_KEYS
+from winder.parts.roll import DRIVE_KEYS as UNWIND_DRIVE_KEYS
+from winder.scene.keys import ALL_TABLES
+from winder.scene.legacy import Drive, Drum, Roll
+from winder.scene.schema import EFFECT_NAMES, effect_settings
+from winder.scene.tables import Effects, Paper, SceneInfo, Solver
 
 __all__ = ["reference", "main", "CHANNEL_DOC", "LEGACY_CHANNEL_DOC"]
 
 #: The dataclasses whose defaults a schema table's keys take (the first that has the
 #: field; ``from`` of ``[web.span]`` is the field ``source``).
 _DEFAULTS_FROM: dict[str, tuple[type, ...]] = {
-    "scene": (sc.SceneInfo,), "effects": (sc.Effects,), "drum": (sc.Drum,),
-    "drum.drive": (sc.Drive,), "roll": (sc.Roll,), "paper": (sc.Paper,),
-    "contact": (ContactLaw,), "friction": (FrictionLaw,), "solver": (sc.Solver,),
+    "scene": (SceneInfo,), "effects": (Effects,), "drum": (Drum,),
+    "drum.drive": (Drive,), "roll": (Roll,), "paper": (Paper,),
+    "contact": (ContactLaw,), "friction": (FrictionLaw,), "solver": (Solver,),
     "drum[]": (DrumPart,), "drum[].drive": (SpeedProfileDrive, TorqueDrive),
     "roll[]": (RollPart,), "roll[].drive": (UnwindTorqueDrive, TensionControl),
     "rider[]": (RiderPart,), "nip[]": (NipPart,), "nip[].contact": (ContactLaw,),
     "nip[].friction": (FrictionLaw,), "web": (WebPart,), "web.span": (SpanPart,),
 }
 
-#: Result channels of a single-drum scene: name -> (unit, meaning).
+#: Result channels of a single-drum scene, in their order (the standard 16, then
+#: winder's extras): name -> (unit, meaning).
 LEGACY_CHANNEL_DOC: dict[str, tuple[str, str]] = {
     "t": ("s", "time"),
     "drum_speed": ("rad/s", "drum speed Ω (operation sense)"),
@@ -110,64 +118,40 @@ CHANNEL_DOC: dict[str, tuple[str, str]] = {
 }
 
 
-def _kind_text(table: str, key: str, kind: str) -> str:
-    choices = sc._CHOICES.get((table, key))
-    if choices:
-        return "string: " + ", ".join(f"`{c}`" for c in choices)
+def _kind_text(key: Key) -> str:
+    if key.choices:
+        return "string: " + ", ".join(f"`{c}`" for c in key.choices)
     return {"num": "number", "bool": "boolean", "str": "string", "name": "name",
             "ref": "name of a part", "pair": "[x, z]", "sense": "+1 or −1",
             "axes": 'list of "x", "z"', "load": "list of [radius, line_load]",
-            "table": "sub-table"}[kind]
+            "table": "sub-table"}[key.kind]
 
 
-def _num(x: float) -> str:
-    """``x`` as in a scene file: 1e6, not 1e+06."""
-    return re.sub(r"e([+-])0*(\d)", lambda m: "e" + m.group(1).replace("+", "") + m.group(2),
-                  f"{x:g}")
+def _value_text(v: object) -> str:
+    if v is None:
+        return "none"
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, tuple):
+        return "[" + ", ".join(f'"{x}"' if isinstance(x, str) else _num(x) for x in v) + "]"
+    assert isinstance(v, int | float)
+    return _num(v)
 
 
-def _range_text(table: str, key: str, kind: str, bound: tuple | None) -> str:
-    if kind == "num":
-        hi = sc._MAX.get((table, key))
-        if bound is None:
-            return f"\\|x\\| ≤ {_num(hi)}" if hi is not None else "any finite"
-        lo, lo_open = bound
-        left = f"({_num(lo)}" if lo_open else f"[{_num(lo)}"
-        if (table, key) == ("solver", "max_wall"):
-            return f"{left}, ∞)"
-        return f"{left}, {_num(hi)}]" if hi is not None else f"{left}, ∞)"
-    if kind == "pair":
-        return f"each \\|·\\| ≤ {_num(sc.MAX_COORD)}"
-    if kind == "name":
-        return "1–40 letters, digits, _ or -, first a letter or _"
-    if kind == "load":
-        return (f"radius (0, {_num(sc.MAX_LOAD_RADIUS)}], line load "
-                f"[0, {_num(sc.MAX_LINE_LOAD)}]")
-    if (table, key) == ("scene", "name"):
-        return f"1–{sc.MAX_NAME} printable characters"
-    return ""
-
-
-def _default_text(table: str, key: str, required: bool, given: str | None) -> str:
-    if given is not None:
-        return given
-    if required:
+def _default_text(table: str, key: Key) -> str:
+    if key.default_text is not None:
+        return key.default_text
+    if key.required:
         return "required"
-    field = "source" if key == "from" else key
+    if key.default is not NO_DEFAULT:
+        return _value_text(key.default)
+    field = "source" if key.name == "from" else key.name
     for cls in _DEFAULTS_FROM.get(table, ()):
         for f in dataclasses.fields(cls):
             if f.name == field and f.default is not dataclasses.MISSING:
-                v = f.default
-                if v is None:
-                    return "none"
-                if isinstance(v, bool):
-                    return "true" if v else "false"
-                if isinstance(v, str):
-                    return f'"{v}"'
-                if isinstance(v, tuple):
-                    return "[" + ", ".join(f'"{x}"' if isinstance(x, str) else _num(x)
-                                           for x in v) + "]"
-                return _num(v)
+                return _value_text(f.default)
             if f.name == field and f.default_factory is not dataclasses.MISSING:
                 return "see its keys"
     return "—"
@@ -177,16 +161,12 @@ def _cell(text: str) -> str:
     return text.replace("|", "\\|")
 
 
-def _table(table: str, spec: dict[str, tuple], skip: tuple[str, ...] = ()) -> list[str]:
+def _table(table: str, keys: Table) -> list[str]:
     lines = ["| key | type | unit | range | default | meaning |", "|---|---|---|---|---|---|"]
-    for key, (kind, required, bound) in spec.items():
-        if key in skip:
-            continue
-        unit, meaning, given = sc.key_doc(table, key)
-        lines.append(f"| `{key}` | {_cell(_kind_text(table, key, kind))} | {_cell(unit)} | "
-                     f"{_range_text(table, key, kind, bound)} | "
-                     f"{_cell(_default_text(table, key, required, given))} | "
-                     f"{_cell(meaning)} |")
+    for key in keys:
+        lines.append(f"| `{key.name}` | {_cell(_kind_text(key))} | {_cell(key.shown_unit)} | "
+                     f"{key.range_text()} | {_cell(_default_text(table, key))} | "
+                     f"{_cell(key.doc)} |")
     return lines
 
 
@@ -206,20 +186,34 @@ _DRIVE_NOTE = {
              "`[[roll]]` may give its own `density` and `caliper`), required in the "
              "single-drum format. Where the table is given, both keys are required.",
     "drum.drive": "Keys by kind: " + "; ".join(
-        f"`{k}`: {', '.join(v)}" for k, v in sc._DRIVE_KEYS.items() if k != "speed_profile")
-    + "; `speed_profile`: kind, web_acceleration, web_speed.",
+        f"`{k}`: {', '.join(v)}" for k, v in reversed(ALL_TABLES["drum.drive"].kinds.items()))
+    + ".",
     "drum[].drive": "Keys by kind: " + "; ".join(
-        f"`{k}`: {', '.join(v)}" for k, v in sc._DRIVE_KEYS.items()) + ".",
+        f"`{k}`: {', '.join(v)}" for k, v in DRUM_DRIVE_KEYS.kinds.items()) + ".",
     "roll[].drive": "Keys by kind: " + "; ".join(
-        f"`{k}`: {', '.join(v)}" for k, v in sc._UNWIND_DRIVE_KEYS.items()) + ".",
+        f"`{k}`: {', '.join(v)}" for k, v in UNWIND_DRIVE_KEYS.kinds.items()) + ".",
 }
 
 
-def _section(table: str, spec: dict[str, tuple], skip: tuple[str, ...] = ()) -> list[str]:
+def _section(table: str) -> list[str]:
     out = [f"### `{_HEADINGS[table]}`", ""]
     if table in _DRIVE_NOTE:
         out += [_DRIVE_NOTE[table], ""]
-    return out + _table(table, spec, skip) + [""]
+    return out + _table(table, ALL_TABLES[table]) + [""]
+
+
+def _effect_sections() -> list[str]:
+    """A section ``[effects.NAME]`` per effect with settings of its own."""
+    out = []
+    for name in EFFECT_NAMES:
+        keys = effect_settings(name)
+        if len(keys) == 1:  # only "enabled"
+            continue
+        out += [f"### `[effects.{name}]`", "",
+                f"The effect `{name}` with its settings: `[effects] {name} = true` (or "
+                "false) takes their defaults; this table sets them.", ""]
+        out += _table(f"effects.{name}", keys) + [""]
+    return out
 
 
 def reference() -> str:
@@ -228,7 +222,8 @@ def reference() -> str:
         "# Scene reference",
         "",
         "<!-- Generated by `python -m winder.scene.reference` (make scene-reference) from "
-        "the scene schema in src/winder/scene/load.py; do not edit by hand. -->",
+        "the declarations of the scene keys (src/winder/parts/*.py KEYS, src/winder/scene/"
+        "schema.py, the effects' settings); do not edit by hand. -->",
         "",
         "Scene files are TOML. There are two formats: **scenes of parts** (arrays of "
         "tables `[[drum]]`, `[[roll]]`, `[[rider]]`, `[[nip]]` and a `[web]` table) and "
@@ -247,31 +242,31 @@ def reference() -> str:
         "## Tables of both formats",
         "",
     ]
-    for t in ("scene", "effects", "solver"):
-        lines += _section(t, sc._SPEC[t])
+    for t in ("scene", "effects"):
+        lines += _section(t)
+    lines += _effect_sections()
+    lines += _section("solver")
     lines += ["## Scenes of parts", "",
               "A part's name names its result channels and its sweep key paths "
               "(`nip.rear_nip.contact.stiffness`). References (`a`, `b`, `rides`, "
               "`entry_nip`, `from`) must name an existing part of the right kind. Every "
               "wound roll needs a web entering it at a nip whose `a` is a drum.", ""]
-    lines += _section("paper", sc._SPEC["paper"])
-    for t in ("drum[]", "drum[].drive", "roll[]", "roll[].drive", "rider[]", "nip[]",
-              "nip[].contact", "nip[].friction", "web", "web.span"):
-        lines += _section(t, sc._PART_SPEC[t])
+    for t in ("paper", "drum[]", "drum[].drive", "roll[]", "roll[].drive", "rider[]",
+              "nip[]", "nip[].contact", "nip[].friction", "web", "web.span"):
+        lines += _section(t)
     lines += ["## Single-drum format", "",
               "Means: drum \"drum\" at the origin (sense +1), roll \"roll\" free along z "
               "above it (sense −1), nip \"nip\" (a = drum, b = roll), web entering at "
               "\"nip\" with tension 0. `[scene]`, `[drum]`, `[drum.drive]`, `[roll]` and "
               "`[paper]` are required, `[contact]` while `effects.contact` is on.", ""]
     for t in ("drum", "drum.drive", "roll", "paper", "contact", "friction"):
-        lines += _section(t, sc._SPEC[t])
+        lines += _section(t)
     lines += ["## Result channels", "",
               "One column each, SI units, first column `t` (CSV and NPZ alike).", "",
               "### Single-drum format", "",
               "The first 16 are the standard set; the others are winder's extras.", "",
               "| channel | unit | meaning |", "|---|---|---|"]
-    for ch in (*CHANNELS, *EXTRA_CHANNELS):
-        unit, meaning = LEGACY_CHANNEL_DOC[ch]
+    for ch, (unit, meaning) in LEGACY_CHANNEL_DOC.items():
         lines.append(f"| `{ch}` | {unit} | {_cell(meaning)} |")
     lines += ["", "### Scenes of parts", "",
               "`BODY` is the name of any drum, roll or rider, `ROLL` of a paper roll, "

@@ -15,7 +15,8 @@ from winder._args import real_argument
 from winder._errors import ArgumentError, ArgumentTypeError, SimulationError
 from winder.io.result import Result
 from winder.model.locked_modes import CORE_AUTO
-from winder.scene.load import BACKENDS, MAX_SAMPLES, METHODS, Scene, load_scene
+from winder.scene.load import Scene, load_scene
+from winder.scene.schema import BACKENDS, MAX_SAMPLES, METHODS
 from winder.solve import integrators as integ
 from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances
 from winder.solve.dopri5 import dopri5

@@ -1,0 +1,236 @@
+"""The single-drum format (the old one: tables ``[drum]``, ``[drum.drive]``, ``[roll]``,
+``[paper]``, ``[contact]``, ``[friction]``; spec section 7). The only module that knows
+it: its tables of keys (read from the parts' declarations, plus ``[roll]
+initial_height``), its dataclasses, its parsing and its translation into parts (machines
+spec §8, last paragraph): drum "drum" at the origin, sense +1; roll "roll" free in ``z``
+at ``(0, R + r0)``, sense −1; nip "nip" (a = drum, b = roll); web entering at "nip" with
+tension 0.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from winder._errors import SceneError
+from winder._schema import Key, Table
+from winder.parts import (
+    ContactLaw,
+    DrumPart,
+    FrictionLaw,
+    NipPart,
+    RollPart,
+    SpeedProfileDrive,
+    TorqueDrive,
+    WebPart,
+)
+from winder.parts import drum as _drum
+from winder.parts import nip as _nip
+from winder.parts import roll as _roll
+from winder.scene.checks import check_roll_core
+from winder.scene.parse import fail, parse_table
+from winder.scene.schema import PAPER_KEYS, TABLES
+from winder.scene.tables import Effects, Paper
+
+__all__ = ["Drive", "Drum", "Roll", "LegacyContact", "LegacyFriction", "LEGACY_TABLES",
+           "TABLE_NAMES", "OWN_TABLES", "is_legacy", "parse_tables", "build", "legacy_parts",
+           "check_rest_on_nip"]
+
+#: ``[drum]``: a drum's body keys.
+DRUM_KEYS = Table(_drum.KEYS.select("radius", "inertia", "mass"))
+#: ``[drum.drive]``: a drum's drive keys but ``ratio``.
+DRIVE_KEYS = Table(_drum.DRIVE_KEYS.select("kind", "web_acceleration", "web_speed", "torque"),
+                   kinds={k: tuple(n for n in v if n != "ratio")
+                          for k, v in _drum.DRIVE_KEYS.kinds.items()})
+#: ``[roll]``: a roll's core and start keys, and the old format's own ``initial_height``.
+ROLL_KEYS = Table((
+    *_roll.KEYS.select("core_radius", "core_mass", "core_inertia", "width", "initial_radius",
+                       "initial_speed", "com_offset"),
+    Key(name="initial_height", unit="m", hi=1e3, default_text="static balance on the nip",
+        doc="height z of the roll axis at t = 0, above the drum radius (e.g. to drop the "
+            "roll onto the drum)"),
+))
+#: The tables of the single-drum format by schema name (those of both formats too).
+LEGACY_TABLES: dict[str, Table] = {
+    "scene": TABLES["scene"], "effects": TABLES["effects"], "drum": DRUM_KEYS,
+    "drum.drive": DRIVE_KEYS, "roll": ROLL_KEYS, "paper": PAPER_KEYS,
+    "contact": _nip.CONTACT_KEYS, "friction": _nip.FRICTION_KEYS, "solver": TABLES["solver"],
+}
+#: The top-level tables of a single-drum scene.
+TABLE_NAMES = tuple(t for t in LEGACY_TABLES if t != "drum.drive")
+#: The tables of a single-drum scene that a scene of parts does not have (its
+#: :class:`~winder.scene.scene.Scene` fields).
+OWN_TABLES = ("drum", "roll", "paper", "contact", "friction")
+#: The tables a single-drum scene must have.
+REQUIRED_TABLES = ("scene", "drum", "roll", "paper")
+
+
+@dataclass(frozen=True)
+class Drive:
+    """``[drum.drive]``: ``speed_profile`` (web speed ramps at ``web_acceleration``
+    [m/s²] to ``web_speed`` [m/s]) or ``torque`` (drum free, driven by an input torque
+    ``torque`` [N·m]; ``web_speed`` then is the initial web speed); bounds:
+    :data:`DRIVE_KEYS`."""
+
+    kind: str = "speed_profile"
+    web_acceleration: float = 0.0
+    web_speed: float = 0.0
+    torque: float = 0.0
+
+
+@dataclass(frozen=True)
+class Drum:
+    """``[drum]``: radius [m], inertia (polar) [kg·m²], mass [kg]; bounds:
+    :data:`DRUM_KEYS`."""
+
+    radius: float
+    inertia: float
+    mass: float
+    drive: Drive = field(default_factory=Drive)
+
+
+@dataclass(frozen=True)
+class Roll:
+    """``[roll]``: core_radius [m], core_mass [kg], core_inertia [kg·m²], width [m],
+    initial_radius [m] (at least core_radius; default: core_radius), initial_speed
+    [rad/s], com_offset ``e`` [m] with ``0 <= e <``
+    :func:`~winder.model.mass_law.max_com_offset` (inside the core, and the core's inertia
+    about its centre of mass stays positive); winder's own key initial_height [m]: ``z``
+    at ``t = 0`` (default: static equilibrium on the contact, spec §6), e.g. to drop the
+    roll onto the drum; the roll axis must lie above the drum's surface. Bounds:
+    :data:`ROLL_KEYS`."""
+
+    core_radius: float
+    core_mass: float
+    core_inertia: float
+    width: float
+    initial_radius: float
+    initial_speed: float = 0.0
+    com_offset: float = 0.0
+    initial_height: float | None = None
+
+
+@dataclass(frozen=True)
+class LegacyContact(ContactLaw):
+    """``[contact]`` of the single-drum format: the nip's :class:`~winder.parts.ContactLaw`
+    (law, stiffness, damping, exponent, hc_damping; same keys and bounds)."""
+
+
+@dataclass(frozen=True)
+class LegacyFriction(FrictionLaw):
+    """``[friction]`` of the single-drum format: the nip's
+    :class:`~winder.parts.FrictionLaw` (mu, slip_velocity, relaxation_length, min_speed;
+    same keys and bounds)."""
+
+
+def legacy_parts(drum: Drum, roll: Roll, paper: Paper, contact: LegacyContact,
+                 friction: LegacyFriction) -> dict[str, Any]:
+    """The parts of a single-drum scene from its tables (machines spec §8, last
+    paragraph): the keyword arguments ``drums``, ``rolls``, ``riders``, ``nips``,
+    ``webs`` of :class:`~winder.scene.scene.Scene`."""
+    d = drum.drive
+    drive: SpeedProfileDrive | TorqueDrive = (
+        TorqueDrive(torque=d.torque, web_speed=d.web_speed) if d.kind == "torque" else
+        SpeedProfileDrive(web_acceleration=d.web_acceleration, web_speed=d.web_speed))
+    return {
+        "drums": (DrumPart(name="drum", radius=drum.radius, inertia=drum.inertia,
+                           mass=drum.mass, centre=(0.0, 0.0), sense=1, drive=drive),),
+        "rolls": (RollPart(name="roll", kind="wound",
+                           centre=(0.0, drum.radius + roll.initial_radius), free=("z",),
+                           sense=-1, core_radius=roll.core_radius, core_mass=roll.core_mass,
+                           core_inertia=roll.core_inertia, width=roll.width,
+                           initial_radius=roll.initial_radius,
+                           initial_speed=roll.initial_speed, com_offset=roll.com_offset,
+                           density=paper.density, caliper=paper.caliper,
+                           initial_height=roll.initial_height),),
+        "riders": (),
+        "nips": (NipPart(name="nip", a="drum", b="roll",
+                         contact=ContactLaw(**dataclasses.asdict(contact)),
+                         friction=FrictionLaw(**dataclasses.asdict(friction))),),
+        "webs": (WebPart(entry_nip="nip", tension=0.0),),
+    }
+
+
+def is_legacy(data: Mapping[str, Any]) -> bool:
+    """Whether ``data`` is in the single-drum format: a single-table ``[drum]`` or
+    ``[roll]``."""
+    return any(isinstance(data.get(t), dict) for t in ("drum", "roll"))
+
+
+def parse_tables(source: str, data: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """The keys of a single-drum scene's own tables, each checked against its declaration
+    (``[drum]`` without its sub-table ``drive``)."""
+    for table in REQUIRED_TABLES:
+        if table not in data:
+            raise SceneError(f"{source}: [{table}]: missing required table")
+    out = {}
+    for name in ("drum", "roll", "paper", "contact", "friction"):
+        raw = data.get(name, {})
+        if name == "drum" and isinstance(raw, dict):
+            raw = {k: v for k, v in raw.items() if k != "drive"}
+        out[name] = parse_table(source, name, raw, LEGACY_TABLES[name])
+    return out
+
+
+def build(source: str, data: Mapping[str, Any], tables: Mapping[str, dict[str, Any]],
+          effects: Effects, gravity: float) -> dict[str, Any]:
+    """The keyword arguments ``drum``, ``roll``, ``paper``, ``contact``, ``friction`` of
+    :class:`~winder.scene.scene.Scene` from the parsed ``tables``
+    (:func:`parse_tables`), with the checks across them (the roll resting on the nip:
+    ``effects``, ``gravity`` [m/s²] of ``[scene]``)."""
+    drum_raw = data["drum"]
+    if "drive" not in drum_raw:
+        raise SceneError(f"{source}: [drum.drive]: missing required table")
+    drive = parse_table(source, "drum.drive", drum_raw["drive"], DRIVE_KEYS)
+    roll_kw = dict(tables["roll"])
+    roll_kw.setdefault("initial_radius", roll_kw["core_radius"])
+    check_roll_core(source, "roll", roll_kw)
+    roll = Roll(**roll_kw)
+    radius = tables["drum"]["radius"]
+    if roll.initial_height is not None and not roll.initial_height > radius:
+        raise fail(source, "roll", "initial_height",
+                   f"{roll.initial_height!r} m puts the roll axis inside the drum or below "
+                   f"it; valid: > {radius!r} m (the drum radius, [drum] radius) and <= "
+                   f"{ROLL_KEYS['initial_height'].hi:g} m")
+    if drive["kind"] == "speed_profile" and "web_speed" not in drive:
+        raise fail(source, "drum.drive", "web_speed", "missing required key "
+                   "(kind = 'speed_profile')")
+    contact = LegacyContact(**tables["contact"])
+    if effects.contact and "contact" not in data:
+        raise SceneError(f"{source}: [contact]: missing required table (effects.contact is on)")
+    paper = Paper(**tables["paper"])
+    check_rest_on_nip(source, effects, gravity, roll, paper, contact)
+    return {"drum": Drum(**tables["drum"], drive=Drive(**drive)), "roll": roll,
+            "paper": paper, "contact": contact,
+            "friction": LegacyFriction(**tables["friction"])}
+
+
+def check_rest_on_nip(source: str, effects: Effects, gravity: float, roll: Roll,
+                      paper: Paper, contact: LegacyContact) -> None:
+    """Spec §6 starts the roll at rest on the nip (``F_n = m g``): the nip must carry the
+    roll's weight with a compression below the roll's radius, else the roll axis would
+    start inside the drum."""
+    if not effects.contact or roll.initial_height is not None:
+        return
+    from winder.forces.contact import rest_penetration  # (imports the Pinocchio model)
+    from winder.model.mass_law import PaperRollLaw
+
+    r = roll.initial_radius
+    weight = PaperRollLaw(roll.core_radius, roll.core_mass, roll.core_inertia, roll.width,
+                          paper.density).mass(r) * (gravity if effects.gravity else 0.0)
+    r_dot = paper.caliper / (2 * math.pi) * roll.initial_speed
+    c = contact
+    delta = rest_penetration(c.law, lambda k: getattr(c, k), weight, r_dot)
+    if not delta < r:
+        raise fail(source, "contact", "stiffness",
+                    f"{c.stiffness!r} ({c.law}) is too soft for the roll's weight "
+                    f"{weight:.4g} N: at rest the nip would be compressed by {delta:.3g} m, "
+                    f"more than the roll's radius {r!r} m, with the roll axis inside the "
+                    "drum (weight from [roll] core_mass, initial_radius, width, [paper] "
+                    "density, [scene] gravity; compression from [contact] stiffness, "
+                    "damping, exponent, hc_damping and [roll] initial_speed); valid: a "
+                    "stiffer nip or a lighter roll, so that the compression stays below the "
+                    "roll's radius")

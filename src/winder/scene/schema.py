@@ -1,0 +1,110 @@
+"""The scene's tables of keys (spec section 7; machines spec §8), each key declared once.
+
+A part's keys are declared in its module under ``winder/parts/`` (``KEYS``), an effect's
+settings on its force element (``settings``); this module declares the tables that are no
+part's (``[scene]``, ``[effects]``, ``[paper]``, ``[solver]``) and gathers every table of
+a scene of parts by its schema name (``drum[]``, ``drum[].drive``, ..., :data:`TABLES`).
+The single-drum format's tables are :data:`winder.scene.legacy.LEGACY_TABLES`.
+"""
+
+from __future__ import annotations
+
+from winder._args import ATOL_MAX, RTOL_MAX
+from winder._schema import Key, Table
+from winder.parts import drum, nip, rider, roll, web
+
+__all__ = ["EFFECT_NAMES", "METHODS", "BACKENDS", "DRIVE_KINDS", "MAX_SAMPLES", "MAX_NAME",
+           "SCENE_KEYS", "EFFECTS_KEYS", "PAPER_KEYS", "SOLVER_KEYS", "TABLES", "ARRAYS",
+           "effect_settings"]
+
+#: The effects of ``[effects]``, in spec order (one force element each,
+#: :data:`winder.forces.FORCES`).
+EFFECT_NAMES = ("variable_mass", "web_momentum", "web_tension", "gravity", "imbalance",
+                "contact", "slip_relaxation", "rider_load")
+#: Integrators of ``[solver] method``.
+METHODS = ("auto", "DOPRI5", "RK4", "ROS2", "RK45", "DOP853", "Radau", "BDF", "LSODA",
+           "RK23")
+#: Right-hand side backends: the compiled planar equations, or Pinocchio's ABA.
+BACKENDS = ("compiled", "pinocchio")
+#: Drive kinds of a drum.
+DRIVE_KINDS = drum.DRIVE_KINDS
+#: Most output samples a scene may ask for (``duration / output_step``); each sample holds
+#: some twenty channels of 8 bytes.
+MAX_SAMPLES = 10_000_000
+#: Longest scene name [characters].
+MAX_NAME = 200
+
+_POS = {"lo": 0.0, "lo_open": True}  # a positive number
+
+#: ``[scene]``.
+SCENE_KEYS = Table((
+    Key(name="name", kind="str", default_text="the file name without .toml",
+        valid=f"1–{MAX_NAME} printable characters",
+        doc="the scene's name, in titles, messages and the result"),
+    Key(name="duration", required=True, unit="s", **_POS, hi=1e6,
+        doc="simulated time of a run"),
+    Key(name="output_step", unit="s", **_POS,
+        doc="time between result samples; at most duration, and at most 1e7 samples per "
+            "run"),
+    Key(name="gravity", unit="m/s²", lo=0.0, hi=1e3,
+        doc="gravitational acceleration g, along −z"),
+))
+
+_EFFECT_DOC = {
+    "variable_mass": "the −Ẏv force of mass that joins a body from rest; off: m(r) and J(r) "
+                     "still follow the radius, the term is dropped (the naive overwrite)",
+    "web_momentum": "the momentum flux ṁ u the web brings into a wound roll (and the leaving "
+                    "paper takes out of an unwinding one)",
+    "web_tension": "the web tension's pull on the wound roll at its entry nip (and on the "
+                   "unwinding roll)",
+    "gravity": "gravity; off: g = 0",
+    "imbalance": "the centre-of-mass offset com_offset; off: e = 0",
+    "contact": "the nips' normal and friction forces",
+    "slip_relaxation": "the friction force relaxes towards the steady slip force over "
+                       "relaxation_length (a state per nip); off: F_t = F_ss; needs contact",
+    "rider_load": "the riders' applied line load; off: only their weight",
+}
+#: ``[effects]``: each effect on (true) or off; an effect with settings of its own may
+#: also be a table ``[effects.NAME]`` of ``enabled`` and its settings
+#: (:func:`effect_settings`).
+EFFECTS_KEYS = Table(tuple(Key(name=n, kind="bool", doc=_EFFECT_DOC[n]) for n in EFFECT_NAMES))
+
+#: ``[paper]``: the default paper of every roll (a roll's own keys, required here).
+PAPER_KEYS = Table(roll.KEYS.select("density", "caliper", required=True, default_text=None))
+
+#: ``[solver]``.
+SOLVER_KEYS = Table((
+    Key(name="method", kind="str", choices=METHODS, doc="integrator; auto is DOPRI5"),
+    Key(name="rtol", unit="-", **_POS, hi=RTOL_MAX, doc="relative tolerance"),
+    Key(name="atol", unit="", doc_unit="state units", **_POS, hi=ATOL_MAX,
+        doc="absolute tolerance"),
+    Key(name="max_rhs", unit="-", **_POS, hi=1e12,
+        doc="budget: most right-hand side evaluations of a run (a whole number)"),
+    Key(name="backend", kind="str", choices=BACKENDS,
+        doc="compiled: the generated code; pinocchio: the numeric Pinocchio path (the "
+            "cross-check)"),
+    Key(name="max_wall", unit="s", **_POS, doc="budget: most wall-clock time of a run"),
+))
+
+#: Every table of a scene of parts by its schema name: ``NAME[]`` an element of the array
+#: of tables ``[[NAME]]``, ``.SUB`` its sub-table.
+TABLES: dict[str, Table] = {
+    "scene": SCENE_KEYS, "effects": EFFECTS_KEYS, "paper": PAPER_KEYS, "solver": SOLVER_KEYS,
+    "drum[]": drum.KEYS, "drum[].drive": drum.DRIVE_KEYS,
+    "roll[]": roll.KEYS, "roll[].drive": roll.DRIVE_KEYS,
+    "rider[]": rider.KEYS,
+    "nip[]": nip.KEYS, "nip[].contact": nip.CONTACT_KEYS, "nip[].friction": nip.FRICTION_KEYS,
+    "web": web.KEYS, "web.span": web.SPAN_KEYS,
+}
+#: Arrays of tables of a scene of parts.
+ARRAYS = ("drum", "roll", "rider", "nip")
+
+
+def effect_settings(effect: str) -> Table:
+    """The table ``[effects.NAME]`` of an effect: ``enabled``, then the settings its force
+    element declares (:attr:`winder.forces.ForceElement.settings`)."""
+    from winder.forces import FORCES  # the force elements (imported when first needed)
+
+    cls = FORCES[effect]
+    enabled = Key(name="enabled", kind="bool", default=True, doc=f"the effect {effect} on")
+    return Table((enabled, *cls.settings))
