@@ -18,7 +18,7 @@ from winder.model.element_order import ElementOrderError, order_elements
 from winder.model.locked_modes import ModeKind
 from winder.model.machine import Machine
 from winder.parts import PARTS, DrumPart, RigidDisc
-from winder.scene.load import Effects, Scene, SceneInfo, Solver
+from winder.scene import Effects, Scene, SceneInfo, Solver
 from winder.solve.system import MachineSystem
 
 TAU = 30.0  # [N·m]
