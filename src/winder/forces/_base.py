@@ -23,7 +23,7 @@ class ForceElement(ABC):
     To add an effect, write its module and register it: nothing else is touched (not the
     scene schema, the scene's tables, the reference generator, the integrators, the code
     generator, the channels or the CLI). Its ``[effects]`` key, meaning, default and
-    settings are read from the class (:func:`winder.scene.schema.effects_keys`):
+    settings are read from the class (:class:`winder.scene.schema.EffectsTable`):
 
     1. Subclass :class:`ForceElement` in its own module under ``winder/forces/``; set
        ``name`` (the ``[effects]`` key), ``doc`` (its meaning, one line, for the scene
