@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import winder
-from winder.forces import FORCES, ForceElement
+from winder.forces import FORCES, RUN_ORDER, ForceElement
 from winder.model.element_order import ElementOrderError, order_elements
 from winder.model.locked_modes import ModeKind
 from winder.model.machine import Machine
@@ -159,13 +159,14 @@ def test_order_cycle_and_missing_provider_raise() -> None:
 def test_machine_orders_its_force_elements() -> None:
     """The winder line: web_tension (span rate) before tension_control (drive torque);
     imbalance (com_offset) before variable_mass; contact before slip_relaxation; the rest
-    in registration order."""
+    in the run order of the effects (RUN_ORDER)."""
     m = Machine(winder.load_scene("models/winder_line.toml"))
     names = [f.name for f in m.forces]
     assert names.index("web_tension") < names.index("tension_control")
     assert names.index("imbalance") < names.index("variable_mass")
     assert names.index("contact") < names.index("slip_relaxation")
-    registered = list(FORCES)
+    registered = list(RUN_ORDER)
+    assert set(registered) == set(FORCES)
     assert [n for n in names if n in registered] == \
         sorted((n for n in names if n in registered), key=registered.index)
 

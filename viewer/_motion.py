@@ -14,7 +14,8 @@ winder-model §8 (``drum_angle``, ``drum_speed``, ``z``, ``roll_angle``, ``roll_
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from types import SimpleNamespace
 
 import numpy as np
@@ -171,7 +172,8 @@ class Motion:
     the unwinding roll's name, ``exit`` its exit points ``p_u`` [m] (``(len(times), 2)``,
     :func:`exit_points`) and ``span_tension`` the span's tension [N] (``None`` when the
     result has no ``span_tension`` channel); all three are ``None`` without a span. These
-    are the first web's; ``webs`` has every web (one per wound roll)."""
+    are the first web's; ``webs`` has every web (one per wound roll). ``units``: the
+    result's channel units (:attr:`winder.Result.units`; empty for a result without)."""
 
     times: np.ndarray
     bodies: dict[str, BodyMotion]
@@ -181,6 +183,7 @@ class Motion:
     exit: np.ndarray | None = None
     span_tension: np.ndarray | None = None
     webs: tuple[WebMotion, ...] = ()
+    units: Mapping[str, str] = field(default_factory=dict)
 
     def web(self, k: int) -> np.ndarray | None:
         """The first web's path at sample ``k`` (:meth:`web_paths`), or ``None``."""
@@ -248,10 +251,10 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
         webs.append(WebMotion(w.name, (w.entry.a.name, w.entry.b.name), unwind, exit_,
                               tension))
     if not webs:
-        return Motion(times, bodies, forces, None)
+        return Motion(times, bodies, forces, None, units=dict(result.units))
     first = webs[0]
     return Motion(times, bodies, forces, first.entry, first.unwind, first.exit,
-                  first.span_tension, tuple(webs))
+                  first.span_tension, tuple(webs), units=dict(result.units))
 
 
 def exit_points(machine: Machine, bodies: dict[str, BodyMotion], web: Web | None = None

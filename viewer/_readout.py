@@ -1,5 +1,6 @@
 """On-screen readout: time, roll radii (the unwinding roll's too), body speeds, nip normal
-forces and, on a winder line, the span's tension, as an HTML overlay on meshcat's page.
+forces and, on a winder line, the span's tension, as an HTML overlay on meshcat's page;
+the units are the result's (:attr:`winder.Result.units`, carried on the Motion).
 
 meshcat 0.3.2 animates only numeric properties of objects, so the text is not part of the
 3-D scene: the page gets a ``<div id="winder-readout">`` and, for an animation, one text
@@ -15,7 +16,7 @@ from types import SimpleNamespace
 
 from winder.viewer._motion import Motion
 
-__all__ = ["readout_text", "with_readout", "READOUT_ID"]
+__all__ = ["readout_text", "with_readout", "unit_of", "DEFAULT_UNITS", "READOUT_ID"]
 
 READOUT_ID = "winder-readout"
 
@@ -25,28 +26,48 @@ _STYLE = (f"#{READOUT_ID} {{position: fixed; left: 10px; top: 10px; margin: 0; "
           "pointer-events: none; z-index: 10;}}")
 
 
+#: The readout's units where the result carries none (an old NPZ, a CSV): SI, as the
+#: channels are.
+DEFAULT_UNITS = {"t": "s", "radius": "m", "speed": "rad/s", "normal_force": "N",
+                 "span_tension": "N"}
+
+
+def unit_of(m: Motion, quantity: str, name: str = "") -> str:
+    """The unit of ``quantity`` (``speed``, ``radius``, ...) of the part ``name`` from
+    the result's units (:attr:`Motion.units`): its channel ``NAME_QUANTITY``, else the
+    channel ``QUANTITY`` (the single-drum format's, a single span's), else
+    :data:`DEFAULT_UNITS`."""
+    for channel in (f"{name}_{quantity}" if name else "", quantity):
+        if channel in m.units:
+            return m.units[channel]
+    return DEFAULT_UNITS[quantity]
+
+
 def readout_text(m: Motion, k: int) -> str:
-    """The readout of sample ``k`` of ``m``: ``t`` [s]; per paper roll its radius [m];
-    per body its speed [rad/s] and surface speed [m/s]; per nip its normal force [kN]; on
-    a winder line the span's tension ``span  T … N`` [N] (``-`` without its channel)."""
-    lines = [f"t  {m.times[k]:10.2f} s"]
+    """The readout of sample ``k`` of ``m``: ``t``; per paper roll its radius; per body
+    its speed and surface speed [m/s]; per nip its normal force (in thousands: kN); on a
+    winder line the span's tension ``span  T … N`` (``-`` without its channel). The units
+    are the result's (:func:`unit_of`): [s], [m], [rad/s], [N] for a result of winder."""
+    lines = [f"t  {m.times[k]:10.2f} {unit_of(m, 't')}"]
     spans = [w for w in m.webs if w.unwind is not None] or (
         [SimpleNamespace(name="", span_tension=m.span_tension)] if m.unwind is not None else [])
     labels = ["span" if len(spans) == 1 else f"{w.name} span" for w in spans]
     width = max(len(n) for n in (*m.bodies, *m.normal_forces, "span", *labels))
     for b in m.bodies.values():
         if b.radius_state:
-            lines.append(f"{b.name:<{width}}  r {b.radius[k]:8.4f} m")
+            lines.append(f"{b.name:<{width}}  r {b.radius[k]:8.4f} "
+                         f"{unit_of(m, 'radius', b.name)}")
     for b in m.bodies.values():
         w = b.speed[k]
-        lines.append(f"{b.name:<{width}}  {w:8.2f} rad/s {w * b.radius[k]:7.2f} m/s")
+        lines.append(f"{b.name:<{width}}  {w:8.2f} {unit_of(m, 'speed', b.name)} "
+                     f"{w * b.radius[k]:7.2f} m/s")
     for name, f in m.normal_forces.items():
         value = "      -" if f is None else f"{f[k] / 1e3:8.3f}"
-        lines.append(f"{name:<{width}}  N {value} kN")
+        lines.append(f"{name:<{width}}  N {value} k{unit_of(m, 'normal_force', name)}")
     for label, w in zip(labels, spans, strict=True):
         T = w.span_tension
         value = "      -" if T is None else f"{T[k]:8.1f}"
-        lines.append(f"{label:<{width}}  T {value} N")
+        lines.append(f"{label:<{width}}  T {value} {unit_of(m, 'span_tension', w.name)}")
     return "\n".join(lines)
 
 

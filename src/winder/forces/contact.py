@@ -51,6 +51,7 @@ class Contact(ForceElement):
     """Normal force and slip friction at every nip."""
 
     name = "contact"
+    doc = "the nips' normal and friction forces"
     provides = frozenset({"steady_friction"})
     relaxed = False
 

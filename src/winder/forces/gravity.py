@@ -16,6 +16,7 @@ class Gravity(ForceElement):
     """Sets the gravity of ABA/RNEA; in the static balance, each body's weight."""
 
     name = "gravity"
+    doc = "gravity; off: g = 0"
     provides = frozenset({"gravity"})
 
     def declare(self, machine: Machine) -> None:

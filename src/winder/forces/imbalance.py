@@ -17,6 +17,7 @@ class Imbalance(ForceElement):
     """Moves each paper roll's centre of mass to ``(com_offset, 0, 0)`` in its frame."""
 
     name = "imbalance"
+    doc = "the centre-of-mass offset com_offset; off: e = 0"
     provides = frozenset({"com_offset"})
 
     def declare(self, machine: Machine) -> None:

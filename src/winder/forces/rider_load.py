@@ -28,6 +28,7 @@ class RiderLoad(ForceElement):
     """The applied load of every rider roll with a load schedule."""
 
     name = "rider_load"
+    doc = "the riders' applied line load; off: only their weight"
     settings = (Key(name="scale", unit="-", lo=0.0, hi=100.0, default=1.0,
                     doc="factor on every rider's line-load schedule (1: as given; 0: only "
                         "the riders' weight)"),)

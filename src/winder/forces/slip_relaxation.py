@@ -19,6 +19,8 @@ class SlipRelaxation(ForceElement):
     """One friction state ``NIP.friction`` [N] per nip."""
 
     name = "slip_relaxation"
+    doc = ("the friction force relaxes towards the steady slip force over relaxation_length "
+           "(a state per nip); off: F_t = F_ss; needs contact")
     uses = frozenset({"steady_friction"})
 
     def declare(self, machine: Machine) -> None:

@@ -32,6 +32,8 @@ class VariableMass(ForceElement):
     """``fext −= Ẏ v`` on every paper roll, ``Ẏ = dY/dr · ṙ``."""
 
     name = "variable_mass"
+    doc = ("the −Ẏv force of mass that joins a body from rest; off: m(r) and J(r) still "
+           "follow the radius, the term is dropped (the naive overwrite)")
     uses = frozenset({"com_offset"})
     provides = frozenset({"spatial_force"})
 

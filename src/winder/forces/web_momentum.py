@@ -22,6 +22,8 @@ class WebMomentum(ForceElement):
     point; channel ``web_force`` [N] (at the entry; ``WEB_web_force`` with several webs)."""
 
     name = "web_momentum"
+    doc = ("the momentum flux ṁ u the web brings into a wound roll (and the leaving paper "
+           "takes out of an unwinding one)")
 
     def declare(self, machine: Machine) -> None:
         for w in machine.webs:

@@ -39,6 +39,8 @@ class WebTension(ForceElement):
     """Each web's tension on its wound roll (and on the unwinding roll of its span)."""
 
     name = "web_tension"
+    doc = ("the web tension's pull on the wound roll at its entry nip (and on the unwinding "
+           "roll)")
     provides = frozenset({"span_rate"})
 
     def declare(self, machine: Machine) -> None:

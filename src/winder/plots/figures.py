@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 
 from winder.io.files import atomic_write, safe_stem  # noqa: E402
 from winder.io.result import Result  # noqa: E402
-from winder.parts import WebPart  # noqa: E402
+from winder.parts import BodyElement, WebPart, body_elements  # noqa: E402
 from winder.scene.load import Scene  # noqa: E402
 
 __all__ = ["paper_figures", "closeup_end", "CLOSEUP_STEP", "machine_figures",
@@ -312,17 +312,21 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     paths: list[Path] = []
     color = nip_colours(scene)
     nip_label = {n.name: f"nip {n.name} ({n.a}–{n.b})" for n in scene.nips}
+    bodies = body_elements(scene)  # drawn by their role, in the machine's order
+    drums = [b for b in bodies if b.role == "drum"]
+    turning = [b for b in bodies if b.role != "drum"]  # rolls, riders, ...
+    wound = [b for b in bodies if b.radius_state]  # their radius is a channel
 
     # drums: speeds, then one torque row per drum
-    fig, ax = _rows(1 + len(scene.drums))
-    first = scene.drums[0].name
+    fig, ax = _rows(1 + len(drums))
+    first = drums[0].name
     unit = _in(result, f"{first}_speed")
-    _panel(ax[0], t, [(f"drum {d.name}", result[f"{d.name}_speed"]) for d in scene.drums],
+    _panel(ax[0], t, [(_body_label(d), result[f"{d.name}_speed"]) for d in drums],
            "speed Ω" + unit, f"{name}: drum speeds{unit}")
-    for a, d in zip(ax[1:], scene.drums, strict=True):
+    for a, d in zip(ax[1:], drums, strict=True):
         unit = _in(result, f"{d.name}_torque", "k")
-        _panel(a, t, [(f"drum {d.name}", result[f"{d.name}_torque"] / 1e3)], "torque" + unit,
-               f"drum {d.name}: drive torque{unit}", lw=0.4)
+        _panel(a, t, [(_body_label(d), result[f"{d.name}_torque"] / 1e3)], "torque" + unit,
+               f"{_body_label(d)}: drive torque{unit}", lw=0.4)
         a.plot(*window_mean(t, result[f"{d.name}_torque"] / 1e3), color="k", lw=0.8,
                label="mean over 0.5 s")
         a.legend(fontsize=8, loc="upper left")
@@ -332,12 +336,11 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
 
     # rolls: speed and radius
     fig, ax = _rows(2, 3.0)
-    speed = _in(result, f"{scene.rolls[0].name}_speed") if scene.rolls else ""
-    radius = _in(result, f"{scene.rolls[0].name}_radius") if scene.rolls else ""
-    _panel(ax[0], t, [(f"roll {r.name}", result[f"{r.name}_speed"]) for r in scene.rolls]
-           + [(f"rider {r.name}", result[f"{r.name}_speed"]) for r in scene.riders],
+    speed = _in(result, f"{wound[0].name}_speed") if wound else ""
+    radius = _in(result, f"{wound[0].name}_radius") if wound else ""
+    _panel(ax[0], t, [(_body_label(b), result[f"{b.name}_speed"]) for b in turning],
            "speed ω" + speed, f"{name}: roll and rider speeds{speed}")
-    _panel(ax[1], t, [(f"roll {r.name}", result[f"{r.name}_radius"]) for r in scene.rolls],
+    _panel(ax[1], t, [(_body_label(b), result[f"{b.name}_radius"]) for b in wound],
            "radius r" + radius, "paper roll radii" + radius)
     ax[1].set_xlabel("t" + _in(result, "t"))
     paths.append(_save(fig, out / f"{stem}_rolls.png"))
@@ -381,8 +384,7 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     paths.append(_save(fig, out / f"{stem}_nip_forces.png"))
 
     # free coordinates of every body, one row each
-    coords = [(b.name, c) for b in (*scene.drums, *scene.rolls, *scene.riders)
-              for c in ("x", "z") if f"{b.name}_{c}" in result]
+    coords = [(b.name, c) for b in bodies for c in ("x", "z") if f"{b.name}_{c}" in result]
     if coords:
         heights = [c for _, c in coords if c == "z"]
         fig, ax = _rows(len(coords) + len(heights), 2.0)
@@ -418,21 +420,27 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     for w in spans:  # one figure per span: STEM_span.png, or STEM_WEB_span.png
         pre = f"{w.name}_" if len(spans) > 1 else ""
         if f"{pre}span_tension" in result:
-            paths.append(_span_figure(result, scene, w, pre, out / f"{stem}_{pre}span.png",
-                                      name))
+            paths.append(_span_figure(result, scene, bodies, w, pre,
+                                      out / f"{stem}_{pre}span.png", name))
     return paths
 
 
-def _span_figure(result: Result, scene: Scene, web: WebPart, pre: str, path: Path,
-                 name: str) -> Path:
+def _body_label(body: BodyElement) -> str:
+    """A body in legends and titles: its drawing role and name (``roll front``)."""
+    return f"{body.role} {body.name}"
+
+
+def _span_figure(result: Result, scene: Scene, bodies: list[BodyElement], web: WebPart,
+                 pre: str, path: Path, name: str) -> Path:
     """A winder line: the span tension of ``web`` (channels ``PRE...``; ``pre`` empty for
     a scene's only span) and its controller's error, the unwind torque, the radii of the
     unwinding roll and of the wound roll the web enters."""
     t = result.t
     span = web.span
-    unwind = next(r for r in scene.rolls if r.name == span.source)
+    body = {b.name: b for b in bodies}
+    unwind = body[span.source]
     entry = next(n for n in scene.nips if n.name == web.entry_nip)
-    wound = [r for r in scene.rolls if r.name == entry.b]
+    wound = [body[entry.b]] if body[entry.b].radius_state else []
     error = f"{pre}tension_error"
     fig, ax = _rows(4 if error in result else 3)
     unit = _in(result, f"{pre}span_tension")
@@ -449,13 +457,13 @@ def _span_figure(result: Result, scene: Scene, web: WebPart, pre: str, path: Pat
         ax[1].axhline(0.0, color="k", lw=0.5)
         rows = 2
     unit = _in(result, f"{unwind.name}_torque", "k")
-    _panel(ax[rows], t, [(f"roll {unwind.name}", result[f"{unwind.name}_torque"] / 1e3)],
+    _panel(ax[rows], t, [(_body_label(unwind), result[f"{unwind.name}_torque"] / 1e3)],
            "torque" + unit, f"unwind torque of {unwind.name}{unit} (negative: braking)",
            lw=0.6)
     ax[rows].axhline(0.0, color="k", lw=0.5)
     unit = _in(result, f"{unwind.name}_radius")
-    _panel(ax[rows + 1], t, [(f"roll {r.name}", result[f"{r.name}_radius"])
-                             for r in [unwind, *wound]], "radius r" + unit,
+    _panel(ax[rows + 1], t, [(_body_label(b), result[f"{b.name}_radius"])
+                             for b in [unwind, *wound]], "radius r" + unit,
            "radii of the unwinding and the wound rolls" + unit)
     ax[-1].set_xlabel("t" + _in(result, "t"))
     return _save(fig, path)

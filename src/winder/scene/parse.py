@@ -15,7 +15,7 @@ from winder._args import check_real, show
 from winder._errors import SceneError
 from winder._schema import Key, Table
 from winder.parts import AXES
-from winder.scene.schema import EFFECT_NAMES, EFFECTS_KEYS, MAX_NAME, effect_settings
+from winder.scene.schema import EFFECTS_KEYS, MAX_NAME, effect_names, effect_settings
 
 __all__ = ["fail", "name_text", "parse_table", "parse_effects", "check_part_name",
            "check_drive_keys"]
@@ -173,7 +173,7 @@ def parse_effects(source: str, raw: Any) -> dict[str, Any]:
         elif isinstance(value, bool):
             out[key] = value
         else:
-            table = effect_settings(key) if key in EFFECT_NAMES else None
+            table = effect_settings(key) if key in effect_names() else None
             extra = (f" or a table [effects.{key}] of enabled and its settings "
                      f"({', '.join(table.names()[1:])})" if table and len(table) > 1 else "")
             raise fail(source, "effects", key, f"expected true or false{extra}, got "

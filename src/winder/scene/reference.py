@@ -39,7 +39,7 @@ from winder.parts.drum import DRIVE_KEYS as DRUM_DRIVE_KEYS
 from winder.parts.roll import DRIVE_KEYS as UNWIND_DRIVE_KEYS
 from winder.scene.keys import ALL_TABLES
 from winder.scene.legacy import Drive, Drum, Roll
-from winder.scene.schema import EFFECT_NAMES, effect_settings
+from winder.scene.schema import effect_names, effect_settings
 from winder.scene.tables import Effects, Paper, SceneInfo, Solver
 
 __all__ = ["reference", "main", "CHANNEL_DOC", "LEGACY_CHANNEL_DOC"]
@@ -205,7 +205,7 @@ def _section(table: str) -> list[str]:
 def _effect_sections() -> list[str]:
     """A section ``[effects.NAME]`` per effect with settings of its own."""
     out = []
-    for name in EFFECT_NAMES:
+    for name in effect_names():
         keys = effect_settings(name)
         if len(keys) == 1:  # only "enabled"
             continue

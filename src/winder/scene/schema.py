@@ -1,8 +1,9 @@
 """The scene's tables of keys (spec section 7; machines spec §8), each key declared once.
 
 A part's keys are declared in its module under ``winder/parts/`` (``KEYS``), an effect's
-settings on its force element (``settings``); this module declares the tables that are no
-part's (``[scene]``, ``[effects]``, ``[paper]``, ``[solver]``) and gathers every table of
+flag, meaning, default and settings on its force element (``[effects]`` is read from the
+registry :data:`winder.forces.FORCES`); this module declares the tables that are no
+part's (``[scene]``, ``[paper]``, ``[solver]``) and gathers every table of
 a scene of parts by its schema name (``drum[]``, ``drum[].drive``, ..., :data:`TABLES`).
 The single-drum format's tables are :data:`winder.scene.legacy.LEGACY_TABLES`.
 """
@@ -11,16 +12,16 @@ from __future__ import annotations
 
 from winder._args import ATOL_MAX, RTOL_MAX
 from winder._schema import Key, Table
+from winder.forces import FORCES
 from winder.parts import drum, nip, rider, roll, web
 
 __all__ = ["EFFECT_NAMES", "METHODS", "BACKENDS", "DRIVE_KINDS", "MAX_SAMPLES", "MAX_NAME",
            "SCENE_KEYS", "EFFECTS_KEYS", "PAPER_KEYS", "SOLVER_KEYS", "TABLES", "ARRAYS",
-           "effect_settings"]
+           "EffectsTable", "effect_names", "effect_settings"]
 
-#: The effects of ``[effects]``, in spec order (one force element each,
-#: :data:`winder.forces.FORCES`).
-EFFECT_NAMES = ("variable_mass", "web_momentum", "web_tension", "gravity", "imbalance",
-                "contact", "slip_relaxation", "rider_load")
+#: The built-in effects of ``[effects]``, in spec order: the force elements of
+#: :data:`winder.forces.FORCES` (:func:`effect_names` also those registered later).
+EFFECT_NAMES = tuple(FORCES)
 #: Integrators of ``[solver] method``.
 METHODS = ("auto", "DOPRI5", "RK4", "ROS2", "RK45", "DOP853", "Radau", "BDF", "LSODA",
            "RK23")
@@ -50,24 +51,33 @@ SCENE_KEYS = Table((
         doc="gravitational acceleration g, along −z"),
 ))
 
-_EFFECT_DOC = {
-    "variable_mass": "the −Ẏv force of mass that joins a body from rest; off: m(r) and J(r) "
-                     "still follow the radius, the term is dropped (the naive overwrite)",
-    "web_momentum": "the momentum flux ṁ u the web brings into a wound roll (and the leaving "
-                    "paper takes out of an unwinding one)",
-    "web_tension": "the web tension's pull on the wound roll at its entry nip (and on the "
-                   "unwinding roll)",
-    "gravity": "gravity; off: g = 0",
-    "imbalance": "the centre-of-mass offset com_offset; off: e = 0",
-    "contact": "the nips' normal and friction forces",
-    "slip_relaxation": "the friction force relaxes towards the steady slip force over "
-                       "relaxation_length (a state per nip); off: F_t = F_ss; needs contact",
-    "rider_load": "the riders' applied line load; off: only their weight",
-}
-#: ``[effects]``: each effect on (true) or off; an effect with settings of its own may
-#: also be a table ``[effects.NAME]`` of ``enabled`` and its settings
-#: (:func:`effect_settings`).
-EFFECTS_KEYS = Table(tuple(Key(name=n, kind="bool", doc=_EFFECT_DOC[n]) for n in EFFECT_NAMES))
+class EffectsTable(Table):
+    """``[effects]``: one flag per effect registered in :data:`winder.forces.FORCES`, in
+    registration order, its meaning and default from its force element (``summary()``,
+    ``default``). Read from the registry each time (an effect registered later is a key at
+    once); an effect with settings of its own may also be a table ``[effects.NAME]`` of
+    ``enabled`` and its settings (:func:`effect_settings`)."""
+
+    def __init__(self) -> None:  # no keys of its own: they are the registry's
+        object.__setattr__(self, "kinds", {})
+
+    @property  # type: ignore[override]
+    def keys(self) -> tuple[Key, ...]:
+        return tuple(Key(name=n, kind="bool", default=cls.default, doc=cls.summary())
+                     for n, cls in FORCES.items())
+
+    def __repr__(self) -> str:
+        return f"EffectsTable({', '.join(effect_names())})"
+
+
+def effect_names() -> tuple[str, ...]:
+    """The effects of ``[effects]`` now registered (:data:`winder.forces.FORCES`), in
+    registration order."""
+    return tuple(FORCES)
+
+
+#: ``[effects]`` (:class:`EffectsTable`, from the force elements).
+EFFECTS_KEYS: Table = EffectsTable()
 
 #: ``[paper]``: the default paper of every roll (a roll's own keys, required here).
 PAPER_KEYS = Table(roll.KEYS.select("density", "caliper", required=True, default_text=None))
@@ -103,8 +113,6 @@ ARRAYS = ("drum", "roll", "rider", "nip")
 def effect_settings(effect: str) -> Table:
     """The table ``[effects.NAME]`` of an effect: ``enabled``, then the settings its force
     element declares (:attr:`winder.forces.ForceElement.settings`)."""
-    from winder.forces import FORCES  # the force elements (imported when first needed)
-
     cls = FORCES[effect]
     enabled = Key(name="enabled", kind="bool", default=True, doc=f"the effect {effect} on")
     return Table((enabled, *cls.settings))

@@ -4,13 +4,14 @@ as frozen dataclasses; their keys, units and bounds are declared in
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from winder._args import number
 from winder._errors import ArgumentError, ArgumentTypeError
-from winder.scene.schema import EFFECT_NAMES, effect_settings
+from winder.forces import FORCES
+from winder.scene.schema import effect_names, effect_settings
 
 __all__ = ["SceneInfo", "Effects", "Paper", "Solver", "Settings"]
 
@@ -29,53 +30,60 @@ class SceneInfo:
     gravity: float = 9.81
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False, repr=False)
 class Effects:
-    """``[effects]``: which physical effects the scene simulates (all on by default), and
-    the settings of those that have their own (``[effects.NAME]``; ``settings`` holds the
-    ones given, a mapping ``{effect: {key: value}}`` or its tuple form :data:`Settings`;
-    :meth:`setting` reads one, its declared default where not given)."""
+    """``[effects]``: which physical effects the scene simulates, and the settings of those
+    that have their own (``[effects.NAME]``).
 
-    variable_mass: bool = True
-    web_momentum: bool = True
-    web_tension: bool = True
-    gravity: bool = True
-    imbalance: bool = True
-    contact: bool = True
-    slip_relaxation: bool = True
-    rider_load: bool = True
-    settings: Settings = ()
+    The effects are the force elements registered in :data:`winder.forces.FORCES`; each
+    is a keyword (``Effects(gravity=False)``) and an attribute (``effects.gravity``), on
+    or off as given, else its force element's ``default`` (on). ``flags`` holds them all,
+    ``((name, on), ...)`` in registration order. ``settings`` holds the settings given, a
+    mapping ``{effect: {key: value}}`` or its tuple form :data:`Settings`; :meth:`setting`
+    reads one, its declared default where not given.
 
-    def __post_init__(self) -> None:
-        given = self.settings
-        if isinstance(given, Mapping):
-            given = tuple(given.items())
-        if not isinstance(given, tuple | list):
-            raise ArgumentTypeError(f"Effects: settings must be a mapping of effect names to "
-                                    f"mappings of their keys, got {type(given).__name__}")
-        out = []
-        for effect, values in given:
-            if effect not in EFFECT_NAMES:
-                raise ArgumentError(f"Effects: settings of {effect!r}, not an effect; valid: "
-                                    f"{', '.join(EFFECT_NAMES)}")
-            items = tuple(values.items()) if isinstance(values, Mapping) else tuple(values)
-            table = effect_settings(effect)
-            for key, value in items:
-                if key not in table or key == "enabled":
-                    valid = ", ".join(table.names()[1:]) or "(none)"
-                    raise ArgumentError(f"Effects: {key!r} is not a setting of {effect}; "
-                                        f"valid: {valid}")
-                k = table[key]
-                if k.kind == "num":
-                    number(f"Effects: settings of {effect}", key, value, lo=k.lo,
-                           lo_open=k.lo_open, hi=k.hi, unit=k.unit)
-            if items:
-                out.append((effect, tuple(sorted(items))))
-        object.__setattr__(self, "settings", tuple(sorted(out)))
+    Raises
+    ------
+    ArgumentError: an unknown effect, or a setting that is not the effect's or out of
+        its range.
+    ArgumentTypeError: a flag that is not a bool, or settings that are not a mapping.
+    """
+
+    flags: tuple[tuple[str, bool], ...]
+    settings: Settings
+
+    def __init__(self, flags: Iterable[tuple[str, bool]] | Mapping[str, bool] = (),
+                 settings: Settings | Mapping[str, Mapping[str, Any]] = (),
+                 **named: bool) -> None:
+        names = effect_names()
+        given = dict(flags.items() if isinstance(flags, Mapping) else flags)
+        given.update(named)
+        for effect, on in given.items():
+            if effect not in names:
+                raise ArgumentError(f"Effects: {effect!r} is not an effect; valid: "
+                                    f"{', '.join(names)}")
+            if not isinstance(on, bool):
+                raise ArgumentTypeError(f"Effects: {effect} must be true or false, got "
+                                        f"{on!r} ({type(on).__name__})")
+        object.__setattr__(self, "flags", tuple(
+            (n, given.get(n, FORCES[n].default)) for n in names))
+        object.__setattr__(self, "settings", _settings(settings, names))
+
+    def __getattr__(self, name: str) -> bool:
+        """``effects.NAME``: the effect ``NAME`` on (True) or off."""
+        if not name.startswith("_"):
+            for effect, on in self.__dict__.get("flags", ()):
+                if effect == name:
+                    return on
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def __repr__(self) -> str:
+        flags = ", ".join(f"{n}={on}" for n, on in self.flags)
+        return f"Effects({flags}, settings={self.settings!r})"
 
     def enabled(self) -> tuple[str, ...]:
-        """Names of the effects that are on, in spec order."""
-        return tuple(n for n in EFFECT_NAMES if getattr(self, n))
+        """Names of the effects that are on, in registration (spec) order."""
+        return tuple(n for n, on in self.flags if on)
 
     def setting(self, effect: str, key: str) -> Any:
         """The value of the setting ``key`` of ``effect``: as given in the scene, else the
@@ -90,10 +98,39 @@ class Effects:
     def to_dict(self) -> dict[str, Any]:
         """``[effects]`` as a TOML table: ``NAME = bool``, or ``[effects.NAME]`` with
         ``enabled`` and the settings given."""
-        out: dict[str, Any] = {n: getattr(self, n) for n in EFFECT_NAMES}
+        out: dict[str, Any] = dict(self.flags)
         for effect, values in self.settings:
             out[effect] = {"enabled": out[effect], **dict(values)}
         return out
+
+
+def _settings(given: Any, names: tuple[str, ...]) -> Settings:
+    """The settings of :class:`Effects`, checked against what each effect declares, in
+    the tuple form (sorted)."""
+    if isinstance(given, Mapping):
+        given = tuple(given.items())
+    if not isinstance(given, tuple | list):
+        raise ArgumentTypeError(f"Effects: settings must be a mapping of effect names to "
+                                f"mappings of their keys, got {type(given).__name__}")
+    out = []
+    for effect, values in given:
+        if effect not in names:
+            raise ArgumentError(f"Effects: settings of {effect!r}, not an effect; valid: "
+                                f"{', '.join(names)}")
+        items = tuple(values.items()) if isinstance(values, Mapping) else tuple(values)
+        table = effect_settings(effect)
+        for key, value in items:
+            if key not in table or key == "enabled":
+                valid = ", ".join(table.names()[1:]) or "(none)"
+                raise ArgumentError(f"Effects: {key!r} is not a setting of {effect}; "
+                                    f"valid: {valid}")
+            k = table[key]
+            if k.kind == "num":
+                number(f"Effects: settings of {effect}", key, value, lo=k.lo,
+                       lo_open=k.lo_open, hi=k.hi, unit=k.unit)
+        if items:
+            out.append((effect, tuple(sorted(items))))
+    return tuple(sorted(out))
 
 
 @dataclass(frozen=True)
