@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from winder._schema import Key
+from winder._schema import Channel, Key
 from winder.forces._base import ForceElement
 
 if TYPE_CHECKING:
@@ -28,6 +28,8 @@ class RiderLoad(ForceElement):
     """The applied load of every rider roll with a load schedule."""
 
     name = "rider_load"
+    CHANNELS = (Channel(name="RIDER_load", unit="N",
+                        doc="applied rider load along z (negative: downwards)"),)
     settings = (Key(name="scale", unit="-", lo=0.0, hi=100.0, default=1.0,
                     doc="factor on every rider's line-load schedule (1: as given; 0: only "
                         "the riders' weight)"),)
@@ -38,7 +40,7 @@ class RiderLoad(ForceElement):
             for i, (r, q) in enumerate(b.load):
                 machine.parameter(f"{b.name}.load_radius_{i}", r)
                 machine.parameter(f"{b.name}.line_load_{i}", q * scale)
-            machine.channel(f"{b.name}_load", "N")
+            machine.channel(self.CHANNELS[0], b.name)
 
     def apply(self, ev: Evaluation) -> None:
         for b in _riders(ev.machine):

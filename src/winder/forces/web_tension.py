@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from winder._schema import Channel
 from winder.forces._base import ForceElement
 
 if TYPE_CHECKING:
@@ -39,6 +40,8 @@ class WebTension(ForceElement):
     """Each web's tension on its wound roll (and on the unwinding roll of its span)."""
 
     name = "web_tension"
+    CHANNELS = (Channel(name="span_tension", unit="N",
+                        doc="web span tension T (a state; the forces use max(T, 0))"),)
     provides = frozenset({"span_rate"})
 
     def declare(self, machine: Machine) -> None:
@@ -50,7 +53,7 @@ class WebTension(ForceElement):
                 machine.parameter(f"{k}span.length", span.length)
                 machine.parameter(f"{k}span.EA", span.EA)
                 machine.parameter(f"{k}span.T_in", span.T_in)
-                machine.channel(f"{w.span_channel}span_tension", "N")
+                machine.channel(self.CHANNELS[0], w.span_channel)
             else:
                 machine.parameter(f"{w.key}web.tension", w.part.tension)
 
