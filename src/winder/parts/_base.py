@@ -108,8 +108,6 @@ class BodyElement(ABC):
     role: ClassVar[str]
     #: the scene key that places it (``centre``; a rider: ``x``)
     place_key: ClassVar[str] = "centre"
-    #: that key in the single-drum format (None: not in that format)
-    legacy_place_key: ClassVar[str | None] = None
     #: its own result channels (after the generic ones of every body), each
     #: ``BODY``/``ROLL``/``RIDER``-named: the machine registers them for it
     CHANNELS: ClassVar[tuple[Channel, ...]] = ()
@@ -129,6 +127,8 @@ class BodyElement(ABC):
         self.drives: tuple[str, ...] = ()
         self.torque_inputs: tuple[str, ...] = ()
         self.setpoint_inputs: tuple[str, ...] = ()
+        #: paper winds onto it: its radius grows with its web (a wound roll)
+        self.winds = False
         #: its centre of mass offset [m] for the ``imbalance`` effect (None: no imbalance)
         self.com_offset: float | None = None
         #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine

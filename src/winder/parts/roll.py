@@ -155,7 +155,6 @@ class RollBody(BodyElement):
 
     table = "roll"
     role = "roll"
-    legacy_place_key = "[roll] initial_radius"
     CHANNELS = (
         Channel(name="ROLL_radius", unit="m", doc="radius r of a paper roll"),
         Channel(name="ROLL_mass", unit="kg", doc="mass m(r)"),
@@ -175,6 +174,7 @@ class RollBody(BodyElement):
         n = self.name
         #: it pays off its web (machines.md §1): fixed centre, shrinking radius
         self.unwinding = part.kind == "unwinding"
+        self.winds = not self.unwinding
         self.torque_inputs = (f"{n}.torque",) if kind == "torque" else ()
         self.drives = ("tension_control",) if kind == "tension_control" else ()
         self.setpoint_inputs = (f"{n}.tension_setpoint",) if self.drives else ()

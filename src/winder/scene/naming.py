@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
 
-__all__ = ["Naming", "FmuNames"]
+__all__ = ["Naming", "FmuNames", "BY_PARTS", "naming_of"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -81,3 +81,14 @@ class Naming:
         ``[[nip]] 'front' friction mu``; ``key("drum", "front", "drive")`` names the
         drive's table."""
         return " ".join((f"[[{table}]] {part!r}", *path))
+
+
+#: The naming of every scene of parts.
+BY_PARTS = Naming()
+
+
+def naming_of(scene: object) -> Naming:
+    """``scene``'s :attr:`~winder.scene.Scene.naming`; by its parts for an object that has
+    none (the plain scene objects the machine tests build)."""
+    naming = getattr(scene, "naming", None)
+    return naming if isinstance(naming, Naming) else BY_PARTS

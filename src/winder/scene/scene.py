@@ -21,7 +21,7 @@ from winder.scene.legacy import (
     Roll,
     legacy_parts,
 )
-from winder.scene.naming import Naming
+from winder.scene.naming import BY_PARTS, Naming
 from winder.scene.tables import Effects, Paper, SceneInfo, Solver
 from winder.scene.validate import scene_kwargs
 
@@ -85,7 +85,7 @@ class Scene:
         """How the scene names its result channels, its keys in messages and its FMU
         variables: by its parts, or the single-drum format's names
         (:mod:`winder.scene.naming`)."""
-        return SINGLE_DRUM if self.legacy else _BY_PARTS
+        return SINGLE_DRUM if self.legacy else BY_PARTS
 
     def replace(self, **changes: Mapping[str, Any]) -> Scene:
         """A copy with some tables' keys changed: ``scene.replace(roll={"com_offset": 0})``.
@@ -206,8 +206,6 @@ def _merge(node: Any, values: Any, table: str, path: tuple[str, ...]) -> None:
         else:  # a value, or a list of values (a rider's load schedule): replace it
             node[key] = value
 
-
-_BY_PARTS = Naming()
 
 
 def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:

@@ -12,7 +12,7 @@ import numpy as np
 from winder._args import real_argument
 from winder._errors import ArgumentError, SimulationError, state_text
 from winder.io.result import Result
-from winder.scene import CHANNELS, EXTRA_CHANNELS
+from winder.scene import CHANNELS, EXTRA_CHANNELS, naming_of
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
 from winder.solve.budgets import budget_error, check_budgets, check_tolerances
@@ -36,7 +36,7 @@ def inputs_of(system: MachineSystem) -> dict[str, str]:
     <winder.scene.Naming.inputs>`)."""
     names = system.torque_inputs() + [name for b in system.machine.bodies
                                       for name in b.setpoint_inputs]
-    return system.scene.naming.inputs({n.replace(".", "_"): n for n in names})
+    return naming_of(system.scene).inputs({n.replace(".", "_"): n for n in names})
 
 
 def outputs_of(system: MachineSystem) -> tuple[str, ...]:

@@ -22,14 +22,12 @@ from winder.model.backends import NumericBackend
 from winder.model.channels import TIME
 from winder.model.codegen import CompilerMissing, Generated, generate
 from winder.model.machine import AT_CORE, AUTO, CORE_AUTO, WINDING, Machine
-from winder.scene import CHANNELS, EXTRA_CHANNELS, Naming  # the single-drum columns (public names)
+from winder.scene import CHANNELS, EXTRA_CHANNELS, naming_of  # (public: the single-drum columns)
 from winder.solve import integrators as integ
 from winder.solve._jit import njit
 from winder.solve.equilibrium import Equilibrium, static_state
 
 __all__ = ["MachineSystem", "CHANNELS", "EXTRA_CHANNELS", "NoCompilerWarning"]
-_BY_PARTS = Naming()
-
 
 class NoCompilerWarning(UserWarning):
     """The generated path is unavailable (no C compiler): the numeric Pinocchio path runs."""
@@ -267,8 +265,7 @@ class MachineSystem:
         """The result's channels after ``t``: name → (the machine's channel, unit), as the
         scene names them (:attr:`winder.scene.Scene.naming`: machines.md §9, or the
         single-drum format's names of winder-model §8)."""
-        naming = getattr(self.scene, "naming", _BY_PARTS)  # (a test's plain scene: parts)
-        return naming.outputs(self.machine.channel_units)
+        return naming_of(self.scene).outputs(self.machine.channel_units)
 
     @property
     def channel_units(self) -> dict[str, str]:
