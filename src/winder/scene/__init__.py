@@ -12,7 +12,13 @@ single-drum format, translated into parts, with its names), ``validate`` (a whol
 """
 
 from winder.scene.keys import key_doc, key_unit
-from winder.scene.legacy import CHANNELS, EXTRA_CHANNELS, LegacyContact, LegacyFriction
+from winder.scene.legacy import (
+    CHANNELS,
+    EXTRA_CHANNELS,
+    SINGLE_DRUM,
+    LegacyContact,
+    LegacyFriction,
+)
 from winder.scene.load import load_scene
 from winder.scene.naming import Naming, naming_of
 from winder.scene.scene import Scene, scene_from_dict
@@ -20,6 +26,6 @@ from winder.scene.schema import BACKENDS, DRIVE_KINDS, EFFECT_NAMES, MAX_SAMPLES
 from winder.scene.tables import Effects, Paper, SceneInfo, Solver
 
 __all__ = ["Scene", "SceneInfo", "Effects", "Paper", "Solver", "LegacyContact",
-           "LegacyFriction", "Naming", "naming_of", "CHANNELS", "EXTRA_CHANNELS", "load_scene",
-           "scene_from_dict", "key_unit", "key_doc",
+           "LegacyFriction", "Naming", "naming_of", "SINGLE_DRUM", "CHANNELS",
+           "EXTRA_CHANNELS", "load_scene", "scene_from_dict", "key_unit", "key_doc",
            "EFFECT_NAMES", "DRIVE_KINDS", "METHODS", "BACKENDS", "MAX_SAMPLES"]
