@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 __all__ = ["Naming", "FmuNames", "BY_PARTS", "naming_of"]
 
@@ -75,6 +75,11 @@ class Naming:
         run-time parameter, from the machine's ``inputs`` (``DRUM_torque`` →
         ``DRUM.torque`` per torque-driven body, ``ROLL_tension_setpoint``)."""
         return dict(inputs)
+
+    def drive_changes(self, scene: Any, drive: dict[str, Any], speed_profile: bool) -> None:
+        """Set ``drive`` (changes of the drive's table) for the FMU's
+        :attr:`FmuNames.profile_switch` ``speed_profile``: nothing without an own FMU
+        interface (a scene of parts keeps its drives)."""
 
     def key(self, table: str, part: str, *path: str) -> str:
         """The message path of a part's key: ``key("nip", "front", "friction", "mu")`` is
