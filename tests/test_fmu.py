@@ -521,3 +521,36 @@ def test_outputs_declare_their_units(fmu_path, two_drum_fmu, two_drum_scene) -> 
     unit = {v.get("name"): v.find("Real").get("unit") for v in parts.iter("ScalarVariable")}
     assert unit["set_z_dot"] == "m/s" and unit["front_torque"] == "N.m"
     assert unit["rear_nip_normal_force"] == "N" and unit["set_inertia_rate"] == "kg.m2/s"
+
+
+def test_parameters_declare_their_units(fmu_path, two_drum_fmu, two_drum_scene) -> None:
+    """Each FMU parameter's ``unit`` is its scene key's (:func:`winder.scene.key_unit` of
+    its place), in FMI spelling; a few by hand; ``rtol`` and ``speed_profile`` have
+    none."""
+    from winder.fmu.build import fmu_parameters
+    from winder.model.units import fmi_name
+    from winder.scene import key_unit
+
+    paper = winder.load_scene(Path(__file__).resolve().parents[1] / "models"
+                              / "paper_winding.toml")
+    for path, scene in ((fmu_path, paper), (two_drum_fmu, two_drum_scene)):
+        root = _model_description(path)
+        got = {v.get("name"): v.find("Real").get("unit") for v in root.iter("ScalarVariable")
+               if v.get("causality") == "parameter" and v.find("Real") is not None}
+        places = fmu_parameters(scene)
+        assert set(got) == {*places, "rtol"}
+        assert got.pop("rtol") is None
+        data = scene.to_dict()
+        for name, ((table, element, keys), _) in places.items():
+            want = key_unit(".".join(p for p in (table, element, *keys) if p), data)
+            assert want and got[name] == fmi_name(want), (name, want, got[name])
+    unit = {v.get("name"): v.find("Real").get("unit")
+            for v in _model_description(fmu_path).iter("ScalarVariable")
+            if v.find("Real") is not None}
+    assert unit["contact_stiffness"] == "N/m" and unit["mu"] == "1"
+    assert unit["density"] == "kg/m3" and unit["web_acceleration"] == "m/s2"
+    unit = {v.get("name"): v.find("Real").get("unit")
+            for v in _model_description(two_drum_fmu).iter("ScalarVariable")
+            if v.find("Real") is not None}
+    assert unit["front_nip_contact_damping"] == "N.s/m" and unit["set_caliper"] == "m"
+    assert unit["web_tension"] == "N" and unit["front_web_speed"] == "m/s"

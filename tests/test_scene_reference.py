@@ -12,13 +12,15 @@ import pytest
 import winder
 from winder._schema import format_number as _num
 from winder.scene.keys import ALL_TABLES
+from winder.scene.legacy import COLUMNS
 from winder.scene.reference import (
-    CHANNEL_DOC,
-    LEGACY_CHANNEL_DOC,
+    CHANNEL_DECLARATIONS,
+    channel_declarations,
     channel_pattern,
     main,
     reference,
 )
+from winder.solve.system import MachineSystem
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scene-reference.md"
@@ -159,8 +161,31 @@ def test_every_channel_of_a_scene_of_parts_is_documented(model):
 def test_every_channel_of_a_single_drum_scene_is_documented():
     res = winder.simulate(ROOT / "models" / "paper_winding.toml", t_end=0.02)
     names = list(res)
-    assert set(names) == set(LEGACY_CHANNEL_DOC)
-    assert set(CHANNEL_DOC) >= {"t", "NIP_normal_force", "BODY_speed"}
+    assert names == ["t", *COLUMNS]
+    assert {c.name for c in CHANNEL_DECLARATIONS} >= {"t", "NIP_normal_force", "BODY_speed"}
+
+
+@pytest.mark.parametrize("model", sorted(p.stem for p in (ROOT / "models").glob("*.toml")))
+def test_every_channel_of_a_shipped_scene_is_declared_once_with_its_unit(model):
+    """Each result channel of each shipped scene (models/*.toml) is one channel of its
+    machine (a single-drum column through the scene's naming) that matches exactly one
+    declaration, and its unit (:attr:`MachineSystem.channel_units`) is the declared one."""
+    scene = winder.load_scene(ROOT / "models" / f"{model}.toml")
+    system = MachineSystem(scene, backend="pinocchio")
+    units = system.channel_units
+    parts = {p.name: k for k, group in (("drum", scene.drums), ("roll", scene.rolls),
+                                        ("rider", scene.riders), ("nip", scene.nips))
+             for p in group}
+    machine = {"t": "t", **{out: ch for out, (ch, _) in system.outputs.items()}}
+    assert list(machine) == list(units)
+    for out, channel in machine.items():
+        found = channel_declarations(channel, parts, [w.name for w in scene.webs])
+        assert len(found) == 1, (out, channel, [d.name for d in found])
+        assert units[out] == found[0].unit, (out, units[out], found[0])
+        if channel in system.machine.channel_units:
+            assert system.machine.channel_units[channel] == found[0].unit
+    if scene.naming.by_parts:  # the machine's channels, unrenamed
+        assert [c for c in machine if c != "t"] == system.machine.channel_names
 
 
 def test_readme_and_docs_point_only_to_files_of_the_package():

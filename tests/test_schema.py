@@ -81,10 +81,15 @@ def test_scene_code_writes_no_bound():
 
 
 def test_single_drum_channels_are_documented_in_their_order():
-    from winder.scene.reference import LEGACY_CHANNEL_DOC
+    from winder.scene.legacy import COLUMNS
+    from winder.scene.reference import reference
     from winder.solve.system import CHANNELS, EXTRA_CHANNELS
 
-    assert tuple(LEGACY_CHANNEL_DOC) == (*CHANNELS, *EXTRA_CHANNELS)
+    assert ("t", *COLUMNS) == (*CHANNELS, *EXTRA_CHANNELS)
+    text = reference()
+    section = text[text.index("### Single-drum format", text.index("## Result channels")):]
+    rows = re.findall(r"^\| `(\w+)` \|", section.split("### Scenes of parts")[0], re.M)
+    assert tuple(rows) == (*CHANNELS, *EXTRA_CHANNELS)
 
 
 def test_parser_bounds_are_the_declared_ones():

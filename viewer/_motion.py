@@ -25,6 +25,7 @@ from winder.forces.web_tension import exit_point
 from winder.io.result import Result
 from winder.model.machine import Machine, Web
 from winder.parts import BodyElement as Body
+from winder.scene import SINGLE_DRUM, Naming
 from winder.scene.load import Scene
 
 __all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
@@ -40,15 +41,6 @@ WEB_ARC_POINTS = 25
 #: drum's motion [rad] (for sense +1 at the lower rear: the web comes from below, behind).
 WEB_MEET = math.radians(15.0)
 
-# old single-drum format (winder-model §8): role -> channel, per body name
-_LEGACY = {"drum": {"angle": "drum_angle", "speed": "drum_speed"},
-           "roll": {"z": "z", "angle": "roll_angle", "speed": "roll_speed",
-                    "radius": "radius"}}
-_LEGACY_NIP = "normal_force"
-#: (body, role) of the single-drum format whose channel may be missing (drawn still)
-_LEGACY_OPTIONAL = {("drum", "angle")}
-
-
 def scene_of(result: Result, scene: Scene | None = None) -> Scene | None:
     """``scene``, else the scene stored in ``result.meta["scene_dict"]``, else ``None``
     (the result is then read with the single-drum channel names)."""
@@ -62,30 +54,28 @@ def scene_of(result: Result, scene: Scene | None = None) -> Scene | None:
     return None
 
 
-def _legacy(scene: Scene | None) -> bool:
-    return scene is None or bool(scene.legacy)
+def _naming(scene: Scene | None) -> Naming:
+    # a result without its scene is read with the single-drum format's names
+    return SINGLE_DRUM if scene is None else scene.naming
 
 
 def body_channels(scene: Scene | None, body: Body) -> dict[str, str]:
     """Channel of each role (``x``, ``z``, ``angle``, ``speed``, ``radius``) of ``body``
-    that the result carries; a role without a channel is constant (fixed coordinate,
-    constant radius)."""
-    if _legacy(scene):
-        return dict(_LEGACY[body.name])
+    that the result carries, as the scene names it; a role without a channel is constant
+    (fixed coordinate, constant radius)."""
     roles = [*body.free, "angle", "speed", *(("radius",) if body.radius_state else ())]
-    return {role: f"{body.name}_{role}" for role in roles}
+    return {role: _naming(scene).output_name(f"{body.name}_{role}") for role in roles}
 
 
 def nip_channels(scene: Scene | None, machine: Machine) -> dict[str, str]:
     """Normal-force channel of every nip [N]."""
-    if _legacy(scene):
-        return {n.name: _LEGACY_NIP for n in machine.nips}
-    return {n.name: f"{n.name}_normal_force" for n in machine.nips}
+    return {n.name: _naming(scene).output_name(f"{n.name}_normal_force")
+            for n in machine.nips}
 
 
 def _optional(scene: Scene | None, role: str, body: Body) -> bool:
-    # the old format's drum angle is optional (the drum is then drawn still)
-    return _legacy(scene) and (body.name, role) in _LEGACY_OPTIONAL
+    # a channel an older result may lack (the old format's drum angle: drawn still)
+    return body_channels(scene, body)[role] in _naming(scene).optional
 
 
 def drawn_channels(scene: Scene | None, machine: Machine) -> list[str]:
@@ -107,10 +97,12 @@ def check_drawable(result: Result, where: str = "result", scene: Scene | None = 
     if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise WinderError(f"{where}: the time axis is not finite and increasing")
     scene = scene_of(result, scene)
-    if scene is None:
-        required = [c for roles in _LEGACY.values() for c in roles.values()
-                    if c != "drum_angle"]
-        radii = ["radius"]
+    if scene is None:  # the single-drum format's drum and roll
+        required = [c for c in (SINGLE_DRUM.output_name(f"{body}_{role}") for body, roles in
+                                (("drum", ("angle", "speed")),
+                                 ("roll", ("z", "angle", "speed", "radius")))
+                                for role in roles) if c not in SINGLE_DRUM.optional]
+        radii = [SINGLE_DRUM.output_name("roll_radius")]
     else:
         m = Machine(scene)
         required = drawn_channels(scene, m)
@@ -119,7 +111,7 @@ def check_drawable(result: Result, where: str = "result", scene: Scene | None = 
     if missing:
         raise WinderError(f"{where}: no channel {', '.join(missing)} (the viewer draws "
                           f"{', '.join(required)})")
-    optional = [c for c in ("drum_angle",) if _legacy(scene) and c in result]
+    optional = [c for c in sorted(_naming(scene).optional) if c in result]
     for c in (*required, *optional):
         bad = np.flatnonzero(~np.isfinite(result[c]))
         if len(bad):

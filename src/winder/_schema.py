@@ -12,6 +12,13 @@ in its module under ``winder/parts/`` (``KEYS``), an effect's settings on its
 - the generated ``docs/scene-reference.md`` (:mod:`winder.scene.reference`);
 - the FMU's parameter units and descriptions (:mod:`winder.fmu.build`).
 
+Each result channel is one :class:`Channel` (its name pattern, unit and meaning),
+declared by what writes it: the generic body, nip and web channels in
+:mod:`winder.model.channels`, a part's own on its body element (``CHANNELS``), an effect's
+on its :class:`~winder.forces.ForceElement` (``CHANNELS``). The machine registers its
+channels with their units from these (:meth:`winder.model.machine.Machine.channel`), the
+reference lists them, the single-drum format names its columns through them.
+
 This module imports nothing of winder but the error types, so every layer may read it.
 """
 
@@ -22,7 +29,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-__all__ = ["Key", "Table", "KINDS", "NO_DEFAULT", "format_number"]
+__all__ = ["Key", "Table", "Channel", "KINDS", "NO_DEFAULT", "format_number"]
 
 #: Kinds of key value: ``num`` a finite number; ``bool`` true or false; ``str`` a string
 #: (one of ``choices`` where given); ``name`` a part's name; ``ref`` the name of another
@@ -198,3 +205,58 @@ class Table:
         """The keys ``names`` (in that order), each with ``changes`` applied
         (``required=True``): the same declaration read by another table."""
         return tuple(replace(self[n], **changes) if changes else self[n] for n in names)
+
+
+#: Placeholders of a :class:`Channel` name: ``BODY`` any drum, roll or rider, ``ROLL`` a
+#: paper roll, ``RIDER`` a rider, ``NIP`` a nip (each the part's name in a channel).
+PLACEHOLDERS = ("BODY", "ROLL", "RIDER", "NIP")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Channel:
+    """One result channel, declared once by what writes it.
+
+    name:
+        Its name pattern: ``PLACEHOLDER_suffix`` for a part's channel (``BODY_speed``,
+        ``ROLL_radius``, ``NIP_normal_force``; :data:`PLACEHOLDERS`), else the channel's
+        own name (``t``, ``web_speed``; a web's channel takes the prefix ``WEB_`` in a
+        scene of several webs).
+    unit:
+        Its SI unit (``rad/s``, ``N·m``; ``-`` a pure number), non-empty.
+    doc:
+        Its meaning, one line (the reference's "meaning" column).
+    """
+
+    name: str
+    unit: str
+    doc: str
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*",
+                                                               self.name):
+            raise ValueError(f"Channel: name must be an identifier, got {self.name!r}")
+        if not isinstance(self.unit, str) or not self.unit:
+            raise TypeError(f"channel {self.name!r}: unit must be a non-empty string such "
+                            f"as 'm' or '-', got {self.unit!r}")
+        if not isinstance(self.doc, str) or not self.doc:
+            raise ValueError(f"Channel {self.name!r}: doc must say what the channel means")
+
+    @property
+    def placeholder(self) -> str:
+        """The part placeholder of the name (``BODY`` of ``BODY_speed``), or ``""``."""
+        head = self.name.split("_", 1)[0]
+        return head if head in PLACEHOLDERS and "_" in self.name else ""
+
+    @property
+    def suffix(self) -> str:
+        """The name after its placeholder (``speed`` of ``BODY_speed``), or the name."""
+        return self.name[len(self.placeholder) + 1:] if self.placeholder else self.name
+
+    def of(self, owner: str = "") -> str:
+        """The channel's name for ``owner``: the part's name for a placeholder
+        (``front_speed``), else a prefix (``""``, or ``WEB_`` of a web among several)."""
+        if self.placeholder:
+            if not owner:
+                raise ValueError(f"channel {self.name!r}: a part's channel needs its name")
+            return f"{owner}_{self.suffix}"
+        return f"{owner}{self.name}"

@@ -80,7 +80,9 @@ class ModeMap:
     web_speed: float
     roll: str
     drum_rotation: dict[str, float] = field(default_factory=dict)
-    legacy: bool = False
+    #: whether the table has a machine from parts' columns (every bounce mode, the drums'
+    #: rotations): the scene's :attr:`Naming.by_parts <winder.scene.Naming.by_parts>`
+    by_parts: bool = True
     #: per bounce mode its natural frequency ``|λ|/2π`` [Hz] (also where it is overdamped)
     natural: dict[str, np.ndarray] = field(default_factory=dict)
 
@@ -166,19 +168,19 @@ class ModeMap:
                 for rc in self.critical_radii(h, c)]
 
     def as_columns(self) -> dict[str, np.ndarray]:
-        """The CSV table: for a single-drum scene the historic columns; otherwise also every
+        """The CSV table: the historic columns (a single-drum scene's); by parts also every
         bounce mode (``BODY_x_frequency``, ``BODY_x_damping``, ...) and the drums'
         rotation frequencies."""
         cols = {"radius": self.radius, "bounce_frequency": self.bounce_frequency,
                 "bounce_damping": self.bounce_damping}
-        if not self.legacy:
+        if self.by_parts:
             for c in self.coordinates:
                 key = c.replace(".", "_")
                 cols[f"{key}_frequency"] = self.frequencies[c]
                 cols[f"{key}_damping"] = self.dampings[c]
         cols.update({"slip_frequency": self.slip_frequency, "slip_damping": self.slip_damping,
                      "rotation_1x": self.rotation_1x, "rotation_2x": self.rotation_2x})
-        if not self.legacy:
+        if self.by_parts:
             cols["rotation_3x"] = 3 * self.rotation_1x
             for name, f in self.drum_rotation.items():
                 cols[f"{name}_rotation"] = np.full(len(self.radius), f)
@@ -291,4 +293,4 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),
                    dict(zip(lin.coords, damp, strict=True)), slip[0], slip[1],
                    ratio * v / (2 * math.pi * radii), v, lin.roll.name, drums,
-                   bool(scene.legacy), dict(zip(lin.coords, natural, strict=True)))
+                   scene.naming.by_parts, dict(zip(lin.coords, natural, strict=True)))

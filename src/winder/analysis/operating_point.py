@@ -84,7 +84,7 @@ class Mode:
 
 
 def _where_drum(scene: Scene, name: str) -> str:
-    return "[drum.drive]" if scene.legacy else f"[[drum]] {name!r} drive"
+    return scene.naming.key("drum", name, "drive")
 
 
 def _check_scene(scene: Scene, where: str) -> None:
@@ -111,7 +111,7 @@ def _check_scene(scene: Scene, where: str) -> None:
                             f"{scene.scene.gravity!r}; valid: gravity on and > 0")
     for n in scene.nips:
         if n.friction.mu == 0.0:
-            key = "[friction] mu" if scene.legacy else f"[[nip]] {n.name!r} friction mu"
+            key = scene.naming.key("nip", n.name, "friction", "mu")
             raise ArgumentError(f"{where}: {scene.source}: {key} = 0: without friction the "
                                 "drum does not drive the roll, so there is no winding "
                                 "operating point and no slip mode; valid: mu > 0")
@@ -476,8 +476,7 @@ def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: b
 
 def _core_key(lin: _Linearisation) -> str:
     """The scene key of the wound roll's core radius, the smallest radius of a map."""
-    return "[roll] core_radius" if lin.scene.legacy else \
-        f"[[roll]] {lin.roll.name!r} core_radius"
+    return lin.scene.naming.key("roll", lin.roll.name, "core_radius")
 
 
 def _radius(where: str, lin: _Linearisation, radius: float) -> float:

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from winder.io.result import Result
-from winder.parts import RollPart
+from winder.parts import RollPart, body_elements
 from winder.scene.load import Scene
 
 __all__ = ["BAND_COLUMNS", "SCALAR_COLUMNS", "NIP_SCALAR_COLUMNS", "default_band_edges",
@@ -70,6 +70,11 @@ def scene_nip_names(scene_dict: Mapping[str, Any]) -> tuple[str, ...]:
     return tuple(str(n["name"]) for n in nips) if isinstance(nips, list) else ()
 
 
+def _winds(scene: Scene, name: str) -> bool:
+    """Whether paper winds onto the body ``name`` (its body element's ``winds``)."""
+    return next(b for b in body_elements(scene) if b.name == name).winds
+
+
 def wound_roll(scene: Scene) -> RollPart:
     """The roll whose radius the bands split: the roll at the web's entry nip, else the
     first wound roll, else the first roll."""
@@ -80,7 +85,7 @@ def wound_roll(scene: Scene) -> RollPart:
                 for side in (nip.b, nip.a):
                     if side in rolls:
                         return rolls[side]
-    wound = [r for r in scene.rolls if r.kind == "wound"]
+    wound = [r for r in scene.rolls if _winds(scene, r.name)]
     return (wound or list(scene.rolls))[0]
 
 
@@ -88,14 +93,12 @@ def end_radius(scene: Scene, t_end: float | None = None) -> float:
     """Radius [m] the roll reaches at ``t_end`` [s] (default: the scene's duration) when
     the paper arrives at the web speed without slip: ``r² = r₀² + h v t/π``."""
     T = scene.scene.duration if t_end is None else float(t_end)
-    if scene.legacy:
-        r0, h, v = scene.roll.initial_radius, scene.paper.caliper, scene.drum.drive.web_speed
-    else:  # the roll the web enters, at the largest drum web speed
-        roll = wound_roll(scene)
-        r0, h = roll.initial_radius, roll.caliper
-        v = max((abs(d.drive.web_speed) for d in scene.drums), default=0.0)
-        if roll.kind != "wound":
-            return r0
+    # the roll the web enters, at the largest drum web speed
+    roll = wound_roll(scene)
+    r0, h = roll.initial_radius, roll.caliper
+    v = max((abs(d.drive.web_speed) for d in scene.drums), default=0.0)
+    if not _winds(scene, roll.name):
+        return r0
     return math.sqrt(r0**2 + h * v * T / math.pi)
 
 

@@ -49,6 +49,8 @@ from pathlib import Path
 from typing import Any
 
 from winder._errors import WinderError
+from winder.parts import body_elements
+from winder.scene import SINGLE_DRUM
 from winder.scene.keys import find_key, key_unit
 from winder.scene.load import Scene, load_scene
 
@@ -62,22 +64,11 @@ def _text(table: str, key: str, unit: str | None = None) -> str:
     return f"{k.doc} [{k.unit if unit is None else unit}]"
 
 
-#: FMU parameter name → (scene table, key, description with unit) of a single-drum scene;
-#: the description and unit are the key's declaration.
+#: FMU parameter name → (scene table, key, description with unit) of a single-drum scene
+#: (its naming's own FMU interface); the description and unit are the key's declaration.
 FMU_PARAMETERS: dict[str, tuple[str, str, str]] = {
-    name: (table, key, _text(table, key)) for name, (table, key) in {
-        "profile_web_speed": ("drum.drive", "web_speed"),
-        "web_acceleration": ("drum.drive", "web_acceleration"),
-        "com_offset": ("roll", "com_offset"),
-        "contact_stiffness": ("contact", "stiffness"),
-        "contact_damping": ("contact", "damping"),
-        "mu": ("friction", "mu"),
-        "slip_reference_velocity": ("friction", "slip_velocity"),
-        "relaxation_length": ("friction", "relaxation_length"),
-        "caliper": ("paper", "caliper"),
-        "density": ("paper", "density"),
-        "width": ("roll", "width"),
-    }.items()}
+    name: (table, key, _text(table, key))
+    for name, (table, key) in SINGLE_DRUM.fmu.parameters.items()}  # type: ignore[union-attr]
 
 # pythonfmu's binary finds the class by the pattern ``class X(Fmi2Slave):`` in this file,
 # hence the alias.
@@ -122,15 +113,16 @@ def _schema_key(place: ParameterPath) -> tuple[str, str]:
 
 def _parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
     """FMU name → (place in the scene, what it is for, before the key's meaning)."""
-    if scene.legacy:
-        out: dict[str, tuple[ParameterPath, str]] = {}
-        for name, (table, key, _) in FMU_PARAMETERS.items():
+    out: dict[str, tuple[ParameterPath, str]] = {}
+    own = scene.naming.fmu
+    if own is not None:  # the scene's own interface (the single-drum format's)
+        for name, (table, key) in own.parameters.items():
             top, *sub = table.split(".")
             out[name] = ((top, None, (*sub, key)), "")
         return out
-    out = {}
+    bodies = {b.name: b for b in body_elements(scene)}
     for drum in scene.drums:
-        if drum.drive.kind == "speed_profile":
+        if bodies[drum.name].prescribed:  # on its speed profile
             out[f"{drum.name}_web_acceleration"] = (
                 ("drum", drum.name, ("drive", "web_acceleration")), f"drum {drum.name}: ")
         out[f"{drum.name}_web_speed"] = (("drum", drum.name, ("drive", "web_speed")),
@@ -140,7 +132,7 @@ def _parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
             for suffix, path in _PART_PARAMETERS[kind].items():
                 out[f"{part.name}_{suffix}"] = ((kind, part.name, path), f"{kind} {part.name}: ")
     for roll in scene.rolls:
-        if getattr(roll.drive, "kind", None) == "tension_control":
+        if bodies[roll.name].setpoint_inputs:  # a tension controller's set-point
             out[f"{roll.name}_bandwidth"] = (("roll", roll.name, ("drive", "bandwidth")),
                                              f"roll {roll.name}: ")
     span = scene.web.span if scene.web is not None else None
@@ -188,7 +180,8 @@ def scene_with_parameters(scene: Scene, values: dict[str, float], *,
     ``speed_profile`` (single-drum scenes only, where it is required): true drives the
     drum along its profile, false frees it at the profile's initial speed."""
     places = fmu_parameters(scene)
-    if scene.legacy != (speed_profile is not None):
+    own = scene.naming.fmu
+    if (own is not None) != (speed_profile is not None):
         raise FmuError("speed_profile is a parameter of single-drum scenes only")
     changes: dict[str, dict[str, Any]] = {}
     for name, value in values.items():
@@ -201,16 +194,9 @@ def scene_with_parameters(scene: Scene, values: dict[str, float], *,
         for key in path[:-1]:
             node = node.setdefault(key, {})
         node[path[-1]] = float(value)
-    if scene.legacy:
-        drive = changes.setdefault("drum", {}).setdefault("drive", {})
-        d = scene.drum.drive
-        a = drive.get("web_acceleration", d.web_acceleration)
-        v = drive.get("web_speed", d.web_speed)
-        if speed_profile:
-            drive.update(kind="speed_profile", web_acceleration=a, web_speed=v)
-        else:  # free drum, started at the profile's initial speed
-            drive.update(kind="torque", web_acceleration=a, web_speed=0.0 if a > 0 else v,
-                         torque=0.0)
+    if own is not None:
+        scene.naming.drive_changes(scene, changes.setdefault("drum", {}).setdefault(
+            "drive", {}), bool(speed_profile))
     return scene.replace(**changes)
 
 

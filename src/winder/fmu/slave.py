@@ -16,10 +16,17 @@ from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variab
 from pythonfmu.enums import Fmi2Status
 
 from winder._errors import WinderError
-from winder.fmu.build import fmu_parameters, parameter_value, scene_with_parameters
+from winder.fmu.build import (
+    fmu_parameters,
+    parameter_units,
+    parameter_value,
+    scene_with_parameters,
+)
 from winder.fmu.units import UnitReal, with_unit_definitions
+from winder.model.units import DIMENSIONS
+from winder.parts import body_elements
 from winder.scene.load import load_scene
-from winder.solve.stepper import OUTPUTS, Stepper
+from winder.solve.stepper import Stepper
 
 __all__ = ["WinderSlave"]
 
@@ -43,19 +50,23 @@ class WinderSlave(Fmi2Slave):
             _PINNED.append(vars(module))
         super().__init__(**kwargs)
         self._scene = sc = load_scene(Path(self.resources) / "scene.toml")
-        self._legacy = bool(sc.legacy)
+        self._own = own = sc.naming.fmu  # the scene's own interface (single-drum), or None
         self._places = fmu_parameters(sc)
+        units = parameter_units(sc)
         for name, (place, text) in self._places.items():
             setattr(self, name, parameter_value(sc, place))
-            self.register_variable(Real(name, causality=Fmi2Causality.parameter,
-                                        variability=Fmi2Variability.fixed, description=text))
-        if self._legacy:
-            self.speed_profile = sc.drum.drive.kind == "speed_profile"
+            # the scene key's unit (none where it has no fixed dimension: N/m^p)
+            unit = units[name] if units[name] in DIMENSIONS else None
+            self.register_variable(UnitReal(name, causality=Fmi2Causality.parameter,
+                                            variability=Fmi2Variability.fixed,
+                                            description=text, unit=unit))
+        if own is not None:  # its drum on the speed profile, or freed on the torque input
+            setattr(self, own.profile_switch, any(b.prescribed for b in body_elements(sc)))
             self.register_variable(Boolean(
-                "speed_profile", causality=Fmi2Causality.parameter,
+                own.profile_switch, causality=Fmi2Causality.parameter,
                 variability=Fmi2Variability.fixed,
                 description="true: drum follows the web-speed profile; false: driven by "
-                            "drum_torque_command"))
+                            + ", ".join(own.inputs)))
         self.rtol = 1e-8
         self.register_variable(Real("rtol", causality=Fmi2Causality.parameter,
                                     variability=Fmi2Variability.fixed,
@@ -66,11 +77,11 @@ class WinderSlave(Fmi2Slave):
         self._build()
         st = self._stepper
         assert st is not None
-        self._inputs = ({"drum_torque_command": "drum_torque"} if self._legacy
+        self._inputs = (dict(own.inputs) if own is not None
                         else {name: name for name in st.inputs})
         for name, stepper_name in self._inputs.items():
-            # start value: the scene's drive torque (legacy: 0, the freed drum's)
-            start = 0.0 if self._legacy else float(
+            # start value: the scene's drive torque (own interface: 0, the freed drum's)
+            start = 0.0 if own is not None else float(
                 st.system.params[st.system.machine.param_index(st.inputs[stepper_name])])
             setattr(self, name, start)
             self.register_variable(Real(name, causality=Fmi2Causality.input,
@@ -78,15 +89,15 @@ class WinderSlave(Fmi2Slave):
                                         description=("tension set-point [N]"
                                                      if name.endswith("_setpoint")
                                                      else "drive torque [N m]")))
-        self._outputs = ((*OUTPUTS, "web_speed_reference") if self._legacy else
-                         tuple(k for k in st.output_names if k not in self._inputs))
-        units = {**st.system.channel_units, "web_speed_reference": "m/s"}
+        reference = () if own is None else (own.profile_reference,)  # the profile [m/s]
+        self._outputs = (*(k for k in st.output_names if k not in self._inputs), *reference)
+        units = {**st.system.channel_units, **dict.fromkeys(reference, "m/s")}
         for name in self._outputs:
             self.register_variable(UnitReal(name, causality=Fmi2Causality.output,
                                             variability=Fmi2Variability.continuous,
                                             initial=Fmi2Initial.exact, unit=units[name]))
         # a run that can end inside a step (an unwinding roll) tells the time it reached
-        self._clock = not self._legacy and st.system.machine.unwind is not None
+        self._clock = st.system.machine.unwind is not None
         if self._clock:
             self.t = 0.0
             self.register_variable(UnitReal(
@@ -105,7 +116,8 @@ class WinderSlave(Fmi2Slave):
         """A Stepper of the scene with the parameters' values (again only when they
         changed since the last build)."""
         values = {name: float(getattr(self, name)) for name in self._places}
-        profile = bool(self.speed_profile) if self._legacy else None
+        own = self._own
+        profile = None if own is None else bool(getattr(self, own.profile_switch))
         key = (tuple(values.values()), profile, float(self.rtol))
         if key != self._built:
             scene = scene_with_parameters(self._scene, values, speed_profile=profile)
@@ -124,9 +136,10 @@ class WinderSlave(Fmi2Slave):
                 setattr(self, name, value)
         if getattr(self, "_clock", False):
             self.t = st.t
-        if self._legacy:  # the profile min(a_w t, v_w) [m/s] (a_w = 0: v_w from t = 0)
-            a, v = float(self.web_acceleration), float(self.profile_web_speed)
-            self.web_speed_reference = min(a * st.t, v) if a > 0 else v
+        own = self._own
+        if own is not None:  # the profile min(a_w t, v_w) [m/s] (a_w = 0: v_w from t = 0)
+            a, v = float(getattr(self, own.acceleration)), float(getattr(self, own.speed))
+            setattr(self, own.profile_reference, min(a * st.t, v) if a > 0 else v)
 
     def exit_initialization_mode(self) -> None:
         self._build()  # parameters may have been set during initialisation
@@ -141,9 +154,10 @@ class WinderSlave(Fmi2Slave):
                 raise WinderError(f"do_step at t = {current_time} but the FMU is at "
                                   f"t = {st.t} (steps must be contiguous)")
             for name, stepper_name in self._inputs.items():
-                if self._legacy and not st.free_drum:
-                    continue  # a single-drum scene on its speed profile (a line's
-                    # tension set-point is an input with no torque-driven body)
+                if st.inputs[stepper_name] not in st.system.machine.param_names:
+                    continue  # an input without its parameter: a single-drum scene on its
+                    # speed profile (a line's tension set-point is an input with no
+                    # torque-driven body, and a parameter)
                 tau = float(getattr(self, name))
                 if not math.isfinite(tau):
                     raise WinderError(f"input {name} is not finite: {tau!r}")

@@ -11,7 +11,7 @@ from abc import ABC
 from typing import TYPE_CHECKING, Any, ClassVar
 
 if TYPE_CHECKING:
-    from winder._schema import Key
+    from winder._schema import Channel, Key
     from winder.model.machine import Evaluation, Machine
 
 __all__ = ["ForceElement"]
@@ -46,7 +46,7 @@ class ForceElement(ABC):
     4. In :meth:`declare`, register with the :class:`~winder.model.machine.Machine` what it
        needs: run-time parameters (``machine.parameter(name, value)``, values from the
        scene's parts and its settings), states (``machine.state(name, initial)``), result
-       channels with their units (``machine.channel(name, unit)``), locked modes
+       channels declared in ``CHANNELS`` (``machine.channel(declaration, owner)``), locked modes
        (``machine.mode(name, switches, ModeKind..., owner=part)``).
     5. In :meth:`apply`, read the :class:`~winder.model.machine.Evaluation`
        (``ev.mathns`` is the math namespace; ``ev.p(name)`` a parameter, ``ev.x(name)`` a
@@ -98,6 +98,9 @@ class ForceElement(ABC):
     #: on (True) or off where a scene does not say
     default: ClassVar[bool] = True
     settings: ClassVar[tuple[Key, ...]] = ()  # its own keys, [effects.NAME] (scene schema)
+    #: the result channels it writes, declared once (it registers each with
+    #: ``machine.channel(declaration, owner)``; the reference lists them)
+    CHANNELS: ClassVar[tuple[Channel, ...]] = ()
 
     #: quantities it writes for other elements and the machine
     provides: ClassVar[frozenset[str]] = frozenset()

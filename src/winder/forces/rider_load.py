@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from winder._schema import Key
+from winder._schema import Channel, Key
 from winder.forces._base import ForceElement
 
 if TYPE_CHECKING:
@@ -29,6 +29,8 @@ class RiderLoad(ForceElement):
 
     name = "rider_load"
     doc = "the riders' applied line load; off: only their weight"
+    CHANNELS = (Channel(name="RIDER_load", unit="N",
+                        doc="applied rider load L·q(r), acting downwards (−z)"),)
     settings = (Key(name="scale", unit="-", lo=0.0, hi=100.0, default=1.0,
                     doc="factor on every rider's line-load schedule (1: as given; 0: only "
                         "the riders' weight)"),)
@@ -39,7 +41,7 @@ class RiderLoad(ForceElement):
             for i, (r, q) in enumerate(b.load):
                 machine.parameter(f"{b.name}.load_radius_{i}", r)
                 machine.parameter(f"{b.name}.line_load_{i}", q * scale)
-            machine.channel(f"{b.name}_load", "N")
+            machine.channel(self.CHANNELS[0], b.name)
 
     def apply(self, ev: Evaluation) -> None:
         for b in _riders(ev.machine):

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from winder._schema import Channel
 from winder.forces._base import ForceElement
 
 if TYPE_CHECKING:
@@ -37,6 +38,8 @@ class TensionController(ForceElement):
     span of its web); state ``ROLL.tension_integral`` [N·s]."""
 
     name = "tension_control"
+    CHANNELS = (Channel(name="tension_error", unit="N",
+                        doc="the unwind controller's error T* − T"),)
     requires = frozenset({"span_rate"})
     provides = frozenset({"drive_torque"})
 
@@ -48,7 +51,7 @@ class TensionController(ForceElement):
             machine.parameter(f"{b.name}.tension_setpoint", b.part.drive.tension)
             machine.parameter(f"{b.name}.bandwidth", b.part.drive.bandwidth)
             machine.state(f"{b.name}.tension_integral", 0.0)
-            machine.channel(f"{w.span_channel}tension_error", "N")
+            machine.channel(self.CHANNELS[0], w.span_channel)
 
     def apply(self, ev: Evaluation) -> None:
         for w in ev.machine.webs:

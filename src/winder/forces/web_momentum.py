@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from winder._schema import Channel
 from winder.forces._base import ForceElement
 from winder.forces.web_tension import exit_point
 
@@ -24,10 +25,12 @@ class WebMomentum(ForceElement):
     name = "web_momentum"
     doc = ("the momentum flux ṁ u the web brings into a wound roll (and the leaving paper "
            "takes out of an unwinding one)")
+    CHANNELS = (Channel(name="web_force", unit="N",
+                        doc="web momentum force ṁ u on the wound roll"),)
 
     def declare(self, machine: Machine) -> None:
         for w in machine.webs:
-            machine.channel(f"{w.channel}web_force", "N")
+            machine.channel(self.CHANNELS[0], w.channel)
 
     def apply(self, ev: Evaluation) -> None:
         m = ev.machine

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from winder._schema import Channel
 from winder.forces._base import ForceElement
 
 if TYPE_CHECKING:
@@ -41,6 +42,8 @@ class WebTension(ForceElement):
     name = "web_tension"
     doc = ("the web tension's pull on the wound roll at its entry nip (and on the unwinding "
            "roll)")
+    CHANNELS = (Channel(name="span_tension", unit="N",
+                        doc="web span tension T (a state; the forces use max(T, 0))"),)
     provides = frozenset({"span_rate"})
 
     def declare(self, machine: Machine) -> None:
@@ -52,7 +55,7 @@ class WebTension(ForceElement):
                 machine.parameter(f"{k}span.length", span.length)
                 machine.parameter(f"{k}span.EA", span.EA)
                 machine.parameter(f"{k}span.T_in", span.T_in)
-                machine.channel(f"{w.span_channel}span_tension", "N")
+                machine.channel(self.CHANNELS[0], w.span_channel)
             else:
                 machine.parameter(f"{w.key}web.tension", w.part.tension)
 

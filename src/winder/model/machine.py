@@ -35,6 +35,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from winder._schema import Channel
+from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, WEB_SPEED
 from winder.model.element_order import order_elements
 from winder.model.locked_modes import (
     AT_CORE,
@@ -53,12 +55,6 @@ __all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState", "AUTO
            "paper_roll_mass"]
 
 _COORDS = ("x", "z")
-#: Units of the generic channels of every body (machines.md §9) by suffix.
-_BODY_CHANNELS = (("speed", "rad/s"), ("angle", "rad"), ("torque", "N·m"),
-                  ("accel", "rad/s²"))
-_COORD_CHANNELS = (("", "m"), ("_dot", "m/s"), ("_accel", "m/s²"))
-_NIP_CHANNELS = (("normal_force", "N"), ("friction_force", "N"), ("slip_velocity", "m/s"),
-                 ("penetration", "m"))
 
 
 @dataclass
@@ -202,15 +198,17 @@ class Machine:
         self.state_names.append(name)
         self.state_initial.append(float(initial))
 
-    def channel(self, name: str, unit: str) -> None:
-        """Register a result channel ``name`` in ``unit`` (SI, machines.md §9: ``rad/s``,
-        ``N·m``, ``m``, ``kg·m²``, ... ``-`` for a pure number)."""
-        if not isinstance(unit, str) or not unit:
-            raise TypeError(f"channel {name!r}: unit must be a non-empty string such as "
-                            f"'m' or '-', got {unit!r}")
+    def channel(self, declared: Channel, owner: str = "") -> str:
+        """Register the result channel ``declared`` of ``owner`` (a part's name, or a web's
+        prefix: :meth:`~winder._schema.Channel.of`) in its declared unit (SI, machines.md
+        §9); return its name."""
+        if not isinstance(declared, Channel):
+            raise TypeError(f"Machine.channel: a Channel declaration, got {declared!r}")
+        name = declared.of(owner)
         if name not in self.channel_names:
             self.channel_names.append(name)
-            self.channel_units[name] = unit
+            self.channel_units[name] = declared.unit
+        return name
 
     def mode(self, name: str, switches: tuple[str, ...], kind: ModeKind, *, owner: str,
              state: str | None = None, param: str | None = None) -> None:
@@ -237,17 +235,18 @@ class Machine:
         for b in self.bodies:
             b.declare(self)
         for b in self.bodies:
-            for ch, unit in _BODY_CHANNELS:
-                self.channel(f"{b.name}_{ch}", unit)
+            for ch in BODY_CHANNELS:
+                self.channel(ch, b.name)
             for c in b.free:
-                for ch, unit in _COORD_CHANNELS:
-                    self.channel(f"{b.name}_{c}{ch}", unit)
-            b.declare_channels(self)
+                for ch in COORD_CHANNELS[c]:
+                    self.channel(ch, b.name)
+            for ch in b.CHANNELS:
+                self.channel(ch, b.name)
         for n in self.nips:
-            for ch, unit in _NIP_CHANNELS:
-                self.channel(f"{n.name}_{ch}", unit)
+            for ch in NIP_CHANNELS:
+                self.channel(ch, n.name)
         for w in self.webs:
-            self.channel(f"{w.channel}web_speed", "m/s")
+            self.channel(WEB_SPEED, w.channel)
 
     # ---- names ------------------------------------------------------------------------
     @property

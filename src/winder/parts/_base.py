@@ -13,6 +13,8 @@ from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from winder._schema import Channel
+
 if TYPE_CHECKING:
     from winder.model.machine import BodyState, Evaluation, Machine
 
@@ -55,8 +57,8 @@ class BodyElement(ABC):
     3. :meth:`declare`: its run-time parameters (``machine.parameter(name, value)``),
        the states beyond its joint coordinates with their initial values (spec §7,
        ``machine.state``), its locked modes (``machine.mode(name, switches,
-       ModeKind..., owner=NAME)``); :meth:`declare_channels` its own channels with their units
-       (``machine.channel(name, unit)``); :meth:`initial_rate` the initial rate of a
+       ModeKind..., owner=NAME)``); :attr:`CHANNELS` its own channels (declared once, with
+       their units; the machine registers them); :meth:`initial_rate` the initial rate of a
        joint coordinate (spec §7).
     4. :meth:`kinematics`: over the math namespace ``ev.mathns`` (floats or CasADi
        symbols: branch on states only with ``if_else``/``fmax``) its radius ``r`` [m]
@@ -106,8 +108,9 @@ class BodyElement(ABC):
     role: ClassVar[str]
     #: the scene key that places it (``centre``; a rider: ``x``)
     place_key: ClassVar[str] = "centre"
-    #: that key in the single-drum format (None: not in that format)
-    legacy_place_key: ClassVar[str | None] = None
+    #: its own result channels (after the generic ones of every body), each
+    #: ``BODY``/``ROLL``/``RIDER``-named: the machine registers them for it
+    CHANNELS: ClassVar[tuple[Channel, ...]] = ()
     #: its radius is the state ``NAME.radius`` and the channel ``NAME_radius`` [m]
     radius_state: ClassVar[bool] = False
     #: its mass properties change in time (the ``variable_mass`` effect applies)
@@ -124,6 +127,8 @@ class BodyElement(ABC):
         self.drives: tuple[str, ...] = ()
         self.torque_inputs: tuple[str, ...] = ()
         self.setpoint_inputs: tuple[str, ...] = ()
+        #: paper winds onto it: its radius grows with its web (a wound roll)
+        self.winds = False
         #: its centre of mass offset [m] for the ``imbalance`` effect (None: no imbalance)
         self.com_offset: float | None = None
         #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine
@@ -143,9 +148,6 @@ class BodyElement(ABC):
     @abstractmethod
     def declare(self, machine: Machine) -> None:
         """Register its parameters, its own states and its modes (once)."""
-
-    def declare_channels(self, machine: Machine) -> None:  # noqa: B027 - optional hook
-        """Register its own channels with their units (after the generic ones)."""
 
     @abstractmethod
     def initial_rate(self, coord: str) -> float:

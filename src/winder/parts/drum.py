@@ -113,7 +113,6 @@ class DrumBody(RigidDisc):
 
     table = "drum"
     role = "drum"
-    legacy_place_key = "[drum] radius"
 
     def __init__(self, part: Any, placed: Any = None) -> None:
         super().__init__(part)

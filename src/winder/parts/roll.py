@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from winder._schema import Key, Table
+from winder._schema import Channel, Key, Table
 from winder.parts.drum import CENTRE, NAME
 
 __all__ = ["RollPart", "ROLL_KINDS", "AXES", "UnwindTorqueDrive", "TensionControl",
@@ -155,7 +155,13 @@ class RollBody(BodyElement):
 
     table = "roll"
     role = "roll"
-    legacy_place_key = "[roll] initial_radius"
+    CHANNELS = (
+        Channel(name="ROLL_radius", unit="m", doc="radius r of a paper roll"),
+        Channel(name="ROLL_mass", unit="kg", doc="mass m(r)"),
+        Channel(name="ROLL_inertia", unit="kg·m²", doc="polar inertia J(r) about its axis"),
+        Channel(name="ROLL_mass_rate", unit="kg/s", doc="ṁ (negative for an unwinding roll)"),
+        Channel(name="ROLL_inertia_rate", unit="kg·m²/s", doc="J̇"),
+    )
     radius_state = True
     variable_mass = True
 
@@ -168,6 +174,7 @@ class RollBody(BodyElement):
         n = self.name
         #: it pays off its web (machines.md §1): fixed centre, shrinking radius
         self.unwinding = part.kind == "unwinding"
+        self.winds = not self.unwinding
         self.torque_inputs = (f"{n}.torque",) if kind == "torque" else ()
         self.drives = ("tension_control",) if kind == "tension_control" else ()
         self.setpoint_inputs = (f"{n}.tension_setpoint",) if self.drives else ()
@@ -194,11 +201,6 @@ class RollBody(BodyElement):
                          owner=n, state=f"{n}.radius", param=f"{n}.core_radius")
         if self.torque_inputs:
             machine.parameter(f"{n}.torque", part.drive.torque)
-
-    def declare_channels(self, machine: Machine) -> None:
-        for ch, unit in (("radius", "m"), ("mass", "kg"), ("inertia", "kg·m²"),
-                         ("mass_rate", "kg/s"), ("inertia_rate", "kg·m²/s")):
-            machine.channel(f"{self.name}_{ch}", unit)
 
     def initial_rate(self, coord: str) -> float:
         """Spec §7: ``θ̇ = s · initial_speed``; the centre at rest."""

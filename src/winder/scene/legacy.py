@@ -4,7 +4,8 @@ it: its tables of keys (read from the parts' declarations, plus ``[roll]
 initial_height``), its dataclasses, its parsing and its translation into parts (machines
 spec §8, last paragraph): drum "drum" at the origin, sense +1; roll "roll" free in ``z``
 at ``(0, R + r0)``, sense −1; nip "nip" (a = drum, b = roll); web entering at "nip" with
-tension 0.
+tension 0; and its names (:class:`SingleDrumNaming`): the result columns of winder-model
+§8 (:data:`COLUMNS`), its keys in messages, its FMU interface.
 """
 
 from __future__ import annotations
@@ -13,15 +14,18 @@ import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 from winder._errors import SceneError
-from winder._schema import Key, Table
+from winder._schema import Channel, Key, Table
+from winder.forces.web_momentum import WebMomentum
+from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, WEB_SPEED
 from winder.parts import (
     ContactLaw,
     DrumPart,
     FrictionLaw,
     NipPart,
+    RollBody,
     RollPart,
     SpeedProfileDrive,
     TorqueDrive,
@@ -31,13 +35,15 @@ from winder.parts import drum as _drum
 from winder.parts import nip as _nip
 from winder.parts import roll as _roll
 from winder.scene.checks import check_roll_core
+from winder.scene.naming import FmuNames, Naming
 from winder.scene.parse import fail, parse_table
 from winder.scene.schema import PAPER_KEYS, TABLES
 from winder.scene.tables import Effects, Paper
 
 __all__ = ["Drive", "Drum", "Roll", "LegacyContact", "LegacyFriction", "LEGACY_TABLES",
            "TABLE_NAMES", "OWN_TABLES", "is_legacy", "parse_tables", "build", "legacy_parts",
-           "check_rest_on_nip"]
+           "check_rest_on_nip", "COLUMNS", "CHANNELS", "EXTRA_CHANNELS", "SingleDrumNaming",
+           "SINGLE_DRUM"]
 
 #: ``[drum]``: a drum's body keys.
 DRUM_KEYS = Table(_drum.KEYS.select("radius", "inertia", "mass"))
@@ -66,6 +72,104 @@ TABLE_NAMES = tuple(t for t in LEGACY_TABLES if t != "drum.drive")
 OWN_TABLES = ("drum", "roll", "paper", "contact", "friction")
 #: The tables a single-drum scene must have.
 REQUIRED_TABLES = ("scene", "drum", "roll", "paper")
+
+# ---- names -------------------------------------------------------------------------------
+_DECLARED: dict[str, Channel] = {c.name: c for c in (
+    *BODY_CHANNELS, *COORD_CHANNELS["z"], *NIP_CHANNELS, WEB_SPEED, *RollBody.CHANNELS,
+    *WebMomentum.CHANNELS)}
+
+#: The result columns of a single-drum scene after ``t``, in order (winder-model §8: the
+#: standard 15, then winder's extras): column → (the channel's declaration, its owner: the
+#: part's name, or ``""`` for the web), i.e. the machine's channel ``declaration.of(owner)``.
+COLUMNS: dict[str, tuple[Channel, str]] = {column: (_DECLARED[pattern], owner) for
+                                           column, (pattern, owner) in {
+    "drum_speed": ("BODY_speed", "drum"), "drum_torque": ("BODY_torque", "drum"),
+    "roll_speed": ("BODY_speed", "roll"), "roll_accel": ("BODY_accel", "roll"),
+    "roll_angle": ("BODY_angle", "roll"), "radius": ("ROLL_radius", "roll"),
+    "mass": ("ROLL_mass", "roll"), "inertia": ("ROLL_inertia", "roll"),
+    "mass_rate": ("ROLL_mass_rate", "roll"), "inertia_rate": ("ROLL_inertia_rate", "roll"),
+    "z": ("BODY_z", "roll"), "z_dot": ("BODY_z_dot", "roll"),
+    "normal_force": ("NIP_normal_force", "nip"),
+    "friction_force": ("NIP_friction_force", "nip"),
+    "slip_velocity": ("NIP_slip_velocity", "nip"), "drum_angle": ("BODY_angle", "drum"),
+    "web_speed": ("web_speed", ""), "z_accel": ("BODY_z_accel", "roll"),
+    "web_force": ("web_force", ""), "penetration": ("NIP_penetration", "nip"),
+}.items()}
+
+#: Result channels of a single-drum scene (winder-model §8), in order (first column ``t``).
+CHANNELS = ("t", *list(COLUMNS)[:15])
+#: Its extra channels (winder's own): drum angle, web speed, roll vertical acceleration,
+#: web momentum force, penetration.
+EXTRA_CHANNELS = tuple(list(COLUMNS)[15:])
+
+#: The keys that place the drum and the roll (their parts' ``centre``).
+_PLACE_KEYS = {("drum", "centre"): "[drum] radius", ("roll", "centre"): "[roll] initial_radius"}
+
+
+@dataclass(frozen=True)
+class SingleDrumNaming(Naming):
+    """The names of a single-drum scene: its result columns (:data:`COLUMNS`; a channel
+    the machine lacks with an effect off, e.g. ``web_force``, is zeros in its declared
+    unit), its keys in messages (``[drum.drive]``, ``[friction] mu``, the drum placed by
+    ``[drum] radius``, the roll by ``[roll] initial_radius``), its FMU interface."""
+
+    by_parts: ClassVar[bool] = False
+    fmu: ClassVar[FmuNames | None] = FmuNames(
+        parameters={
+            "profile_web_speed": ("drum.drive", "web_speed"),
+            "web_acceleration": ("drum.drive", "web_acceleration"),
+            "com_offset": ("roll", "com_offset"),
+            "contact_stiffness": ("contact", "stiffness"),
+            "contact_damping": ("contact", "damping"),
+            "mu": ("friction", "mu"),
+            "slip_reference_velocity": ("friction", "slip_velocity"),
+            "relaxation_length": ("friction", "relaxation_length"),
+            "caliper": ("paper", "caliper"),
+            "density": ("paper", "density"),
+            "width": ("roll", "width"),
+        },
+        profile_switch="speed_profile", inputs={"drum_torque_command": "drum_torque"},
+        profile_reference="web_speed_reference", acceleration="web_acceleration",
+        speed="profile_web_speed")
+    #: a result written before the drum angle was a channel draws the drum still
+    optional: ClassVar[frozenset[str]] = frozenset({"drum_angle"})
+
+    def outputs(self, units: Mapping[str, str]) -> dict[str, tuple[str, str]]:
+        return {column: (decl.of(owner), decl.unit) for column, (decl, owner) in COLUMNS.items()}
+
+    def output_name(self, channel: str) -> str:
+        return _COLUMN_OF.get(channel, channel)
+
+    def inputs(self, inputs: Mapping[str, str]) -> dict[str, str]:
+        """``drum_torque``, the drum's torque (set only with drive kind ``torque``)."""
+        return {"drum_torque": "drum.torque"}
+
+    def key(self, table: str, part: str, *path: str) -> str:
+        if (table, *path) in _PLACE_KEYS:
+            return _PLACE_KEYS[(table, *path)]
+        if table == "nip" and path:  # the nip's laws are tables of their own
+            table, path = path[0], path[1:]
+        elif table == "drum" and path[:1] == ("drive",):
+            table, path = "drum.drive", path[1:]
+        return " ".join((f"[{table}]", *path))
+
+    def drive_changes(self, scene: Any, drive: dict[str, Any], speed_profile: bool) -> None:
+        """Set ``drive`` (the changes of ``[drum.drive]``) for the FMU's
+        :attr:`FmuNames.profile_switch`: true drives the drum along its profile, false
+        frees it, started at the profile's initial speed, on the torque input."""
+        d = scene.drum.drive
+        a = drive.get("web_acceleration", d.web_acceleration)
+        v = drive.get("web_speed", d.web_speed)
+        if speed_profile:
+            drive.update(kind="speed_profile", web_acceleration=a, web_speed=v)
+        else:  # free drum, started at the profile's initial speed
+            drive.update(kind="torque", web_acceleration=a, web_speed=0.0 if a > 0 else v,
+                         torque=0.0)
+
+
+_COLUMN_OF = {decl.of(owner): column for column, (decl, owner) in COLUMNS.items()}
+#: The naming of every single-drum scene (and of a result without its scene).
+SINGLE_DRUM = SingleDrumNaming()
 
 
 @dataclass(frozen=True)

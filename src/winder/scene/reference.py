@@ -4,7 +4,9 @@ Every table and key of both scene formats with its type, unit, range, default an
 meaning, read from each key's one declaration (:class:`~winder._schema.Key`: the parts'
 ``KEYS``, the effects' ``settings``, :mod:`winder.scene.schema`,
 :mod:`winder.scene.legacy`) and, for a default the key does not declare, the dataclass
-field's; then the result channels. Regenerate with ``make scene-reference`` or::
+field's; then the result channels, read from each channel's one declaration
+(:class:`~winder._schema.Channel`: :mod:`winder.model.channels`, the parts' and the
+force elements' ``CHANNELS``). Regenerate with ``make scene-reference`` or::
 
     python -m winder.scene.reference [--out docs/scene-reference.md] [--check]
 
@@ -17,11 +19,15 @@ import argparse
 import dataclasses
 import re
 import sys
+from collections.abc import Iterable
 from pathlib import Path
 
-from winder._schema import NO_DEFAULT, Key, Table
+from winder._schema import NO_DEFAULT, Channel, Key, Table
 from winder._schema import format_number as _num
+from winder.forces import DRIVES, FORCES
+from winder.model.channels import GENERIC_CHANNELS, TIME
 from winder.parts import (
+    PARTS,
     ContactLaw,
     DrumPart,
     FrictionLaw,
@@ -38,11 +44,12 @@ from winder.parts import (
 from winder.parts.drum import DRIVE_KEYS as DRUM_DRIVE_KEYS
 from winder.parts.roll import DRIVE_KEYS as UNWIND_DRIVE_KEYS
 from winder.scene.keys import ALL_TABLES
-from winder.scene.legacy import Drive, Drum, Roll
+from winder.scene.legacy import COLUMNS, Drive, Drum, Roll
 from winder.scene.schema import effect_names, effect_settings
 from winder.scene.tables import Effects, Paper, SceneInfo, Solver
 
-__all__ = ["reference", "main", "CHANNEL_DOC", "LEGACY_CHANNEL_DOC"]
+__all__ = ["reference", "main", "CHANNEL_DECLARATIONS", "channel_declarations",
+           "channel_pattern"]
 
 #: The dataclasses whose defaults a schema table's keys take (the first that has the
 #: field; ``from`` of ``[web.span]`` is the field ``source``).
@@ -56,66 +63,16 @@ _DEFAULTS_FROM: dict[str, tuple[type, ...]] = {
     "nip[].friction": (FrictionLaw,), "web": (WebPart,), "web.span": (SpanPart,),
 }
 
-#: Result channels of a single-drum scene, in their order (the standard 16, then
-#: winder's extras): name -> (unit, meaning).
-LEGACY_CHANNEL_DOC: dict[str, tuple[str, str]] = {
-    "t": ("s", "time"),
-    "drum_speed": ("rad/s", "drum speed Ω (operation sense)"),
-    "drum_torque": ("N·m", "drum drive torque (inverse dynamics for a speed profile, the "
-                           "input for a torque drive)"),
-    "roll_speed": ("rad/s", "roll speed ω (operation sense)"),
-    "roll_accel": ("rad/s²", "roll angular acceleration ω̇"),
-    "roll_angle": ("rad", "roll angle φ (operation sense)"),
-    "radius": ("m", "roll radius r"),
-    "mass": ("kg", "roll mass m(r)"),
-    "inertia": ("kg·m²", "roll polar inertia J(r) about its axis"),
-    "mass_rate": ("kg/s", "ṁ"),
-    "inertia_rate": ("kg·m²/s", "J̇"),
-    "z": ("m", "height of the roll axis above the drum axis"),
-    "z_dot": ("m/s", "ż"),
-    "normal_force": ("N", "nip normal force F_n on the roll (0: in the air)"),
-    "friction_force": ("N", "nip friction force F_t on the roll, along +x"),
-    "slip_velocity": ("m/s", "slip v_s = Ω R − ω r"),
-    "drum_angle": ("rad", "drum angle"),
-    "web_speed": ("m/s", "surface speed of the drum the web wraps, Ω R"),
-    "z_accel": ("m/s²", "z̈"),
-    "web_force": ("N", "web momentum force ṁ u on the roll"),
-    "penetration": ("m", "nip penetration δ = R + r − z (negative: open)"),
-}
+#: Every result channel's declaration (:class:`~winder._schema.Channel`): the machine's
+#: generic ones (:mod:`winder.model.channels`), then each body's (:data:`PARTS`), each
+#: force element's (:data:`FORCES`, :data:`DRIVES`), in that order.
+CHANNEL_DECLARATIONS: tuple[Channel, ...] = (
+    *GENERIC_CHANNELS, *(c for cls in PARTS.values() for c in cls.CHANNELS),
+    *(c for cls in (*FORCES.values(), *DRIVES.values()) for c in cls.CHANNELS))
 
-#: Result channels of a scene of parts: name pattern -> (unit, meaning). ``BODY`` is any
-#: drum, roll or rider, ``ROLL`` a paper roll, ``RIDER`` a rider, ``NIP`` a nip.
-CHANNEL_DOC: dict[str, tuple[str, str]] = {
-    "t": ("s", "time"),
-    "BODY_speed": ("rad/s", "speed in the body's operation sense (s θ̇)"),
-    "BODY_angle": ("rad", "angle in the operation sense (s θ)"),
-    "BODY_accel": ("rad/s²", "angular acceleration in the operation sense"),
-    "BODY_torque": ("N·m", "driven body: its drive torque (inverse dynamics for a speed "
-                           "profile, the input or the controller's torque otherwise); "
-                           "undriven body: the torque of the nip friction and web forces "
-                           "about its axis; operation sense, without gravity, imbalance "
-                           "and −Ẏv"),
-    "BODY_x": ("m", "centre x, for a body free along x"),
-    "BODY_x_dot": ("m/s", "ẋ"),
-    "BODY_x_accel": ("m/s²", "ẍ"),
-    "BODY_z": ("m", "centre z, for a body free along z"),
-    "BODY_z_dot": ("m/s", "ż"),
-    "BODY_z_accel": ("m/s²", "z̈"),
-    "ROLL_radius": ("m", "radius r of a paper roll"),
-    "ROLL_mass": ("kg", "mass m(r)"),
-    "ROLL_inertia": ("kg·m²", "polar inertia J(r) about its axis"),
-    "ROLL_mass_rate": ("kg/s", "ṁ (negative for an unwinding roll)"),
-    "ROLL_inertia_rate": ("kg·m²/s", "J̇"),
-    "RIDER_load": ("N", "applied rider load along z (negative: downwards)"),
-    "NIP_normal_force": ("N", "normal force F_n (0: open)"),
-    "NIP_friction_force": ("N", "friction force F_t, on b along +t"),
-    "NIP_slip_velocity": ("m/s", "slip v_s = u_a − u_b"),
-    "NIP_penetration": ("m", "penetration δ = r_a + r_b − |c_b − c_a| (negative: open)"),
-    "web_speed": ("m/s", "surface speed of the drum at the entry nip"),
-    "web_force": ("N", "web momentum force ṁ u on the wound roll"),
-    "span_tension": ("N", "web span tension T (a state; the forces use max(T, 0))"),
-    "tension_error": ("N", "the unwind controller's error T* − T"),
-}
+#: What each placeholder of a channel's name stands for: the kinds of part it names.
+_PLACEHOLDER_KINDS = {"BODY": ("drum", "roll", "rider"), "ROLL": ("roll",),
+                      "RIDER": ("rider",), "NIP": ("nip",)}
 
 
 def _kind_text(key: Key) -> str:
@@ -262,12 +219,17 @@ def reference() -> str:
     for t in ("drum", "drum.drive", "roll", "paper", "contact", "friction"):
         lines += _section(t)
     lines += ["## Result channels", "",
-              "One column each, SI units, first column `t` (CSV and NPZ alike).", "",
+              "One column each, SI units, first column `t` (CSV and NPZ alike). Each "
+              "channel is declared once, by what writes it (the machine, a part, an "
+              "effect); this list is generated from those declarations.", "",
               "### Single-drum format", "",
-              "The first 16 are the standard set; the others are winder's extras.", "",
-              "| channel | unit | meaning |", "|---|---|---|"]
-    for ch, (unit, meaning) in LEGACY_CHANNEL_DOC.items():
-        lines.append(f"| `{ch}` | {unit} | {_cell(meaning)} |")
+              "The first 16 are the standard set; the others are winder's extras. Each is "
+              "a channel of the machine the format means (drum `drum`, roll `roll`, nip "
+              "`nip`), renamed.", "",
+              "| channel | unit | machine channel | meaning |", "|---|---|---|---|",
+              f"| `{TIME.name}` | {TIME.unit} | `{TIME.name}` | {_cell(TIME.doc)} |"]
+    for column, (decl, owner) in COLUMNS.items():
+        lines.append(f"| `{column}` | {decl.unit} | `{decl.of(owner)}` | {_cell(decl.doc)} |")
     lines += ["", "### Scenes of parts", "",
               "`BODY` is the name of any drum, roll or rider, `ROLL` of a paper roll, "
               "`RIDER` of a rider, `NIP` of a nip; `web_speed` and `web_force` exist with a "
@@ -277,27 +239,33 @@ def reference() -> str:
               "spans, `span_tension` and `tension_error` are `WEB_span_tension` and "
               "`WEB_tension_error`.", "",
               "| channel | unit | meaning |", "|---|---|---|"]
-    for ch, (unit, meaning) in CHANNEL_DOC.items():
-        lines.append(f"| `{ch}` | {unit} | {_cell(meaning)} |")
+    for decl in CHANNEL_DECLARATIONS:
+        lines.append(f"| `{decl.name}` | {decl.unit} | {_cell(decl.doc)} |")
     return "\n".join(lines) + "\n"
 
 
-def channel_pattern(name: str, bodies: dict[str, str]) -> str | None:
-    """The :data:`CHANNEL_DOC` pattern of the channel ``name`` of a scene of parts, or
-    None; ``bodies`` maps every part name to its kind (``drum``, ``roll``, ``rider``,
-    ``nip``)."""
-    if name in CHANNEL_DOC:
-        return name
-    for part, kind in sorted(bodies.items(), key=lambda kv: -len(kv[0])):
-        if not name.startswith(part + "_"):
-            continue
-        rest = name[len(part) + 1:]
-        keys = {"nip": ("NIP",), "roll": ("ROLL", "BODY"), "rider": ("RIDER", "BODY"),
-                "drum": ("BODY",)}[kind]
-        for k in keys:
-            if f"{k}_{rest}" in CHANNEL_DOC:
-                return f"{k}_{rest}"
-    return None
+def channel_declarations(name: str, parts: dict[str, str], webs: Iterable[str] = ()
+                         ) -> list[Channel]:
+    """The declarations (:data:`CHANNEL_DECLARATIONS`) the channel ``name`` of a scene of
+    parts matches: a placeholder's with the name of a part of its kind, a web's alone or
+    after the name of one of ``webs`` (``WEB_web_speed``); ``parts`` maps every part name
+    to its kind (``drum``, ``roll``, ``rider``, ``nip``)."""
+    out = []
+    for decl in CHANNEL_DECLARATIONS:
+        if decl.placeholder:
+            owners = [p for p, k in parts.items() if k in _PLACEHOLDER_KINDS[decl.placeholder]]
+            if any(name == decl.of(p) for p in owners):
+                out.append(decl)
+        elif name == decl.name or any(name == decl.of(f"{w}_") for w in webs):
+            out.append(decl)
+    return out
+
+
+def channel_pattern(name: str, parts: dict[str, str]) -> str | None:
+    """The declared name pattern (``BODY_speed``) of the channel ``name`` of a scene of
+    parts (:func:`channel_declarations`; the first where several match), or None."""
+    found = channel_declarations(name, parts)
+    return found[0].name if found else None
 
 
 def main(argv: list[str] | None = None) -> int:

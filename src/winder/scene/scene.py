@@ -12,7 +12,16 @@ from typing import Any
 from winder._args import show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.parts import DrumPart, NipPart, RiderPart, RollPart, WebPart
-from winder.scene.legacy import OWN_TABLES, Drum, LegacyContact, LegacyFriction, Roll, legacy_parts
+from winder.scene.legacy import (
+    OWN_TABLES,
+    SINGLE_DRUM,
+    Drum,
+    LegacyContact,
+    LegacyFriction,
+    Roll,
+    legacy_parts,
+)
+from winder.scene.naming import BY_PARTS, Naming
 from winder.scene.tables import Effects, Paper, SceneInfo, Solver
 from winder.scene.validate import scene_kwargs
 
@@ -70,6 +79,13 @@ class Scene:
     @property
     def name(self) -> str:
         return self.scene.name
+
+    @property
+    def naming(self) -> Naming:
+        """How the scene names its result channels, its keys in messages and its FMU
+        variables: by its parts, or the single-drum format's names
+        (:mod:`winder.scene.naming`)."""
+        return SINGLE_DRUM if self.legacy else BY_PARTS
 
     def replace(self, **changes: Mapping[str, Any]) -> Scene:
         """A copy with some tables' keys changed: ``scene.replace(roll={"com_offset": 0})``.
@@ -189,6 +205,7 @@ def _merge(node: Any, values: Any, table: str, path: tuple[str, ...]) -> None:
             _merge(node[key], value, table, (*path, key))
         else:  # a value, or a list of values (a rider's load schedule): replace it
             node[key] = value
+
 
 
 def scene_from_dict(data: dict[str, Any], *, source: str = "<scene>") -> Scene:

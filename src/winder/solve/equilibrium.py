@@ -29,6 +29,7 @@ from winder.model.backends import NumericBackend
 from winder.model.locked_modes import AUTO, CORE_AUTO, FREE, IN_CONTACT, ModeKind
 from winder.model.machine import Machine, Nip
 from winder.parts import BodyElement as Body
+from winder.scene.naming import naming_of
 
 __all__ = ["static_state", "resting_state", "Resting", "Equilibrium", "EquilibriumError",
            "RESIDUAL_LIMIT", "balance_keys", "body_key", "nip_key"]
@@ -67,16 +68,13 @@ def body_key(machine: Machine, body: Body) -> str:
     """The scene key that places ``body`` (``[[drum]] 'front' centre``, ``[[roll]] 'set'
     centre``, ``[[rider]] 'rider' x``; the single-drum format: ``[drum] radius``,
     ``[roll] initial_radius``)."""
-    if machine.scene.legacy and body.legacy_place_key is not None:
-        return body.legacy_place_key
-    return f"[[{body.table}]] {body.name!r} {body.place_key}"
+    return naming_of(machine.scene).key(body.table, body.name, body.place_key)
 
 
 def nip_key(machine: Machine, nip: Nip, key: str = "stiffness") -> str:
     """The scene key of a nip's contact law (``[[nip]] 'rider_nip' contact stiffness``; the
     single-drum format: ``[contact] stiffness``)."""
-    return f"[contact] {key}" if machine.scene.legacy else \
-        f"[[nip]] {nip.name!r} contact {key}"
+    return naming_of(machine.scene).key("nip", nip.name, "contact", key)
 
 
 def balance_keys(machine: Machine, body: Body) -> list[str]:

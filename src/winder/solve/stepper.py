@@ -12,12 +12,13 @@ import numpy as np
 from winder._args import real_argument
 from winder._errors import ArgumentError, SimulationError, state_text
 from winder.io.result import Result
+from winder.scene import CHANNELS, EXTRA_CHANNELS, naming_of
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
 from winder.solve.budgets import budget_error, check_budgets, check_tolerances
 from winder.solve.dopri5 import dopri5
 from winder.solve.simulate import _as_scene
-from winder.solve.system import LEGACY_CHANNELS, MachineSystem
+from winder.solve.system import MachineSystem
 
 __all__ = ["Stepper", "INPUTS", "OUTPUTS", "inputs_of", "outputs_of"]
 
@@ -25,25 +26,22 @@ __all__ = ["Stepper", "INPUTS", "OUTPUTS", "inputs_of", "outputs_of"]
 #: ``torque`` only). A machine from parts has ``DRUM_torque`` per torque-driven drum.
 INPUTS = ("drum_torque",)
 #: Outputs of a single-drum scene: every result channel but ``t``.
-OUTPUTS = tuple(LEGACY_CHANNELS)
+OUTPUTS = (*CHANNELS[1:], *EXTRA_CHANNELS)
 
 
 def inputs_of(system: MachineSystem) -> dict[str, str]:
     """The inputs of a scene: input name → run-time parameter: ``DRUM_torque`` per
     torque-driven drum or unwinding roll, ``ROLL_tension_setpoint`` [N] of a
-    tension-controlled unwind."""
-    if getattr(system.scene, "legacy", False):
-        return {"drum_torque": "drum.torque"}
+    tension-controlled unwind (as the scene names them: :meth:`Naming.inputs
+    <winder.scene.Naming.inputs>`)."""
     names = system.torque_inputs() + [name for b in system.machine.bodies
                                       for name in b.setpoint_inputs]
-    return {n.replace(".", "_"): n for n in names}
+    return naming_of(system.scene).inputs({n.replace(".", "_"): n for n in names})
 
 
 def outputs_of(system: MachineSystem) -> tuple[str, ...]:
     """The outputs of a scene: its result channels but ``t``."""
-    if getattr(system.scene, "legacy", False):
-        return OUTPUTS
-    return tuple(system.machine.channel_names)
+    return tuple(system.outputs)
 _RAISE = {"max_rhs": "Stepper(max_rhs=...) or [solver] max_rhs; it is the budget of one step",
           "max_wall": "Stepper(max_wall=...) or [solver] max_wall; it is the budget of one "
                       "step"}

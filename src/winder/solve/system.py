@@ -19,47 +19,15 @@ import numpy as np
 
 from winder._errors import ArgumentError, SimulationError, state_text
 from winder.model.backends import NumericBackend
+from winder.model.channels import TIME
 from winder.model.codegen import CompilerMissing, Generated, generate
 from winder.model.machine import AT_CORE, AUTO, CORE_AUTO, WINDING, Machine
+from winder.scene import CHANNELS, EXTRA_CHANNELS, naming_of  # (public: the single-drum columns)
 from winder.solve import integrators as integ
 from winder.solve._jit import njit
 from winder.solve.equilibrium import Equilibrium, static_state
 
-__all__ = ["MachineSystem", "LEGACY_CHANNELS", "LEGACY_UNITS", "CHANNELS", "EXTRA_CHANNELS",
-           "NoCompilerWarning"]
-
-#: Channel names of a scene in the single-drum format (winder-model §8 and winder's
-#: extras), from the machine's channels of drum "drum", roll "roll" and nip "nip".
-LEGACY_CHANNELS = {
-    "drum_speed": "drum_speed", "drum_torque": "drum_torque", "roll_speed": "roll_speed",
-    "roll_accel": "roll_accel", "roll_angle": "roll_angle", "radius": "roll_radius",
-    "mass": "roll_mass", "inertia": "roll_inertia", "mass_rate": "roll_mass_rate",
-    "inertia_rate": "roll_inertia_rate", "z": "roll_z", "z_dot": "roll_z_dot",
-    "normal_force": "nip_normal_force", "friction_force": "nip_friction_force",
-    "slip_velocity": "nip_slip_velocity", "drum_angle": "drum_angle",
-    "web_speed": "web_speed", "z_accel": "roll_z_accel", "web_force": "web_force",
-    "penetration": "nip_penetration",
-}
-
-#: Units of the channels of a single-drum scene (those its machine lacks with an effect
-#: off, e.g. ``web_force``, are zeros in these units).
-LEGACY_UNITS = {
-    "drum_speed": "rad/s", "drum_torque": "N·m", "roll_speed": "rad/s",
-    "roll_accel": "rad/s²", "roll_angle": "rad", "radius": "m", "mass": "kg",
-    "inertia": "kg·m²", "mass_rate": "kg/s", "inertia_rate": "kg·m²/s", "z": "m",
-    "z_dot": "m/s", "normal_force": "N", "friction_force": "N", "slip_velocity": "m/s",
-    "drum_angle": "rad", "web_speed": "m/s", "z_accel": "m/s²", "web_force": "N",
-    "penetration": "m",
-}
-
-#: Result channels of a single-drum scene (winder-model §8), in order (first column ``t``).
-CHANNELS = ("t", *list(LEGACY_CHANNELS)[:15])
-#: Its extra channels (winder's own): drum angle, web speed, roll vertical acceleration,
-#: web momentum force, penetration.
-EXTRA_CHANNELS = tuple(list(LEGACY_CHANNELS)[15:])
-
-
-
+__all__ = ["MachineSystem", "CHANNELS", "EXTRA_CHANNELS", "NoCompilerWarning"]
 
 class NoCompilerWarning(UserWarning):
     """The generated path is unavailable (no C compiler): the numeric Pinocchio path runs."""
@@ -293,13 +261,17 @@ class MachineSystem:
 
     # ---- outputs ----------------------------------------------------------------------------
     @property
+    def outputs(self) -> dict[str, tuple[str, str]]:
+        """The result's channels after ``t``: name → (the machine's channel, unit), as the
+        scene names them (:attr:`winder.scene.Scene.naming`: machines.md §9, or the
+        single-drum format's names of winder-model §8)."""
+        return naming_of(self.scene).outputs(self.machine.channel_units)
+
+    @property
     def channel_units(self) -> dict[str, str]:
         """The unit of every channel :meth:`channels` returns, in its order: ``t`` [s],
-        then the machine's (:attr:`Machine.channel_units`), or a single-drum scene's
-        names of winder-model §8 (:data:`LEGACY_UNITS`)."""
-        if getattr(self.scene, "legacy", False):
-            return {"t": "s", **LEGACY_UNITS}
-        return {"t": "s", **self.machine.channel_units}
+        then each channel's declared unit (:attr:`outputs`)."""
+        return {TIME.name: TIME.unit, **{n: u for n, (_, u) in self.outputs.items()}}
 
     def channels(self, t: np.ndarray, Y: np.ndarray) -> dict[str, np.ndarray]:
         """All result channels at times ``t`` for states ``Y`` (``(n_states, len(t))``):
@@ -321,9 +293,7 @@ class MachineSystem:
                             AT_CORE if g[row[1]] >= 0.0 and g[row[2]] <= 0.0 else WINDING)
                 ev = self.evaluate_numeric(float(ti), Y[:, i], modes)
                 out[:, i] = [float(ev.channels.get(n, 0.0)) for n in names]
-        ch = {"t": t.copy()}
-        ch.update(zip(names, out, strict=True))
-        if getattr(self.scene, "legacy", False):
-            ch = {"t": ch["t"], **{old: ch.get(new, np.zeros(len(t)))
-                                   for old, new in LEGACY_CHANNELS.items()}}
-        return ch
+        ch = dict(zip(names, out, strict=True))
+        # a channel the machine lacks (an effect off) is zeros
+        return {"t": t.copy(), **{name: ch[c] if c in ch else np.zeros(len(t))
+                                  for name, (c, _) in self.outputs.items()}}
