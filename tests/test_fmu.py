@@ -241,6 +241,7 @@ def test_parts_interface(which, request) -> None:
     if which == "torque":
         assert "front_web_acceleration" not in params
         assert float(by["front_torque"].start) == 0.0
+        assert (by["front_torque"].unit, by["rear_torque"].unit) == ("N.m", "N.m")
     else:
         assert float(by["front_web_speed"].start) == 41.7
 
@@ -412,6 +413,9 @@ def test_line_interface(which, line_fmus, models_dir) -> None:
         assert float(by[name].start) == parameter_value(scene, place), name
     assert float(by["span_EA"].start) == 1.4e6 and float(by["span_length"].start) == 3.0
     (name,) = want
+    # each input's unit and description are its declaration's (winder.model.channels)
+    assert (by[name].unit, by[name].description) == (
+        ("N", "tension set-point [N]") if which == "small" else ("N.m", "drive torque [N·m]"))
     if which == "small":
         assert float(by["parent_bandwidth"].start) == 10.0
         assert float(by[name].start) == 1000.0
