@@ -40,10 +40,13 @@ def test_fmpy_validate_reports_no_problems(fmu_path) -> None:
 
 def test_interface(fmu_path, paper_scene) -> None:
     """The model description lists exactly the Stepper's inputs and outputs (plus the
-    profile reference) and the FMU parameters, with start values from the scene."""
+    profile reference) and the FMU parameters, with start values from the scene; the
+    input with its declared unit and description."""
     from winder.fmu.build import FMU_PARAMETERS
-    from winder.solve.stepper import INPUTS, OUTPUTS
+    from winder.scene.legacy import COLUMNS, SINGLE_DRUM
 
+    OUTPUTS = tuple(COLUMNS)  # the single-drum format's columns but t
+    INPUTS = tuple(SINGLE_DRUM.inputs({}))
     md = fmpy.read_model_description(str(fmu_path))
     by = {v.name: v for v in md.modelVariables}
     kinds: dict[str, set[str]] = {}
@@ -61,6 +64,11 @@ def test_interface(fmu_path, paper_scene) -> None:
     for name, (table, key, _) in FMU_PARAMETERS.items():
         assert float(by[name].start) == float(getattr(tables[table], key)), name
     assert by["speed_profile"].start in (True, "true")
+    torque = by["drum_torque_command"]
+    assert (torque.unit, torque.description) == ("N.m", "drive torque [N·m]")
+    assert by["web_speed_reference"].unit == "m/s"
+    assert by["speed_profile"].description == \
+        "true: drum follows the web-speed profile; false: driven by drum_torque_command"
 
 
 # pythonfmu 0.7's binary now and then corrupts the heap of a host that loads and unloads
@@ -233,6 +241,7 @@ def test_parts_interface(which, request) -> None:
     if which == "torque":
         assert "front_web_acceleration" not in params
         assert float(by["front_torque"].start) == 0.0
+        assert (by["front_torque"].unit, by["rear_torque"].unit) == ("N.m", "N.m")
     else:
         assert float(by["front_web_speed"].start) == 41.7
 
@@ -253,6 +262,36 @@ def test_parts_scene_with_parameters(torque_scene) -> None:
         scene_with_parameters(torque_scene, {"mu": 0.2})
     with pytest.raises(FmuError, match="single-drum scenes only"):
         scene_with_parameters(torque_scene, {}, speed_profile=True)
+
+
+def test_parameters_are_the_keys_declared_for_the_fmu(models_dir, monkeypatch) -> None:
+    """A scene of parts' FMU parameters are its parts' keys declared with ``Key.fmu``
+    (a drive's only for the kind that takes them), collected with no list per part kind:
+    a key newly declared for the FMU is a parameter with its unit and value at once."""
+    from dataclasses import replace
+
+    from winder._schema import Table
+    from winder.fmu.build import fmu_parameters, parameter_units, parameter_value
+    from winder.scene.schema import TABLES
+
+    scene = winder.load_scene(models_dir / "winder_line.toml")
+    names = set(fmu_parameters(scene))
+    assert {"front_web_acceleration", "set_width", "parent_bandwidth", "rider_nip_mu",
+            "span_EA"} <= names
+    assert not {"set_bandwidth", "web_tension", "rider_radius"} & names
+    keys = TABLES["roll[]"]
+    monkeypatch.setitem(TABLES, "roll[]", Table(tuple(
+        replace(k, fmu="core_mass") if k.name == "core_mass" else k for k in keys)))
+    params = fmu_parameters(scene)
+    assert set(params) == names | {"set_core_mass", "parent_core_mass"}
+    assert parameter_units(scene)["set_core_mass"] == "kg"
+    assert parameter_value(scene, params["set_core_mass"][0]) == scene.rolls[0].core_mass
+    hc = winder.load_scene(models_dir / "two_drum_winder.toml")
+    data = hc.to_dict()
+    data["nip"][0]["contact"]["law"] = "hunt_crossley"
+    units = parameter_units(winder.scene_from_dict(data))
+    assert (units["front_nip_contact_stiffness"], units["rear_nip_contact_stiffness"]) == \
+        ("N/m^p", "N/m")
 
 
 @pytest.mark.parametrize("which", ["two_drum_fmu", "torque_fmu"])
@@ -374,6 +413,9 @@ def test_line_interface(which, line_fmus, models_dir) -> None:
         assert float(by[name].start) == parameter_value(scene, place), name
     assert float(by["span_EA"].start) == 1.4e6 and float(by["span_length"].start) == 3.0
     (name,) = want
+    # each input's unit and description are its declaration's (winder.model.channels)
+    assert (by[name].unit, by[name].description) == (
+        ("N", "tension set-point [N]") if which == "small" else ("N.m", "drive torque [N·m]"))
     if which == "small":
         assert float(by["parent_bandwidth"].start) == 10.0
         assert float(by[name].start) == 1000.0

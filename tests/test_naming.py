@@ -10,8 +10,8 @@ import pytest
 
 import winder
 from winder._schema import Channel
-from winder.scene import SINGLE_DRUM, Naming, naming_of
-from winder.scene.legacy import COLUMNS
+from winder.scene import Naming, naming_of
+from winder.scene.legacy import COLUMNS, SINGLE_DRUM
 from winder.solve.system import MachineSystem
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -67,6 +67,10 @@ def test_scene_naming_and_single_drum_columns():
     assert paper.naming is SINGLE_DRUM and not paper.naming.by_parts
     assert type(parts.naming) is Naming and parts.naming.by_parts
     assert naming_of(object()).by_parts  # a plain scene object: by parts
+    # a result without its scene: the naming that reads one, and the bodies it draws
+    assert naming_of(None) == SINGLE_DRUM and not Naming.bodies_without_scene
+    assert dict(naming_of(None).bodies_without_scene) == {
+        "drum": ("angle", "speed"), "roll": ("z", "angle", "speed", "radius")}
     assert (*winder.CHANNELS, *winder.EXTRA_CHANNELS) == ("t", *COLUMNS)
     assert SINGLE_DRUM.output_name("roll_radius") == "radius"
     assert SINGLE_DRUM.output_name("nip_normal_force") == "normal_force"
@@ -81,10 +85,28 @@ def test_scene_naming_and_single_drum_columns():
     assert list(system.channel_units)[1:] == system.machine.channel_names
 
 
+#: Modules outside ``winder/scene`` that still name the single-drum format's names, each
+#: with the names it still uses. Another branch of #22 removes these (solve/, analysis/,
+#: cli.py, parts/roll.py): this allow-list only shrinks, and an entry that no longer
+#: violates fails the test, so the merge empties it.
+STILL_NAMING = {
+    "src/winder/cli.py": {"by_parts"},
+    "src/winder/analysis/modes.py": {"by_parts"},
+    "src/winder/parts/roll.py": {"initial_height"},
+    "src/winder/solve/system.py": {"CHANNELS", "EXTRA_CHANNELS"},
+    "src/winder/solve/stepper.py": {"CHANNELS", "EXTRA_CHANNELS"},
+}
+#: The package's public names of the single-drum columns (``winder.CHANNELS``, lazily from
+#: :mod:`winder.scene`): the one place outside the scene package that names them.
+PUBLIC = {"src/winder/__init__.py": {"CHANNELS", "EXTRA_CHANNELS"}}
+
+
 def test_only_the_scene_package_knows_the_single_drum_format():
     """Outside ``winder/scene`` no module reads ``scene.legacy``, imports
-    :mod:`winder.scene.legacy` or names a ``LEGACY_`` table: they ask the scene's naming
-    (a docstring may point to the module)."""
+    :mod:`winder.scene.legacy` or names a ``LEGACY_`` table, nor names the single-drum
+    format's naming, columns or keys (``SINGLE_DRUM``, ``CHANNELS``, ``EXTRA_CHANNELS``,
+    ``by_parts``, ``initial_height``): they ask the scene's naming (a docstring may point
+    to the module; an element's own ``CHANNELS`` declarations are no legacy names)."""
     import re
 
     files = [p for p in (ROOT / "src" / "winder").rglob("*.py") if "scene" not in p.parts]
@@ -94,3 +116,27 @@ def test_only_the_scene_package_knows_the_single_drum_format():
             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
             if pattern.search(line)]
     assert not hits
+    names = {
+        "SINGLE_DRUM": re.compile(r"\bSINGLE_DRUM\b"),
+        "EXTRA_CHANNELS": re.compile(r"\bEXTRA_CHANNELS\b"),
+        # the legacy tuple, not an element's ``CHANNELS`` (``self.CHANNELS``, a class body's
+        # ``CHANNELS = (...)``, ````CHANNELS```` in a docstring)
+        "CHANNELS": re.compile(r"(?<![\w.`])CHANNELS\b|\bwinder\.CHANNELS\b"),
+        "by_parts": re.compile(r"\bby_parts\b"),
+        "initial_height": re.compile(r"\binitial_height\b"),
+    }
+    declaration = re.compile(r"^\s+CHANNELS\s*(:[^=]*)?=")
+    assert names["CHANNELS"].search("from winder.scene import CHANNELS")
+    assert names["CHANNELS"].search("out = winder.CHANNELS[1:]")
+    assert not names["CHANNELS"].search("for ch in b.CHANNELS:")
+    assert declaration.match("    CHANNELS = (Channel(name=...),)")
+    found: dict[str, set[str]] = {}
+    for p in files:
+        for line in p.read_text(encoding="utf-8").splitlines():
+            for name, pat in names.items():
+                if pat.search(line) and not (name == "CHANNELS" and declaration.match(line)):
+                    found.setdefault(str(p.relative_to(ROOT)), set()).add(name)
+    for path, allowed in {**STILL_NAMING, **PUBLIC}.items():
+        assert found.get(path, set()) == allowed, \
+            f"{path}: names {sorted(found.get(path, set()))}, allow-list {sorted(allowed)}"
+    assert {p: n for p, n in found.items() if p not in {**STILL_NAMING, **PUBLIC}} == {}

@@ -208,6 +208,10 @@ def test_imports_point_down_the_layers_and_never_in_a_circle() -> None:
 
     assert upward(graph) == []
     assert cycle(graph) is None
+    # every module is in a layer (the package's entry points aside)
+    assert [m for m in mods if _rank(m, layers) is None
+            and m not in ("winder", "winder.__main__")] == []
+    assert _rank("winder._schema", layers) == _rank("winder._args", layers)
     # the oracle sees what it must: an upward import, a sibling import and a cycle
     planted = {**graph, "winder.io.files": graph["winder.io.files"] | {"winder.solve.simulate"},
                "winder.viewer._motion": graph["winder.viewer._motion"] | {"winder.fmu.build"}}
@@ -228,3 +232,22 @@ def test_no_module_is_over_600_lines() -> None:
     assert len(sizes) > 60 and sizes["src/winder/solve/simulate.py"] > 100
     over = {p: n for p, n in sizes.items() if n > MAX_LINES}
     assert over == {}
+
+
+def test_no_lower_module_imports_the_package_root() -> None:
+    """No module of a layer (``src/winder/*/``) nor of ``viewer/`` imports ``winder``
+    itself (``from winder import X``, ``import winder``): the root re-exports every layer,
+    so such an import points up past every layer and neither import-linter nor the scan
+    above sees through it."""
+    import re
+
+    pattern = re.compile(r"^\s*(from\s+winder\s+import\b|import\s+winder\s*(#.*)?$)")
+    assert pattern.match("    from winder import simulate") and pattern.match("import winder")
+    assert not pattern.match("from winder.scene import Scene")
+    files = [*(p for p in (ROOT / "src" / "winder").rglob("*.py")
+               if p.parent != ROOT / "src" / "winder"), *(ROOT / "viewer").glob("*.py")]
+    assert len(files) > 50
+    hits = [f"{p.relative_to(ROOT)}:{i}" for p in files
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+            if pattern.match(line)]
+    assert hits == []

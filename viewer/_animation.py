@@ -16,7 +16,13 @@ from dataclasses import dataclass
 import meshcat
 import numpy as np
 from meshcat.animation import Animation
-from winder.viewer._motion import Motion, body_channels, check_drawable, motion, scene_of
+from winder.viewer._motion import (
+    Motion,
+    check_drawable,
+    motion,
+    scene_of,
+    speed_channels,
+)
 from winder.viewer._readout import readout_text
 from winder.viewer._scene_graph import WinderGraph, apply_poses
 
@@ -55,13 +61,7 @@ def plan_animation(result: Result, *, playback: float = 30.0, fps: int = 30,
     n = max(2, int(round(playback * fps)) + 1)
     times = np.linspace(t[0], t[-1], n)
     compression = (t[-1] - t[0]) / playback
-    scene = scene_of(result, scene)
-    if scene is None:
-        speeds = ["roll_speed", "drum_speed"]
-    else:
-        from winder.model.machine import Machine
-
-        speeds = [body_channels(scene, b)["speed"] for b in Machine(scene).bodies]
+    speeds = speed_channels(scene_of(result, scene))
     w_max = max(max(float(np.max(np.abs(result[c]))) for c in speeds if c in result), 1e-9)
     gain = min(1.0, 2 * math.pi * max_turns_per_second / (w_max * compression))
     return AnimationPlan(times, fps, gain)

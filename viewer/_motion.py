@@ -5,10 +5,10 @@ the unwinding roll's exit point ``p_u`` along the span (machines spec §5).
 
 A scene of parts (machines spec §9) names its channels per body (``NAME_angle``,
 ``NAME_speed``, ``NAME_x``/``NAME_z`` where free, ``NAME_radius`` for a paper roll) and
-per nip (``NIP_normal_force``); a scene in the old single-drum format keeps the names of
-winder-model §8 (``drum_angle``, ``drum_speed``, ``z``, ``roll_angle``, ``roll_speed``,
-``radius``, ``normal_force``). The model's rotation about ``+y`` of a body is
-``θ = sense · angle`` (spec §1).
+per nip (``NIP_normal_force``); the viewer asks the scene's naming for them
+(:attr:`winder.scene.Scene.naming`), and for a result without its scene the naming that
+reads one (:func:`winder.scene.naming_of` ``(None)``, with the bodies it draws). The
+model's rotation about ``+y`` of a body is ``θ = sense · angle`` (spec §1).
 """
 
 from __future__ import annotations
@@ -25,10 +25,11 @@ from winder.forces.web_tension import exit_point
 from winder.io.result import Result
 from winder.model.machine import Machine, Web
 from winder.parts import BodyElement as Body
-from winder.scene import SINGLE_DRUM, Naming
+from winder.scene import Naming, naming_of
 from winder.scene.load import Scene
 
 __all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
+           "speed_channels",
            "check_drawable", "scene_of", "motion", "WebMotion", "web_path", "span_web_path",
            "exit_points",
            "WEB_LEAD", "WEB_ARC_POINTS"]
@@ -43,7 +44,7 @@ WEB_MEET = math.radians(15.0)
 
 def scene_of(result: Result, scene: Scene | None = None) -> Scene | None:
     """``scene``, else the scene stored in ``result.meta["scene_dict"]``, else ``None``
-    (the result is then read with the single-drum channel names)."""
+    (the result is then read with :func:`~winder.scene.naming_of` ``(None)``'s names)."""
     if scene is not None:
         return scene
     stored = result.meta.get("scene_dict")
@@ -55,8 +56,16 @@ def scene_of(result: Result, scene: Scene | None = None) -> Scene | None:
 
 
 def _naming(scene: Scene | None) -> Naming:
-    # a result without its scene is read with the single-drum format's names
-    return SINGLE_DRUM if scene is None else scene.naming
+    # a result without its scene is read with the names of the naming that reads one
+    return naming_of(scene)
+
+
+def _without_scene() -> dict[str, dict[str, str]]:
+    """The channels of a result without its scene: body → role → channel
+    (:attr:`Naming.bodies_without_scene <winder.scene.Naming.bodies_without_scene>`)."""
+    naming = naming_of(None)
+    return {body: {role: naming.output_name(f"{body}_{role}") for role in roles}
+            for body, roles in naming.bodies_without_scene.items()}
 
 
 def body_channels(scene: Scene | None, body: Body) -> dict[str, str]:
@@ -78,6 +87,15 @@ def _optional(scene: Scene | None, role: str, body: Body) -> bool:
     return body_channels(scene, body)[role] in _naming(scene).optional
 
 
+def speed_channels(scene: Scene | None) -> list[str]:
+    """The speed channel of every body [rad/s], as the scene names it; for a result
+    without its scene (``None``) those of :func:`~winder.scene.naming_of` ``(None)``'s
+    bodies."""
+    if scene is None:
+        return [roles["speed"] for roles in _without_scene().values() if "speed" in roles]
+    return [body_channels(scene, b)["speed"] for b in Machine(scene).bodies]
+
+
 def drawn_channels(scene: Scene | None, machine: Machine) -> list[str]:
     """Channels the viewer needs (optional ones and nip forces excluded)."""
     return [ch for b in machine.bodies for role, ch in body_channels(scene, b).items()
@@ -89,20 +107,19 @@ def check_drawable(result: Result, where: str = "result", scene: Scene | None = 
     """Raise :class:`~winder.WinderError` (prefixed by ``where``, e.g. the file) unless
     ``result`` can be drawn: at least two samples on an increasing, finite time axis, the
     channels of :func:`drawn_channels` present and finite, and every roll radius > 0.
-    ``scene`` defaults to the one stored in the result; without one the single-drum
-    channel names are checked."""
+    ``scene`` defaults to the one stored in the result; without one the channels of
+    :func:`~winder.scene.naming_of` ``(None)``'s bodies are checked."""
     t = np.asarray(result.t, dtype=float)
     if len(t) < 2:
         raise WinderError(f"{where}: {len(t)} sample(s); the viewer needs at least 2")
     if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise WinderError(f"{where}: the time axis is not finite and increasing")
     scene = scene_of(result, scene)
-    if scene is None:  # the single-drum format's drum and roll
-        required = [c for c in (SINGLE_DRUM.output_name(f"{body}_{role}") for body, roles in
-                                (("drum", ("angle", "speed")),
-                                 ("roll", ("z", "angle", "speed", "radius")))
-                                for role in roles) if c not in SINGLE_DRUM.optional]
-        radii = [SINGLE_DRUM.output_name("roll_radius")]
+    if scene is None:  # the bodies of the naming that reads a result without its scene
+        bodies = _without_scene()
+        required = [c for roles in bodies.values() for c in roles.values()
+                    if c not in _naming(None).optional]
+        radii = [roles["radius"] for roles in bodies.values() if "radius" in roles]
     else:
         m = Machine(scene)
         required = drawn_channels(scene, m)

@@ -16,7 +16,12 @@ from types import SimpleNamespace
 
 from winder.viewer._motion import Motion
 
-__all__ = ["readout_text", "with_readout", "unit_of", "DEFAULT_UNITS", "READOUT_ID"]
+from winder.forces import FORCES
+from winder.model.channels import GENERIC_CHANNELS, WEB_SPEED
+from winder.parts import PARTS
+
+__all__ = ["readout_text", "with_readout", "unit_of", "DEFAULT_UNITS", "SURFACE_SPEED_UNIT",
+           "READOUT_ID"]
 
 READOUT_ID = "winder-readout"
 
@@ -26,10 +31,20 @@ _STYLE = (f"#{READOUT_ID} {{position: fixed; left: 10px; top: 10px; margin: 0; "
           "pointer-events: none; z-index: 10;}}")
 
 
-#: The readout's units where the result carries none (an old NPZ, a CSV): SI, as the
-#: channels are.
-DEFAULT_UNITS = {"t": "s", "radius": "m", "speed": "rad/s", "normal_force": "N",
-                 "span_tension": "N"}
+def _declared_units() -> dict[str, str]:
+    """Each channel's declared unit by its name after the part (``speed`` of
+    ``BODY_speed``): the generic channels, the body elements' and the effects'."""
+    declared = (*GENERIC_CHANNELS, *(c for cls in PARTS.values() for c in cls.CHANNELS),
+                *(c for cls in FORCES.values() for c in cls.CHANNELS))
+    return {c.suffix: c.unit for c in declared}
+
+
+#: The readout's units where the result carries none (an old NPZ, a CSV): the channels'
+#: declared units (:class:`winder._schema.Channel`), SI.
+DEFAULT_UNITS = {q: unit for q, unit in _declared_units().items()
+                 if q in ("t", "radius", "speed", "normal_force", "span_tension")}
+#: The unit of a body's surface speed ``ω r``: a web speed's.
+SURFACE_SPEED_UNIT = WEB_SPEED.unit
 
 
 def unit_of(m: Motion, quantity: str, name: str = "") -> str:
@@ -45,9 +60,10 @@ def unit_of(m: Motion, quantity: str, name: str = "") -> str:
 
 def readout_text(m: Motion, k: int) -> str:
     """The readout of sample ``k`` of ``m``: ``t``; per paper roll its radius; per body
-    its speed and surface speed [m/s]; per nip its normal force (in thousands: kN); on a
-    winder line the span's tension ``span  T … N`` (``-`` without its channel). The units
-    are the result's (:func:`unit_of`): [s], [m], [rad/s], [N] for a result of winder."""
+    its speed and surface speed (:data:`SURFACE_SPEED_UNIT`); per nip its normal force
+    (in thousands: kN); on a winder line the span's tension ``span  T … N`` (``-``
+    without its channel). The units are the result's (:func:`unit_of`): [s], [m],
+    [rad/s], [N] for a result of winder."""
     lines = [f"t  {m.times[k]:10.2f} {unit_of(m, 't')}"]
     spans = [w for w in m.webs if w.unwind is not None] or (
         [SimpleNamespace(name="", span_tension=m.span_tension)] if m.unwind is not None else [])
@@ -60,7 +76,7 @@ def readout_text(m: Motion, k: int) -> str:
     for b in m.bodies.values():
         w = b.speed[k]
         lines.append(f"{b.name:<{width}}  {w:8.2f} {unit_of(m, 'speed', b.name)} "
-                     f"{w * b.radius[k]:7.2f} m/s")
+                     f"{w * b.radius[k]:7.2f} {SURFACE_SPEED_UNIT}")
     for name, f in m.normal_forces.items():
         value = "      -" if f is None else f"{f[k] / 1e3:8.3f}"
         lines.append(f"{name:<{width}}  N {value} k{unit_of(m, 'normal_force', name)}")

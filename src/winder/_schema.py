@@ -86,6 +86,15 @@ class Key:
     valid:
         The reference's "range" column for a key whose validity is not a range of numbers
         (``1–200 printable characters``); None: from the bounds or the items.
+    fmu:
+        The FMU parameter this number is, by its name after its part's (``contact_stiffness``
+        of a nip ``front`` is the FMU parameter ``front_contact_stiffness``; a key of a
+        single table, ``web_tension``, is named as given); ``""``: not an FMU parameter.
+        :mod:`winder.fmu.build` collects these from every part's keys.
+    law_units:
+        Units of the number that depend on a sibling key ``law``: ``(("hunt_crossley",
+        "N/m^p"),)`` is the unit under that law (a Hunt–Crossley stiffness); the unit is
+        :attr:`unit` under any other.
     """
 
     name: str
@@ -102,6 +111,8 @@ class Key:
     doc_unit: str | None = None
     items: tuple[Key, ...] = ()
     valid: str | None = None
+    fmu: str = ""
+    law_units: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:

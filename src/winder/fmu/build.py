@@ -15,23 +15,27 @@ Interface of a single-drum scene (the old format)
   by the input ``drum_torque_command``.
 - input ``drum_torque_command`` [N·m] (named apart from the output channel
   ``drum_torque``, which reports the torque acting in either mode).
-- outputs: every result channel (:data:`winder.solve.stepper.OUTPUTS`) and
+- outputs: every result channel (the scene's naming's columns but ``t``) and
   ``web_speed_reference`` = ``min(a_w t, v_w)`` [m/s], the profile a speed controller
   follows.
 
 Interface of a machine from parts
 ---------------------------------
-- parameters (:func:`fmu_parameters`), named by part: per drum ``DRUM_web_speed`` (and
-  ``DRUM_web_acceleration`` for a speed profile), per roll ``ROLL_com_offset``,
-  ``ROLL_width``, ``ROLL_density``, ``ROLL_caliper``, per nip ``NIP_contact_stiffness``,
-  ``NIP_contact_damping``, ``NIP_mu``, ``NIP_slip_reference_velocity``,
-  ``NIP_relaxation_length``, and ``web_tension``; the drives are the scene's.
+- parameters (:func:`fmu_parameters`): every part's keys declared as FMU parameters
+  (:attr:`Key.fmu <winder._schema.Key.fmu>`, in the part's ``KEYS``; a drive's only for
+  the drive kind that takes them), named by part, in the parts' order: per drum
+  ``DRUM_web_speed`` (and ``DRUM_web_acceleration`` for a speed profile), per roll
+  ``ROLL_width``, ``ROLL_com_offset``, ``ROLL_density``, ``ROLL_caliper`` (and
+  ``ROLL_bandwidth`` for a tension-controlled unwinding roll), per nip
+  ``NIP_contact_stiffness``, ``NIP_contact_damping``, ``NIP_mu``,
+  ``NIP_slip_reference_velocity``, ``NIP_relaxation_length``, and ``web_tension``; the
+  drives are the scene's.
   A winder line (``[web.span]``, machines.md §5) has ``span_length``, ``span_EA`` and
-  ``span_T_in`` instead of ``web_tension`` (the tension is the span's state), and
-  ``ROLL_bandwidth`` for a tension-controlled unwinding roll.
+  ``span_T_in`` instead of ``web_tension`` (the tension is the span's state).
 - inputs: the :class:`~winder.Stepper`'s, ``DRUM_torque`` [N·m] per torque-driven drum
   or unwinding roll (``parent_torque``), ``ROLL_tension_setpoint`` [N] of a
-  tension-controlled unwind (none when every drum follows a speed profile).
+  tension-controlled unwind (none when every drum follows a speed profile); units and
+  descriptions from their declarations (:data:`winder.model.channels.INPUTS`).
 - outputs: the Stepper's outputs (machines.md §9 channels) but the ``DRUM_torque``
   channel of a torque-driven drum, which is its input (same name, same value); with an
   unwinding roll also ``t`` [s], the time of the outputs.
@@ -49,10 +53,11 @@ from pathlib import Path
 from typing import Any
 
 from winder._errors import WinderError
-from winder.parts import body_elements
-from winder.scene import SINGLE_DRUM
-from winder.scene.keys import find_key, key_unit
+from winder._schema import Key
+from winder.scene import naming_of
+from winder.scene.keys import find_key
 from winder.scene.load import Scene, load_scene
+from winder.scene.schema import ARRAYS, TABLES
 
 __all__ = ["build_fmu", "FMU_PARAMETERS", "fmu_parameters", "parameter_units",
            "parameter_value", "scene_with_parameters", "FmuError"]
@@ -64,11 +69,13 @@ def _text(table: str, key: str, unit: str | None = None) -> str:
     return f"{k.doc} [{k.unit if unit is None else unit}]"
 
 
-#: FMU parameter name → (scene table, key, description with unit) of a single-drum scene
-#: (its naming's own FMU interface); the description and unit are the key's declaration.
+#: FMU parameter name → (scene table, key, description with unit) of a scene with its own
+#: FMU interface (:attr:`winder.scene.naming.Naming.fmu`: the single-drum format's, the
+#: naming a result without its scene is read with); the description and unit are the
+#: key's declaration.
 FMU_PARAMETERS: dict[str, tuple[str, str, str]] = {
     name: (table, key, _text(table, key))
-    for name, (table, key) in SINGLE_DRUM.fmu.parameters.items()}  # type: ignore[union-attr]
+    for name, (table, key) in naming_of(None).fmu.parameters.items()}  # type: ignore[union-attr]
 
 # pythonfmu's binary finds the class by the pattern ``class X(Fmi2Slave):`` in this file,
 # hence the alias.
@@ -87,79 +94,84 @@ class FmuError(WinderError):
     """The FMU could not be built or does not run in this Python."""
 
 
-#: Parameters of a machine from parts, per part kind: FMU name suffix → key path in
-#: the part's table (its declaration gives the description and unit).
-_PART_PARAMETERS: dict[str, dict[str, tuple[str, ...]]] = {
-    "roll": {"com_offset": ("com_offset",), "width": ("width",), "density": ("density",),
-             "caliper": ("caliper",)},
-    "nip": {"contact_stiffness": ("contact", "stiffness"),
-            "contact_damping": ("contact", "damping"), "mu": ("friction", "mu"),
-            "slip_reference_velocity": ("friction", "slip_velocity"),
-            "relaxation_length": ("friction", "relaxation_length")},
-}
-
 #: A parameter's place in the scene: the table, the element name for an array of tables
 #: (None for a single table) and the key path below it.
 ParameterPath = tuple[str, "str | None", tuple[str, ...]]
 
 
-def _schema_key(place: ParameterPath) -> tuple[str, str]:
-    """``(schema table, key)`` of a parameter's place: ``("nip", "rear", ("contact",
-    "stiffness"))`` is ``("nip[].contact", "stiffness")``."""
-    table, element, path = place
-    head = table + ("[]" if element is not None else "")
-    return ".".join((head, *path[:-1])), path[-1]
+def _elements(scene: Scene, table: str) -> Any:
+    """The parts of the scene's array of tables ``table`` (:data:`~winder.scene.schema.ARRAYS`:
+    the scene's field ``TABLEs``)."""
+    return getattr(scene, f"{table}s")
 
 
-def _parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
-    """FMU name → (place in the scene, what it is for, before the key's meaning)."""
-    out: dict[str, tuple[ParameterPath, str]] = {}
+def _flagged(schema: str, obj: Any) -> list[tuple[tuple[str, ...], Key, str]]:
+    """``(key path, declaration, unit)`` of every FMU parameter of the schema table
+    ``schema`` (``roll[]``, ``nip[].contact``) whose values are ``obj``: its numbers
+    declared with :attr:`Key.fmu <winder._schema.Key.fmu>` that its ``kind`` takes (a
+    drive's), then those of its sub-tables that ``obj`` has, recursively. The unit is the
+    key's, or its unit under ``obj``'s ``law`` (:attr:`~winder._schema.Key.law_units`)."""
+    table = TABLES[schema]
+    takes = table.kinds.get(getattr(obj, "kind", None)) if table.kinds else None
+    out: list[tuple[tuple[str, ...], Key, str]] = []
+    for k in table:
+        if takes is not None and k.name not in takes:
+            continue
+        if k.fmu:
+            out.append(((k.name,), k, dict(k.law_units).get(getattr(obj, "law", None),
+                                                           k.unit)))
+        elif k.kind == "table" and f"{schema}.{k.name}" in TABLES and \
+                getattr(obj, k.name, None) is not None:
+            out += [((k.name, *path), key, unit) for path, key, unit in
+                    _flagged(f"{schema}.{k.name}", getattr(obj, k.name))]
+    return out
+
+
+def _parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str, str]]:
+    """FMU name → (place in the scene, description with unit, unit): the scene's own
+    interface's (:attr:`Naming.fmu <winder.scene.naming.Naming.fmu>`), else every part's
+    keys declared as FMU parameters (:attr:`Key.fmu <winder._schema.Key.fmu>`), named
+    ``PART_NAME`` (``front_nip_mu``), and the web's (the FMU's one web: its span's,
+    which hold the tension as a state, or else its own)."""
+    out: dict[str, tuple[ParameterPath, str, str]] = {}
     own = scene.naming.fmu
     if own is not None:  # the scene's own interface (the single-drum format's)
+        data = scene.to_dict()
         for name, (table, key) in own.parameters.items():
             top, *sub = table.split(".")
-            out[name] = ((top, None, (*sub, key)), "")
+            place: ParameterPath = (top, None, (*sub, key))
+            k = find_key(table, key)
+            unit = dict(k.law_units).get(data.get(top, {}).get("law"), k.unit) \
+                if not sub else k.unit
+            out[name] = (place, f"{k.doc} [{unit}]", unit)
         return out
-    bodies = {b.name: b for b in body_elements(scene)}
-    for drum in scene.drums:
-        if bodies[drum.name].prescribed:  # on its speed profile
-            out[f"{drum.name}_web_acceleration"] = (
-                ("drum", drum.name, ("drive", "web_acceleration")), f"drum {drum.name}: ")
-        out[f"{drum.name}_web_speed"] = (("drum", drum.name, ("drive", "web_speed")),
-                                         f"drum {drum.name}: ")
-    for kind, parts in (("roll", scene.rolls), ("nip", scene.nips)):
-        for part in parts:
-            for suffix, path in _PART_PARAMETERS[kind].items():
-                out[f"{part.name}_{suffix}"] = ((kind, part.name, path), f"{kind} {part.name}: ")
-    for roll in scene.rolls:
-        if bodies[roll.name].setpoint_inputs:  # a tension controller's set-point
-            out[f"{roll.name}_bandwidth"] = (("roll", roll.name, ("drive", "bandwidth")),
-                                             f"roll {roll.name}: ")
-    span = scene.web.span if scene.web is not None else None
-    if span is not None:  # the tension is the span's state (no web_tension)
-        for key in ("length", "EA", "T_in"):
-            out[f"span_{key}"] = (("web", None, ("span", key)), "web span: ")
-    elif scene.web is not None:
-        out["web_tension"] = (("web", None, ("tension",)), "")
+    for table in ARRAYS:
+        for part in _elements(scene, table):
+            for path, k, unit in _flagged(f"{table}[]", part):
+                out[f"{part.name}_{k.fmu}"] = ((table, part.name, path),
+                                               f"{table} {part.name}: {k.doc} [{unit}]", unit)
+    web = scene.web
+    if web is not None:
+        sub = ("span",) if web.span is not None else ()
+        for path, k, unit in _flagged(".".join(("web", *sub)),
+                                      web.span if sub else web):
+            who = " ".join(("web", *sub)) + ": " if sub else ""
+            out[k.fmu] = (("web", None, (*sub, *path)), f"{who}{k.doc} [{unit}]", unit)
     return out
 
 
 def fmu_parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str]]:
-    """The FMU parameters of ``scene`` (besides ``rtol`` and, single-drum only,
-    ``speed_profile``): FMU name → (place in the scene, description with unit, from the
-    scene key's declaration)."""
-    units = parameter_units(scene)
-    return {name: (place, who + _text(*_schema_key(place), units[name]))
-            for name, (place, who) in _parameters(scene).items()}
+    """The FMU parameters of ``scene`` (besides ``rtol`` and, with the scene's own
+    interface, its profile switch ``speed_profile``): FMU name → (place in the scene,
+    description with unit, from the scene key's declaration)."""
+    return {name: (place, text) for name, (place, text, _) in _parameters(scene).items()}
 
 
 def parameter_units(scene: Scene) -> dict[str, str]:
     """The unit of each FMU parameter of ``scene`` (:func:`fmu_parameters`): its scene
-    key's (:func:`winder.scene.key_unit`: as declared; ``N/m^p`` for a Hunt–Crossley
-    nip's stiffness; ``"-"``: dimensionless)."""
-    data = scene.to_dict()
-    return {name: key_unit(".".join(p for p in (place[0], place[1], *place[2]) if p), data)
-            for name, (place, _) in _parameters(scene).items()}
+    key's as declared (its unit under the nip's law where it has one: ``N/m^p`` for a
+    Hunt–Crossley stiffness; ``"-"``: dimensionless)."""
+    return {name: unit for name, (_, _, unit) in _parameters(scene).items()}
 
 
 def parameter_value(scene: Scene, place: ParameterPath) -> float:
@@ -168,7 +180,7 @@ def parameter_value(scene: Scene, place: ParameterPath) -> float:
     if element is None:
         obj: Any = getattr(scene, table)
     else:
-        obj = next(p for p in getattr(scene, f"{table}s") if p.name == element)
+        obj = next(p for p in _elements(scene, table) if p.name == element)
     for key in path:
         obj = getattr(obj, key)
     return float(obj)
@@ -195,8 +207,7 @@ def scene_with_parameters(scene: Scene, values: dict[str, float], *,
             node = node.setdefault(key, {})
         node[path[-1]] = float(value)
     if own is not None:
-        scene.naming.drive_changes(scene, changes.setdefault("drum", {}).setdefault(
-            "drive", {}), bool(speed_profile))
+        scene.naming.drive_changes(scene, changes, bool(speed_profile))
     return scene.replace(**changes)
 
 

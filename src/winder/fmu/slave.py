@@ -1,4 +1,5 @@
-"""The pythonfmu slave behind ``winder fmu`` (imported inside the FMU; see :mod:`._fmu`)."""
+"""The pythonfmu slave behind ``winder fmu`` (imported inside the FMU; its interface:
+:mod:`winder.fmu.build`)."""
 
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from winder.fmu.build import (
     scene_with_parameters,
 )
 from winder.fmu.units import UnitReal, with_unit_definitions
+from winder.model.channels import input_of
 from winder.model.units import DIMENSIONS
 from winder.parts import body_elements
 from winder.scene.load import load_scene
@@ -65,8 +67,7 @@ class WinderSlave(Fmi2Slave):
             self.register_variable(Boolean(
                 own.profile_switch, causality=Fmi2Causality.parameter,
                 variability=Fmi2Variability.fixed,
-                description="true: drum follows the web-speed profile; false: driven by "
-                            + ", ".join(own.inputs)))
+                description=f"{own.switch_doc} {', '.join(own.inputs)}"))
         self.rtol = 1e-8
         self.register_variable(Real("rtol", causality=Fmi2Causality.parameter,
                                     variability=Fmi2Variability.fixed,
@@ -84,14 +85,15 @@ class WinderSlave(Fmi2Slave):
             start = 0.0 if own is not None else float(
                 st.system.params[st.system.machine.param_index(st.inputs[stepper_name])])
             setattr(self, name, start)
-            self.register_variable(Real(name, causality=Fmi2Causality.input,
-                                        variability=Fmi2Variability.continuous,
-                                        description=("tension set-point [N]"
-                                                     if name.endswith("_setpoint")
-                                                     else "drive torque [N m]")))
-        reference = () if own is None else (own.profile_reference,)  # the profile [m/s]
+            decl = input_of(st.inputs[stepper_name])  # its declaration, with its unit
+            self.register_variable(UnitReal(name, causality=Fmi2Causality.input,
+                                            variability=Fmi2Variability.continuous,
+                                            description=f"{decl.doc} [{decl.unit}]",
+                                            unit=decl.unit))
+        # the profile min(a_w t, v_w), in the unit of its web speed parameter
+        reference = {} if own is None else {own.profile_reference: units[own.speed]}
         self._outputs = (*(k for k in st.output_names if k not in self._inputs), *reference)
-        units = {**st.system.channel_units, **dict.fromkeys(reference, "m/s")}
+        units = {**st.system.channel_units, **reference}
         for name in self._outputs:
             self.register_variable(UnitReal(name, causality=Fmi2Causality.output,
                                             variability=Fmi2Variability.continuous,

@@ -1,14 +1,16 @@
 """The generic result channels of a machine (machines.md §9), declared once: time, every
 body's rotation and free coordinates, every nip's forces, every web's speed. A part's
 own channels are on its body element (``CHANNELS``: a paper roll's radius, mass, ...),
-an effect's on its force element (``CHANNELS``)."""
+an effect's on its force element (``CHANNELS``). The run-time inputs a body takes
+(:attr:`~winder.parts.BodyElement.torque_inputs`, ``setpoint_inputs``) are declared here
+too, with their units (:data:`INPUTS`): the FMU's inputs carry them."""
 
 from __future__ import annotations
 
 from winder._schema import Channel
 
 __all__ = ["TIME", "BODY_CHANNELS", "COORD_CHANNELS", "NIP_CHANNELS", "WEB_SPEED",
-           "GENERIC_CHANNELS"]
+           "GENERIC_CHANNELS", "TORQUE_INPUT", "SETPOINT_INPUT", "INPUTS", "input_of"]
 
 #: The first column of every result.
 TIME = Channel(name="t", unit="s", doc="time")
@@ -52,3 +54,22 @@ WEB_SPEED = Channel(name="web_speed", unit="m/s",
 #: The generic channels, in the reference's order.
 GENERIC_CHANNELS = (TIME, *BODY_CHANNELS, *COORD_CHANNELS["x"], *COORD_CHANNELS["z"],
                     *NIP_CHANNELS, WEB_SPEED)
+
+#: A torque-driven body's drive torque, the run-time parameter ``BODY.torque``
+#: (:attr:`~winder.parts.BodyElement.torque_inputs`; the FMU input ``BODY_torque``).
+TORQUE_INPUT = Channel(name="BODY_torque", unit="N·m", doc="drive torque")
+#: A tension-controlled unwind's set-point, the run-time parameter
+#: ``ROLL.tension_setpoint`` (:attr:`~winder.parts.BodyElement.setpoint_inputs`).
+SETPOINT_INPUT = Channel(name="ROLL_tension_setpoint", unit="N", doc="tension set-point")
+#: Every kind of run-time input, by the run-time parameter's name after the body's.
+INPUTS = (TORQUE_INPUT, SETPOINT_INPUT)
+
+
+def input_of(parameter: str) -> Channel:
+    """The declaration of the run-time input ``parameter`` (``front.torque``:
+    :data:`TORQUE_INPUT`); KeyError for a parameter that is no input."""
+    suffix = parameter.rpartition(".")[2]
+    for decl in INPUTS:
+        if decl.suffix == suffix:
+            return decl
+    raise KeyError(parameter)

@@ -7,7 +7,8 @@ generated as C, wrapped with flat entry points ``int NAME(const double* t, const
 x, const double* p, const double* m, double* out)`` and compiled with the system C
 compiler. The cache key is everything that changes the generated code: the machine's
 structure (:meth:`~winder.model.machine.Machine.structure_key`), the source of the physics
-(:mod:`winder.core`, :mod:`winder.forces`, the mass law), the CasADi version and the compiler flags.
+(:mod:`winder.model`, :mod:`winder.parts`, :mod:`winder.forces`), the CasADi version and
+the compiler flags.
 Writes are atomic (a temporary file, then ``os.replace``), so processes building the same
 model at once all succeed. Parameter values are run-time inputs: changing one compiles
 nothing.

@@ -1,10 +1,11 @@
 """Math namespaces: the same force and mass-law code runs on floats and on CasADi symbols.
 
-Every piece of physics in :mod:`winder.forces` and :mod:`winder.core` is written once over
-a namespace ``mathns`` with the functions below; :data:`NUMERIC` evaluates it on floats (the
-numeric Pinocchio path), :data:`SYMBOLIC` builds CasADi ``SX`` expressions (the generated
-code). Branches on states must go through ``mathns.if_else`` / ``mathns.fmax`` so that the
-generated code stays branch-free.
+Every piece of physics in :mod:`winder.forces`, :mod:`winder.parts` and :mod:`winder.model`
+(the machine, the mass law) is written once over a namespace ``mathns`` with the functions
+below; :data:`NUMERIC` evaluates it on floats (the numeric Pinocchio path),
+:data:`SYMBOLIC` builds CasADi ``SX`` expressions (the generated code). Branches on
+states must go through ``mathns.if_else`` / ``mathns.fmax`` so that the generated code
+stays branch-free.
 """
 
 from __future__ import annotations

@@ -45,9 +45,9 @@ DRIVE_KEYS = Table((
     Key(name="kind", kind="str", required=True, choices=DRIVE_KINDS,
         doc="speed_profile: the drum's speed is prescribed, its torque follows from inverse "
             "dynamics; torque: the drum is free and driven by an input torque"),
-    Key(name="web_acceleration", unit="m/s²", lo=0.0, hi=1e3,
+    Key(name="web_acceleration", unit="m/s²", fmu="web_acceleration", lo=0.0, hi=1e3,
         doc="ramp of the surface (web) speed a_w; 0: full speed from t = 0"),
-    Key(name="web_speed", unit="m/s", lo=0.0, hi=1e3,
+    Key(name="web_speed", unit="m/s", lo=0.0, hi=1e3, fmu="web_speed",
         default_text="required (kind speed_profile); 0 (kind torque)",
         doc="speed_profile: the surface speed v_w the ramp reaches; torque: the initial "
             "surface speed"),

@@ -30,8 +30,10 @@ CONTACT_KEYS = Table((
     Key(name="law", kind="str", choices=CONTACT_LAWS,
         doc="linear: F_n = max(0, k δ + c δ̇); hunt_crossley: F_n = max(0, k δ^p (1 + α δ̇))"),
     Key(name="stiffness", unit="N/m", doc_unit="N/m (N/m^p)", lo=0.0, lo_open=True, hi=1e18,
+        fmu="contact_stiffness", law_units=(("hunt_crossley", "N/m^p"),),
         doc="stiffness k of the nip"),
-    Key(name="damping", unit="N·s/m", lo=0.0, hi=1e12, doc="damping c of the linear law"),
+    Key(name="damping", unit="N·s/m", lo=0.0, hi=1e12, fmu="contact_damping",
+        doc="damping c of the linear law"),
     Key(name="exponent", unit="-", lo=1.0, hi=3.0, doc="exponent p of the Hunt–Crossley law"),
     Key(name="hc_damping", unit="s/m", lo=0.0, hi=1e4,
         doc="damping α of the Hunt–Crossley law"),
@@ -39,11 +41,13 @@ CONTACT_KEYS = Table((
 
 #: The keys of a nip's friction law (and of the single-drum format's ``[friction]``).
 FRICTION_KEYS = Table((
-    Key(name="mu", unit="-", lo=0.0, hi=10.0,
+    Key(name="mu", unit="-", lo=0.0, hi=10.0, fmu="mu",
         doc="friction coefficient μ: F_ss = μ F_n tanh(v_s / v_ref)"),
     Key(name="slip_velocity", unit="m/s", lo=0.0, lo_open=True, hi=1e3,
+        fmu="slip_reference_velocity",
         doc="slip velocity scale v_ref of the tanh law"),
     Key(name="relaxation_length", unit="m", lo=0.0, lo_open=True, hi=1e3,
+        fmu="relaxation_length",
         doc="relaxation length σ: dF_t/dt = (|u_a| + v_min)/σ (F_ss − F_t)"),
     Key(name="min_speed", unit="m/s", lo=0.0, lo_open=True, hi=1e3,
         doc="speed v_min added in the relaxation rate (keeps it finite at standstill)"),

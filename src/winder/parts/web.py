@@ -18,7 +18,7 @@ KEYS = Table((
     Key(name="entry_nip", kind="ref", required=True,
         doc="the nip where the web enters the wound roll (a: the drum it wraps, b: the "
             "roll)"),
-    Key(name="tension", unit="N", lo=0.0, hi=1e7,
+    Key(name="tension", unit="N", lo=0.0, hi=1e7, fmu="web_tension",
         doc="constant web tension (not with [web.span])"),
     Key(name="span", kind="table", default_text="none",
         doc="an elastic span from an unwinding roll, a sub-table: keys below"),
@@ -29,10 +29,12 @@ SPAN_KEYS = Table((
     Key(name="from", kind="ref", required=True,
         doc="the unwinding roll that feeds the span"),
     Key(name="length", required=True, unit="m", lo=0.0, lo_open=True, hi=1e3,
+        fmu="span_length",
         doc="span length L_s"),
-    Key(name="EA", required=True, unit="N", lo=0.0, lo_open=True, hi=1e12,
+    Key(name="EA", required=True, unit="N", lo=0.0, lo_open=True, hi=1e12, fmu="span_EA",
         doc="axial stiffness EA of the web"),
-    Key(name="T_in", unit="N", lo=0.0, hi=1e7, doc="tension wound into the unwinding roll"),
+    Key(name="T_in", unit="N", lo=0.0, hi=1e7, fmu="span_T_in",
+        doc="tension wound into the unwinding roll"),
     Key(name="initial_tension", unit="N", lo=0.0, hi=1e7, default_text="T_in",
         doc="span tension at t = 0"),
 ))

@@ -130,9 +130,13 @@ class SingleDrumNaming(Naming):
         },
         profile_switch="speed_profile", inputs={"drum_torque_command": "drum_torque"},
         profile_reference="web_speed_reference", acceleration="web_acceleration",
-        speed="profile_web_speed")
+        speed="profile_web_speed",
+        switch_doc="true: drum follows the web-speed profile; false: driven by")
     #: a result written before the drum angle was a channel draws the drum still
     optional: ClassVar[frozenset[str]] = frozenset({"drum_angle"})
+    #: a result without its scene is one of this format (its drum and its roll, free in z)
+    bodies_without_scene: ClassVar[Mapping[str, tuple[str, ...]]] = {
+        "drum": ("angle", "speed"), "roll": ("z", "angle", "speed", "radius")}
 
     def outputs(self, units: Mapping[str, str]) -> dict[str, tuple[str, str]]:
         return {column: (decl.of(owner), decl.unit) for column, (decl, owner) in COLUMNS.items()}
@@ -153,10 +157,11 @@ class SingleDrumNaming(Naming):
             table, path = "drum.drive", path[1:]
         return " ".join((f"[{table}]", *path))
 
-    def drive_changes(self, scene: Any, drive: dict[str, Any], speed_profile: bool) -> None:
-        """Set ``drive`` (the changes of ``[drum.drive]``) for the FMU's
+    def drive_changes(self, scene: Any, changes: dict[str, Any], speed_profile: bool) -> None:
+        """Add the changes of ``[drum.drive]`` to ``changes`` for the FMU's
         :attr:`FmuNames.profile_switch`: true drives the drum along its profile, false
         frees it, started at the profile's initial speed, on the torque input."""
+        drive = changes.setdefault("drum", {}).setdefault("drive", {})
         d = scene.drum.drive
         a = drive.get("web_acceleration", d.web_acceleration)
         v = drive.get("web_speed", d.web_speed)

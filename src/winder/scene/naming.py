@@ -35,6 +35,9 @@ class FmuNames:
         parameters :attr:`acceleration` and :attr:`speed`).
     acceleration, speed:
         The FMU parameters of the profile's acceleration [m/s²] and web speed [m/s].
+    switch_doc:
+        The description of :attr:`profile_switch` (the inputs it frees the drum on
+        follow it).
     """
 
     parameters: Mapping[str, tuple[str, str]]
@@ -43,6 +46,7 @@ class FmuNames:
     profile_reference: str
     acceleration: str
     speed: str
+    switch_doc: str = "true: follows the speed profile; false: driven by"
 
 
 @dataclass(frozen=True)
@@ -76,16 +80,23 @@ class Naming:
         ``DRUM.torque`` per torque-driven body, ``ROLL_tension_setpoint``)."""
         return dict(inputs)
 
-    def drive_changes(self, scene: Any, drive: dict[str, Any], speed_profile: bool) -> None:
-        """Set ``drive`` (changes of the drive's table) for the FMU's
-        :attr:`FmuNames.profile_switch` ``speed_profile``: nothing without an own FMU
-        interface (a scene of parts keeps its drives)."""
+    def drive_changes(self, scene: Any, changes: dict[str, Any], speed_profile: bool) -> None:
+        """Add to ``changes`` (:meth:`Scene.replace <winder.scene.Scene.replace>`'s, by
+        table) the drive's for the FMU's :attr:`FmuNames.profile_switch`
+        ``speed_profile``: nothing without an own FMU interface (a scene of parts keeps
+        its drives)."""
 
     def key(self, table: str, part: str, *path: str) -> str:
         """The message path of a part's key: ``key("nip", "front", "friction", "mu")`` is
         ``[[nip]] 'front' friction mu``; ``key("drum", "front", "drive")`` names the
         drive's table."""
         return " ".join((f"[[{table}]] {part!r}", *path))
+
+    #: a naming that reads a result written without its scene (an older result file):
+    #: body name → the roles (``x``, ``z``, ``angle``, ``speed``, ``radius``) the viewer
+    #: draws it by, as :meth:`output_name` of ``BODY_ROLE``; empty: the result needs its
+    #: scene (:func:`naming_of` ``(None)`` is the naming that has them)
+    bodies_without_scene: ClassVar[Mapping[str, tuple[str, ...]]] = {}
 
 
 #: The naming of every scene of parts.
@@ -94,6 +105,11 @@ BY_PARTS = Naming()
 
 def naming_of(scene: object) -> Naming:
     """``scene``'s :attr:`~winder.scene.Scene.naming`; by its parts for an object that has
-    none (the plain scene objects the machine tests build)."""
+    none (the plain scene objects the machine tests build); for ``None`` (a result
+    without its scene) the naming that reads one (:attr:`Naming.bodies_without_scene`,
+    the single-drum format's), else by parts."""
+    if scene is None:
+        return next((cls() for cls in Naming.__subclasses__() if cls.bodies_without_scene),
+                    BY_PARTS)
     naming = getattr(scene, "naming", None)
     return naming if isinstance(naming, Naming) else BY_PARTS
