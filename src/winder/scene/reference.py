@@ -57,12 +57,18 @@ def _defaults_from(table: str) -> tuple[type, ...]:
     return _DEFAULTS_FROM.get(table, ())
 
 
-#: Every result channel's declaration (:class:`~winder._schema.Channel`): the machine's
-#: generic ones (:mod:`winder.model.channels`), then each body's (:data:`PARTS`), each
-#: force element's (:data:`FORCES`, :data:`DRIVES`), in that order.
-CHANNEL_DECLARATIONS: tuple[Channel, ...] = (
-    *GENERIC_CHANNELS, *(c for cls in PARTS.values() for c in cls.CHANNELS),
-    *(c for cls in (*FORCES.values(), *DRIVES.values()) for c in cls.CHANNELS))
+def _declarations() -> tuple[Channel, ...]:
+    """Every result channel's declaration now registered: the machine's generic ones
+    (:mod:`winder.model.channels`), then each body's (:data:`PARTS`), each force
+    element's (:data:`FORCES`, :data:`DRIVES`), in that order."""
+    return (*GENERIC_CHANNELS, *(c for cls in PARTS.values() for c in cls.CHANNELS),
+            *(c for cls in (*FORCES.values(), *DRIVES.values()) for c in cls.CHANNELS))
+
+
+#: Every result channel's declaration (:class:`~winder._schema.Channel`) of the built-in
+#: parts and effects (:func:`_declarations` at import).
+CHANNEL_DECLARATIONS: tuple[Channel, ...] = _declarations()
+
 
 def _placeholder_kinds(placeholder: str) -> tuple[str, ...]:
     """The kinds of part a placeholder of a channel's name stands for (``BODY``: every
@@ -194,6 +200,8 @@ def _effect_sections() -> list[str]:
 def reference() -> str:
     """The text of ``docs/scene-reference.md`` (Markdown)."""
     arrays = ", ".join(f"`[[{cls.table}]]`" for cls in PARTS.values()) + ", `[[nip]]`"
+    tables = [cls.table for cls in PARTS.values()]
+    bodies = ", ".join(tables[:-1]) + " or " + tables[-1] if len(tables) > 1 else tables[0]
     lines = [
         "# Scene reference",
         "",
@@ -250,7 +258,7 @@ def reference() -> str:
     for column, (decl, owner) in COLUMNS.items():
         lines.append(f"| `{column}` | {decl.unit} | `{decl.of(owner)}` | {_cell(decl.doc)} |")
     lines += ["", "### Scenes of parts", "",
-              "`BODY` is the name of any drum, roll or rider, `ROLL` of a paper roll, "
+              f"`BODY` is the name of any {bodies}, `ROLL` of a paper roll, "
               "`RIDER` of a rider, `NIP` of a nip; `web_speed` and `web_force` exist with a "
               "web, `span_tension` with `[web.span]`, `tension_error` with an unwind of kind "
               "`tension_control`. With several webs, `web_speed` and `web_force` are "
@@ -258,19 +266,19 @@ def reference() -> str:
               "spans, `span_tension` and `tension_error` are `WEB_span_tension` and "
               "`WEB_tension_error`.", "",
               "| channel | unit | meaning |", "|---|---|---|"]
-    for decl in CHANNEL_DECLARATIONS:
+    for decl in _declarations():
         lines.append(f"| `{decl.name}` | {decl.unit} | {_cell(decl.doc)} |")
     return "\n".join(lines) + "\n"
 
 
 def channel_declarations(name: str, parts: dict[str, str], webs: Iterable[str] = ()
                          ) -> list[Channel]:
-    """The declarations (:data:`CHANNEL_DECLARATIONS`) the channel ``name`` of a scene of
+    """The declarations (:func:`_declarations`) the channel ``name`` of a scene of
     parts matches: a placeholder's with the name of a part of its kind, a web's alone or
     after the name of one of ``webs`` (``WEB_web_speed``); ``parts`` maps every part name
     to its kind (``drum``, ``roll``, ``rider``, ``nip``)."""
     out = []
-    for decl in CHANNEL_DECLARATIONS:
+    for decl in _declarations():
         if decl.placeholder:
             owners = [p for p, k in parts.items() if k in _placeholder_kinds(decl.placeholder)]
             if any(name == decl.of(p) for p in owners):
