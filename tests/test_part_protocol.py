@@ -165,6 +165,10 @@ def test_new_body_type_rejects_bad_keys(discs: None) -> None:
         _scene(ONE_DISC + 'colour = "red"\n')
     with pytest.raises(winder.SceneError, match=r"\[disc 'disc'\] mass: missing required"):
         _scene(ONE_DISC.replace("mass = 50.0\ncentre", "centre"))
+    with pytest.raises(winder.SceneError,
+                       match=r"\[disc 'disc'\] parent: 'nowhere' is not a body of the "
+                             r"scene; valid names: drum, disc$"):
+        _scene(ONE_DISC + 'parent = "nowhere"\n')
     with pytest.raises(winder.SceneError, match=r"'disc' is already the name of disc"):
         _scene(ONE_DISC + ONE_DISC[len(HEAD):])
     with pytest.raises(winder.SceneError, match=r"\[disc 'd2'\] centre: disc 'd2' .*overlaps "
@@ -176,6 +180,7 @@ def test_new_body_type_is_documented(discs: None) -> None:
     """The reference lists ``[[disc]]`` with its keys, after the built-in bodies."""
     text = reference()
     assert "`[[drum]]`, `[[roll]]`, `[[rider]]`, `[[disc]]`, `[[nip]]`" in text
+    assert "`BODY` is the name of any drum, roll, rider or disc" in text
     section = text[text.index("### `[[disc]]`"):text.index("### `[[nip]]`")]
     assert "| `torque` | number | N·m | \\|x\\| ≤ 1e8 | 0 | the drive torque" in section
     assert "| `radius` | number | m | (0, 10] | required | disc radius |" in section

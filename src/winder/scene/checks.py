@@ -105,6 +105,16 @@ def check_references(source: str, bodies: Bodies, nips: list[NipPart],
                         f"{rider.name!r} (the rider rests on its roll through a nip); "
                         "declare one; nips: "
                         f"{', '.join(f'{n.name} ({n.a}, {n.b})' for n in nips) or '(none)'}")
+    for cls, parts in types:  # any other reference of a body type's keys: to a body
+        refs = [k.name for k in cls.KEYS if k.kind == "ref"]
+        for p in parts:
+            for key in refs:
+                ref = getattr(p, key, None)
+                if ref is not None and ref not in body_names:
+                    what = f"is {kinds[ref]} {ref!r}, not a body" if ref in kinds else \
+                        "is not a body of the scene"
+                    raise fail(source, f"{cls.table} {p.name!r}", key,
+                               f"{show(ref)} {what}; valid names: {', '.join(body_names)}")
     wound = [r.name for r in rolls if r.kind == "wound"]
     entries = [n.name for n in nips if kinds[n.a] == "drum" and n.b in wound]
     if not webs and wound:
