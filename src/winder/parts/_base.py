@@ -87,10 +87,12 @@ class BodyElement(ABC):
     ``NAME_angle`` [rad], ``NAME_torque`` [N·m], ``NAME_accel`` [rad/s²], ``NAME_x``
     [m], ...) and the dynamics (Pinocchio's ABA). The element says everything else.
 
-    To add a body type (the machine, the solvers, the generated code, the static balance,
-    the scene's tables, parsing, checks and ``to_dict``, the reference and the viewer read
-    it from here; the figures and the FMU draw and expose it by its generic channels and
-    parameters):
+    To add a body type: the machine, the solvers, the generated code, the static balance,
+    the scene (its tables, parsing, checks, ``to_dict``), the generated reference and the
+    viewer's scene graph read it from here. Not yet generic: the figures draw a body by
+    :attr:`role` (``drum``: a driven body, else a turning one), and the FMU's tunable
+    parameters are listed per table in :mod:`winder.fmu.build` (a new type has its
+    co-simulation inputs, :attr:`torque_inputs`, but no tunable parameters there).
 
     1. Subclass :class:`BodyElement` (or :class:`RigidDisc` for a body of constant radius,
        mass and inertia) in the part's module under ``winder/parts/``; set the class
