@@ -5,7 +5,9 @@ mode kinds."""
 
 from __future__ import annotations
 
+import tomllib
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import machines as mc
@@ -13,12 +15,15 @@ import numpy as np
 import pytest
 
 import winder
+from winder._schema import Key, Table
 from winder.forces import FORCES, RUN_ORDER, ForceElement
 from winder.model.element_order import ElementOrderError, order_elements
 from winder.model.locked_modes import ModeKind
 from winder.model.machine import Machine
-from winder.parts import PARTS, DrumPart, RigidDisc
-from winder.scene import Effects, Scene, SceneInfo, Solver
+from winder.parts import CENTRE, NAME, PARTS, Drawing, RigidDisc
+from winder.scene import key_unit
+from winder.scene.reference import reference
+from winder.scene.schema import TABLES
 from winder.solve.system import MachineSystem
 
 TAU = 30.0  # [N·m]
@@ -27,8 +32,7 @@ J_DISC = 4.0  # [kg·m²]
 
 @dataclass(frozen=True)
 class DiscPart:
-    """A disc: radius [m], inertia [kg·m²], mass [kg], centre [m] (in its parent's frame),
-    torque [N·m] (operation sense), parent (None: the world)."""
+    """``[[disc]]``: keys, units and bounds: :data:`DISC_KEYS`."""
 
     name: str
     radius: float
@@ -40,17 +44,40 @@ class DiscPart:
     sense: int = 1
 
 
+#: The keys of ``[[disc]]``.
+DISC_KEYS = Table((
+    NAME,
+    Key(name="radius", required=True, unit="m", lo=0.0, lo_open=True, hi=10.0,
+        doc="disc radius"),
+    Key(name="inertia", required=True, unit="kg·m²", lo=0.0, lo_open=True, hi=1e7,
+        doc="polar inertia of the disc"),
+    Key(name="mass", required=True, unit="kg", lo=0.0, lo_open=True, hi=1e6,
+        doc="disc mass"),
+    CENTRE,
+    Key(name="torque", unit="N·m", hi=1e8, doc="the drive torque (operation sense)"),
+    Key(name="parent", kind="ref", doc="the body it hangs off (its centre in that body's "
+                                       "frame); none: the world"),
+    Key(name="sense", kind="sense", doc="operation direction"),
+))
+
+
 class DiscBody(RigidDisc):
     """A disc on a fixed axis (or on its parent), driven by a constant torque."""
 
     table = "disc"
     role = "drum"
+    KEYS = DISC_KEYS
+    part_cls = DiscPart
 
     def __init__(self, part: Any, placed: Any) -> None:
         super().__init__(part)
         self.centre = tuple(part.centre)
         self.parent = part.parent
         self.torque_inputs = (f"{self.name}.torque",)
+
+    @classmethod
+    def initial_circle(cls, part: Any) -> Any:
+        return None if part.parent else super().initial_circle(part)
 
     def declare(self, machine: Machine) -> None:
         super().declare(machine)
@@ -59,12 +86,8 @@ class DiscBody(RigidDisc):
     def drive_torque(self, ev: Any) -> Any:
         return ev.p(f"{self.name}.torque")
 
-
-@dataclass(frozen=True)
-class DiscScene(Scene):
-    """A scene that also lists discs."""
-
-    discs: tuple[DiscPart, ...] = ()
+    def drawing(self) -> Drawing:
+        return Drawing(colour="disc")  # not a colour of the viewer: it falls back
 
 
 @pytest.fixture
@@ -72,21 +95,139 @@ def discs(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(PARTS, "discs", DiscBody)  # the one registration line
 
 
-def _scene(*parts: DiscPart, duration: float = 2.0) -> DiscScene:
-    """The discs beside a drum standing still (a result's metadata names a drum)."""
-    drum = DrumPart("drum", 0.5, 100.0, 500.0, (-3.0, 0.0))
-    return DiscScene(scene=SceneInfo(name="discs", duration=duration, output_step=0.1,
-                                     gravity=9.81),
-                     effects=Effects(), drum=None, roll=None, paper=None, contact=None,
-                     friction=None, solver=Solver(rtol=1e-10, atol=1e-12), drums=(drum,),
-                     discs=parts)
+#: The discs beside a drum standing still (a result's metadata names a drum).
+HEAD = """
+[scene]
+name = "discs"
+duration = 2.0
+output_step = 0.1
+
+[solver]
+rtol = 1e-10
+atol = 1e-12
+
+[[drum]]
+name = "drum"
+radius = 0.5
+inertia = 100.0
+mass = 500.0
+centre = [-3.0, 0.0]
+drive = { kind = "speed_profile", web_speed = 0.0 }
+"""
+ONE_DISC = HEAD + f"""
+[[disc]]
+name = "disc"
+radius = 0.3
+inertia = {J_DISC}
+mass = 50.0
+centre = [0.0, 1.0]
+torque = {TAU}
+"""
+
+
+def _scene(text: str) -> winder.Scene:
+    return winder.scene_from_dict(tomllib.loads(text), source="discs.toml")
+
+
+def test_new_body_type_loads_from_a_scene_file(discs: None, tmp_path: Path) -> None:
+    """``[[disc]]`` is a table of a scene file at once: parsed against its keys into its
+    dataclass, listed as ``scene.discs``, written back by ``to_dict`` and ``replace``."""
+    path = tmp_path / "discs.toml"
+    path.write_text(ONE_DISC, encoding="utf-8")
+    scene = winder.load_scene(path)
+    disc = DiscPart("disc", 0.3, J_DISC, 50.0, (0.0, 1.0), torque=TAU)
+    assert scene.discs == (disc,)
+    assert scene.bodies["discs"] == (disc,)
+    assert [d.name for d in scene.drums] == ["drum"]
+    assert scene.to_dict()["disc"] == [{"name": "disc", "radius": 0.3, "inertia": J_DISC,
+                                        "mass": 50.0, "centre": [0.0, 1.0], "torque": TAU,
+                                        "sense": 1}]
+    assert winder.scene_from_dict(scene.to_dict(), source=str(path)) == scene
+    assert scene.replace(disc={"disc": {"torque": 1.0}}).discs[0].torque == 1.0
+    assert TABLES["disc[]"] is DISC_KEYS
+    assert key_unit("disc.disc.torque") == "N·m"
+
+
+def test_new_body_type_rejects_bad_keys(discs: None) -> None:
+    """A bad value, an unknown key, a missing key: the standard messages, naming
+    ``[disc 'disc']`` and the key (the same text as for a drum's)."""
+    with pytest.raises(winder.SceneError) as bad:
+        _scene(ONE_DISC.replace("radius = 0.3", "radius = -0.3"))
+    with pytest.raises(winder.SceneError) as drum:
+        _scene(ONE_DISC.replace("radius = 0.5", "radius = -0.3"))
+    head = "discs.toml: [disc 'disc'] radius: "
+    assert str(bad.value).startswith(head)
+    assert str(bad.value)[len(head):] == \
+        str(drum.value)[len("discs.toml: [drum 'drum'] radius: "):]
+    with pytest.raises(winder.SceneError,
+                       match=r"\[disc 'disc'\] colour: unknown key; valid keys: name, "
+                             r"radius, inertia, mass, centre, torque, parent, sense"):
+        _scene(ONE_DISC + 'colour = "red"\n')
+    with pytest.raises(winder.SceneError, match=r"\[disc 'disc'\] mass: missing required"):
+        _scene(ONE_DISC.replace("mass = 50.0\ncentre", "centre"))
+    with pytest.raises(winder.SceneError,
+                       match=r"\[disc 'disc'\] parent: 'nowhere' is not a body of the "
+                             r"scene; valid names: drum, disc$"):
+        _scene(ONE_DISC + 'parent = "nowhere"\n')
+    with pytest.raises(winder.SceneError, match=r"'disc' is already the name of disc"):
+        _scene(ONE_DISC + ONE_DISC[len(HEAD):])
+    with pytest.raises(winder.SceneError, match=r"\[disc 'd2'\] centre: disc 'd2' .*overlaps "
+                                                r"disc 'disc'"):
+        _scene(ONE_DISC + ONE_DISC[len(HEAD):].replace('"disc"', '"d2"'))
+
+
+def test_new_body_type_is_documented(discs: None) -> None:
+    """The reference lists ``[[disc]]`` with its keys, after the built-in bodies."""
+    text = reference()
+    assert "`[[drum]]`, `[[roll]]`, `[[rider]]`, `[[disc]]`, `[[nip]]`" in text
+    assert "`BODY` is the name of any drum, roll, rider or disc" in text
+    section = text[text.index("### `[[disc]]`"):text.index("### `[[nip]]`")]
+    assert "| `torque` | number | N·m | \\|x\\| ≤ 1e8 | 0 | the drive torque" in section
+    assert "| `radius` | number | m | (0, 10] | required | disc radius |" in section
+    assert text.index("### `[[rider]]`") < text.index("### `[[disc]]`")
+
+
+def test_new_body_type_is_drawn(discs: None) -> None:
+    """The viewer draws a disc by its drawing spec (a cylinder as long as the machine;
+    an unknown colour falls back to the drum's) and poses it by Pinocchio FK."""
+    from winder.viewer import COLOURS, WinderGraph
+
+    graph = WinderGraph(_scene(ONE_DISC))
+    vis = _Recorder()
+    graph.build(vis)
+    shell = vis.objects["/winder/disc/shell"]
+    assert shell[0] == pytest.approx((1.05 * graph.length, 0.3))
+    assert shell[1] == COLOURS["drum"]
+    T = graph.poses({"drum": (0.0, 0.0, 0.0), "disc": (0.0, 1.0, 0.4)})
+    np.testing.assert_allclose(T["disc"][:3, 3], [0.0, 0.0, 1.0], atol=1e-15)
+
+
+class _Recorder:
+    """A stand-in for a meshcat visualizer: records each node's object (cylinder height
+    and radius, colour)."""
+
+    def __init__(self, path: str = "", objects: dict[str, Any] | None = None) -> None:
+        self.path, self.objects = path, {} if objects is None else objects
+
+    def __getitem__(self, name: str) -> _Recorder:
+        return _Recorder(f"{self.path}/{name.strip('/')}", self.objects)
+
+    def set_object(self, geometry: Any, material: Any) -> None:
+        size = (geometry.height, geometry.radiusTop) if hasattr(geometry, "height") else None
+        self.objects[self.path] = (size, material.color)
+
+    def set_transform(self, T: Any) -> None:
+        pass
+
+    def set_property(self, key: str, value: Any) -> None:
+        pass
 
 
 @pytest.mark.parametrize("backend", ["compiled", "pinocchio"])
 def test_new_body_type_simulates(discs: None, backend: str) -> None:
     """A disc under a constant torque: ``ω(t) = τ t / J``, ``angle = τ t² / 2J``
     (closed form), its torque channel the input, in its units."""
-    scene = _scene(DiscPart("disc", 0.3, J_DISC, 50.0, (0.0, 1.0), torque=TAU))
+    scene = _scene(ONE_DISC)
     m = Machine(scene)
     assert [type(b).__name__ for b in m.bodies] == ["DrumBody", "DiscBody"]
     assert m.state_names == ["disc.theta", "disc.theta_dot"]  # the drum is prescribed
@@ -106,8 +247,23 @@ def test_body_hangs_off_its_parent(discs: None) -> None:
     one turns as a rigid body of inertia ``J₁ + m₂ d²``: ``ω₁ = τ t / (J₁ + m₂ d²)`` and
     the pin's relative rate ``θ̇₂ = −ω₁``."""
     d, m2 = 0.5, 20.0
-    scene = _scene(DiscPart("hub", 0.8, J_DISC, 60.0, (0.0, 2.0), torque=TAU),
-                   DiscPart("planet", 0.1, 0.05, m2, (d, 0.0), parent="hub"))
+    scene = _scene(HEAD + f"""
+[[disc]]
+name = "hub"
+radius = 0.8
+inertia = {J_DISC}
+mass = 60.0
+centre = [0.0, 2.0]
+torque = {TAU}
+
+[[disc]]
+name = "planet"
+radius = 0.1
+inertia = 0.05
+mass = {m2}
+centre = [{d}, 0.0]
+parent = "hub"
+""")
     m = Machine(scene)
     model = m.model
     hub, planet = m.body["hub"], m.body["planet"]

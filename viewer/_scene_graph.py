@@ -1,7 +1,8 @@
-"""meshcat scene graph of any machine of parts: every drum, paper roll and rider roll as a
-cylinder along ``y`` with a radial mark (so that rotation shows), the web into its entry
-nip as a strip of segments (on a winder line from the unwinding roll), a floor and the far
-side frames of the fixed stands (drums, unwinding rolls).
+"""meshcat scene graph of any machine of parts: every body as a cylinder along ``y`` with a
+radial mark (so that rotation shows), drawn as its element's
+:meth:`~winder.parts.BodyElement.drawing` says (a paper roll: core and paper), the web
+into its entry nip as a strip of segments (on a winder line from the unwinding roll), a
+floor and the far side frames of the fixed stands (drums, unwinding rolls).
 
 Placements of the bodies come from the Pinocchio model of the machine
 (:class:`winder.model.machine.Machine`: per body prismatic ``x``/``z`` where free, then a
@@ -61,9 +62,11 @@ class WinderGraph:
         self.machine = Machine(self.scene)
         self.model = self.machine.model
         self.data = self.model.createData()
-        rolls = [b.part for b in self.machine.bodies if b.role == "roll"]
-        #: Length of the drums [m]: the widest roll's width.
-        self.length = max((r.width for r in rolls), default=1.0)
+        #: How each body is drawn (:meth:`~winder.parts.BodyElement.drawing`), by name.
+        self.drawings = {b.name: b.drawing() for b in self.machine.bodies}
+        #: Length of the drums [m]: the widest body's width (a paper roll's).
+        self.length = max((d.width for d in self.drawings.values() if d.width is not None),
+                          default=1.0)
         #: Bodies on stands (drums and unwinding rolls: fixed centres) or, without any,
         #: every body: the floor spans them and each stand gets a far side frame.
         self.fixed = [b for b in self.machine.bodies if not b.free]
@@ -71,11 +74,23 @@ class WinderGraph:
         #: Height of the floor [m]: 0.35 m below the lowest stand.
         self.floor_z = min(b.centre[1] - _radius0(b) for b in self.stands) - 0.35
         entry = self.machine.entry
-        self.web_width = 1.12 * (entry.b.part.width if entry is not None else self.length)
+        self.web_width = 1.12 * (self._width(entry.b.name) if entry is not None
+                                 else self.length)
         #: Node of each web's strip (``web`` for the first) and its width [m]: 1.12 × the
         #: width of the roll it enters.
-        self.web_nodes = [("web" if i == 0 else f"web-{w.name}", 1.12 * w.entry.b.part.width)
+        self.web_nodes = [("web" if i == 0 else f"web-{w.name}",
+                           1.12 * self._width(w.entry.b.name))
                           for i, w in enumerate(self.machine.webs)]
+
+    def _width(self, name: str) -> float:
+        """The drawn length along ``y`` [m] of body ``name``: its own width, the width of
+        the body it takes it from, else the machine's (1.05 × :attr:`length`)."""
+        d = self.drawings[name]
+        if d.width is not None:
+            return d.width
+        if d.width_of is not None and d.width_of in self.drawings:
+            return self._width(d.width_of)
+        return 1.05 * self.length if d.width_of is None else self.length
 
     # ---- objects --------------------------------------------------------------------
     def build(self, vis: meshcat.Visualizer) -> None:
@@ -83,25 +98,25 @@ class WinderGraph:
         on the machine's initial layout."""
         root, L = vis[self.root], self.length
         lam = g.MeshLambertMaterial
-        width = {b.name: b.part.width for b in self.machine.bodies if b.role == "roll"}
         # meshcat cylinders lie along their local y axis: the machine's cross axis
         for b in self.machine.bodies:
-            node = root[b.name]
-            if b.role == "roll":
-                w, rc = b.part.width, b.part.core_radius
+            node, d = root[b.name], self.drawings[b.name]
+            if d.core_radius is not None:  # a paper roll: core, paper scaled by its radius
+                w, rc = self._width(b.name), d.core_radius
                 node["core"].set_object(g.Cylinder(1.08 * w, rc), lam(color=COLOURS["core"]))
-                node["paper"].set_object(g.Cylinder(w, 1.0), lam(color=COLOURS["paper"]))
+                node["paper"].set_object(g.Cylinder(w, 1.0),
+                                         lam(color=COLOURS.get(d.colour, COLOURS["paper"])))
                 # a radial stripe on the face, child of the scaled paper: grows with it
                 node["paper"]["mark"].set_object(g.Box([1.0, 1.01 * w, 0.06]),
                                                  lam(color=COLOURS["mark"]))
                 node["paper"]["mark"].set_transform(_translation([0.5, 0.0, 0.0]))
                 node["com"].set_object(g.Sphere(0.03), lam(color=COLOURS["com"]))
-                e = b.part.com_offset if self.scene.effects.imbalance else 0.0
+                e = d.com_offset if self.scene.effects.imbalance else 0.0
                 node["com"].set_transform(_translation([COM_MARKER_GAIN * e, -0.56 * w, 0.0]))
                 continue
-            R = b.part.radius
-            length = 1.05 * L if b.role == "drum" else width.get(b.rides, L)
-            colour = COLOURS[b.role]
+            R = b.initial_radius
+            length = self._width(b.name)
+            colour = COLOURS.get(d.colour, COLOURS["drum"])
             node["shell"].set_object(g.Cylinder(length, R), lam(color=colour))
             node["mark"].set_object(g.Box([0.9 * R, 1.01 * length + 0.01, 0.04 * R]),
                                     lam(color=COLOURS["frame"]))

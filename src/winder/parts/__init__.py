@@ -1,11 +1,16 @@
-"""The parts a machine is built from (machines spec §8): drums, paper rolls, rider rolls,
-nips and the web with its span, as frozen dataclasses (one module per part). A scene file
-is read into them by :func:`winder.load_scene` (:class:`~winder.Scene` fields ``drums``,
-``rolls``, ``riders``, ``nips``, ``web``)."""
+"""The parts a machine is built from (machines spec §8), one module per part: drums, paper
+rolls and rider rolls (bodies: a frozen dataclass of the scene's data, its keys ``KEYS``
+and its :class:`BodyElement`, registered in :data:`PARTS`), nips and the web with its span
+(frozen dataclasses and their keys). A scene file is read into them by
+:func:`winder.load_scene`: ``[[TABLE]]`` of each registered body type, listed as
+``scene.ATTRIBUTE`` (:class:`~winder.Scene` ``drums``, ``rolls``, ``riders``; every body
+type in ``scene.bodies``), and ``nips``, ``webs``."""
 
+from collections.abc import Mapping
 from typing import Any
 
-from winder.parts._base import BodyElement, RigidDisc
+from winder.parts._base import BodyElement, Drawing, RigidDisc, SubTable, TableReader
+from winder.parts._keys import CENTRE, MAX_COORD, NAME
 from winder.parts.drum import DrumBody, DrumPart, SpeedProfileDrive, TorqueDrive
 from winder.parts.nip import CONTACT_LAWS, ContactLaw, FrictionLaw, NipPart
 from winder.parts.rider import RiderBody, RiderPart
@@ -23,11 +28,13 @@ from winder.parts.web import SpanPart, WebPart
 __all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "RollPart", "ROLL_KINDS", "AXES",
            "UnwindTorqueDrive", "TensionControl", "UNWIND_DRIVE_KINDS", "RiderPart",
            "NipPart", "ContactLaw", "FrictionLaw", "CONTACT_LAWS", "WebPart", "SpanPart",
-           "BodyElement", "RigidDisc", "DrumBody", "RollBody", "RiderBody", "PARTS",
-           "body_elements"]
+           "BodyElement", "RigidDisc", "SubTable", "TableReader", "Drawing", "DrumBody",
+           "RollBody", "RiderBody", "PARTS", "NAME", "CENTRE", "MAX_COORD", "body_elements",
+           "body_types"]
 
-#: The body types by the scene attribute that lists their parts, in the order the machine
-#: builds them (a body may rest on one built before it): one registration line each.
+#: The body types by the scene attribute that lists their parts (``scene.drums``), in the
+#: order the machine builds them (a body may rest on one built before it) and the scene
+#: reads, checks and writes their tables: one registration line each.
 PARTS: dict[str, type[BodyElement]] = {
     "drums": DrumBody,
     "rolls": RollBody,
@@ -35,10 +42,18 @@ PARTS: dict[str, type[BodyElement]] = {
 }
 
 
+def body_types() -> dict[str, type[BodyElement]]:
+    """The body types now registered by their table name (``drum``: :class:`DrumBody`),
+    in :data:`PARTS` order."""
+    return {cls.table: cls for cls in PARTS.values()}
+
+
 def body_elements(scene: Any) -> list[BodyElement]:
     """The body elements of ``scene``'s parts (:data:`PARTS` order, then the scene's)."""
+    bodies: Mapping[str, Any] = getattr(scene, "bodies", None) or {}
     placed: dict[str, BodyElement] = {}
     for attr, cls in PARTS.items():
-        for part in getattr(scene, attr, None) or ():
+        parts = bodies.get(attr) if attr in bodies else getattr(scene, attr, None)
+        for part in parts or ():
             placed[part.name] = cls(part, placed)
     return list(placed.values())

@@ -2,23 +2,79 @@
 
 A scene's part (the frozen dataclass read from its table, e.g. :class:`DrumPart`) is data;
 its behaviour is a :class:`BodyElement` beside it in the same module (``DrumBody`` for
-``[[drum]]``). :class:`~winder.model.machine.Machine` assembles the body elements and the
-force elements of :mod:`winder.forces` without knowing which kinds there are: a new body
-type is its module plus one line in :data:`winder.parts.PARTS`.
+``[[drum]]``). The element class is also the body type's registration record: its
+table (:attr:`~BodyElement.table`), keys (:attr:`~BodyElement.KEYS`, sub-tables
+:attr:`~BodyElement.SUB_TABLES`), part dataclass (:attr:`~BodyElement.part_cls`) and
+parser (:meth:`~BodyElement.parse`). :class:`~winder.model.machine.Machine` assembles
+the body elements and the force elements of :mod:`winder.forces` without knowing which
+kinds there are, and the scene (its tables, parsing, checks, ``to_dict``, the generated
+reference) and the viewer read the registry :data:`winder.parts.PARTS`: a new body type is
+its module plus one line there.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any, ClassVar
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
-from winder._schema import Channel
+from winder._schema import Channel, Table
 
 if TYPE_CHECKING:
     from winder.model.machine import BodyState, Evaluation, Machine
 
-__all__ = ["BodyElement", "RigidDisc"]
+__all__ = ["BodyElement", "RigidDisc", "SubTable", "TableReader", "Drawing"]
+
+
+@dataclass(frozen=True)
+class SubTable:
+    """A sub-table of a body's table (a drum's ``drive``): its keys, the dataclasses whose
+    field defaults the reference shows for keys that declare none, and its heading in the
+    reference after ``[[TABLE]]`` (None: the key's name)."""
+
+    keys: Table
+    defaults: tuple[type, ...] = ()
+    heading: str | None = None
+
+
+class TableReader(Protocol):
+    """What :meth:`BodyElement.parse` reads a scene table with (the scene's parser,
+    :mod:`winder.scene.parts`): every error names the file, the table and the key."""
+
+    #: the scene file (messages)
+    source: str
+    #: the scene's ``[paper]`` (:class:`~winder.scene.tables.Paper`) or None
+    paper: Any
+    #: the scene's ``[effects]`` (:class:`~winder.scene.tables.Effects`)
+    effects: Any
+
+    def keys(self, label: str, raw: Any, table: Table) -> dict[str, Any]:
+        """The keys of ``raw`` checked against ``table`` (sub-tables left out)."""
+
+    def kinds(self, label: str, parsed: Mapping[str, Any], table: Table) -> None:
+        """Every key of ``parsed`` belongs to its ``kind`` (``table.kinds``)."""
+
+    def fail(self, label: str, key: str, message: str) -> Exception:
+        """The error of ``key`` of ``[label]``."""
+
+
+@dataclass(frozen=True)
+class Drawing:
+    """How the viewer draws a body, whatever its type: a cylinder along ``y`` with a radial
+    mark.
+
+    colour: a colour key of the viewer (``drum``, ``rider``, ...; an unknown one: the
+    drum's). width: its own length along ``y`` [m] (None: the machine's, 1.05 × the widest
+    body's width). width_of: the name of a body whose width it takes (a rider: the roll
+    it rides). core_radius: a paper roll's core [m] (then a core, a paper cylinder scaled
+    by its radius state, and a centre-of-mass marker at com_offset [m])."""
+
+    colour: str = "drum"
+    width: float | None = None
+    width_of: str | None = None
+    core_radius: float | None = None
+    com_offset: float = 0.0
 
 
 class BodyElement(ABC):
@@ -31,18 +87,23 @@ class BodyElement(ABC):
     ``NAME_angle`` [rad], ``NAME_torque`` [N·m], ``NAME_accel`` [rad/s²], ``NAME_x``
     [m], ...) and the dynamics (Pinocchio's ABA). The element says everything else.
 
-    To add a body type (nothing else is touched: not the machine, the solvers, the
-    generated code, the static balance or the viewer; the scene's schema declares its
-    table and keys, the part's frozen dataclass beside the element):
+    To add a body type: the machine, the solvers, the generated code, the static balance,
+    the scene (its tables, parsing, checks, ``to_dict``), the generated reference and the
+    viewer's scene graph read it from here. Not yet generic: the figures draw a body by
+    :attr:`role` (``drum``: a driven body, else a turning one), and the FMU's tunable
+    parameters are listed per table in :mod:`winder.fmu.build` (a new type has its
+    co-simulation inputs, :attr:`torque_inputs`, but no tunable parameters there).
 
     1. Subclass :class:`BodyElement` (or :class:`RigidDisc` for a body of constant radius,
        mass and inertia) in the part's module under ``winder/parts/``; set the class
        variables :attr:`table` (the scene's array of tables: messages name its keys as
-       ``[[drum]] 'front' centre``), :attr:`role` (how the viewer and the figures draw it:
-       ``"drum"``, ``"roll"`` or ``"rider"``), :attr:`place_key` (the key that places
-       it) and, where they apply, :attr:`radius_state` (its radius is a state and a
-       ``NAME_radius`` channel) and :attr:`variable_mass` (its mass properties change:
-       the ``variable_mass`` effect adds ``−Ẏv``).
+       ``[[drum]] 'front' centre``), :attr:`KEYS` (its keys, :class:`~winder._schema.Table`;
+       sub-tables :attr:`SUB_TABLES`), :attr:`part_cls` (its frozen dataclass),
+       :attr:`role` (how the figures draw it: ``"drum"``, ``"roll"`` or ``"rider"``),
+       :attr:`place_key` (the key that places it) and, where they apply,
+       :attr:`radius_state` (its radius is a state and a ``NAME_radius`` channel) and
+       :attr:`variable_mass` (its mass properties change: the ``variable_mass`` effect
+       adds ``−Ẏv``).
     2. In ``__init__(part, placed)`` (``placed``: the bodies built before it, by name)
        call ``super().__init__(part)`` and set :attr:`free` (the translational axes
        among ``("x", "z")``, in that order), :attr:`centre` [m] (the fixed coordinates,
@@ -75,13 +136,30 @@ class BodyElement(ABC):
        :meth:`hold_operating_speed` (a prescribed drive at a given web speed, for the
        resonance map), :meth:`structure_tag`
        (what changes its generated code beyond its names).
-    6. Register it: one line in :data:`winder.parts.PARTS` (scene attribute → class).
+    6. Scene side, where the defaults do not do: :meth:`parse` (its part from its raw
+       table: the default checks :attr:`KEYS` and builds :attr:`part_cls`; sub-tables and
+       checks across keys need their own), :meth:`fixed_centre` and
+       :meth:`initial_circle` (the scene's nip and overlap checks), :meth:`drawing`
+       (the viewer's shape and colour).
+    7. Register it: one line in :data:`winder.parts.PARTS` (scene attribute → class);
+       the scene then reads ``[[TABLE]]`` and lists its parts as ``scene.ATTRIBUTE``.
 
-    Example: a free disc of constant radius under a constant torque, as a scene's
-    ``discs`` (in ``winder/parts/disc.py``, plus ``PARTS["discs"] = DiscBody``)::
+    Example: a disc of constant radius on a fixed axis under a constant torque, a scene's
+    ``[[disc]]`` (in ``winder/parts/disc.py``, plus ``PARTS["discs"] = DiscBody``)::
+
+        @dataclass(frozen=True)
+        class DiscPart:               # keys, units and bounds: KEYS
+            name: str
+            radius: float
+            inertia: float
+            mass: float
+            centre: tuple[float, float]
+            torque: float = 0.0
 
         class DiscBody(RigidDisc):
-            table, role = "disc", "drum"
+            table, role, part_cls = "disc", "drum", DiscPart
+            KEYS = Table((NAME, Key(name="radius", ...), ..., CENTRE, Key(name="torque",
+                          unit="N·m", doc="the drive torque")))
 
             def __init__(self, part, placed):
                 super().__init__(part)
@@ -104,7 +182,14 @@ class BodyElement(ABC):
 
     #: the scene's array of tables (``[[drum]]``): error messages name keys by it
     table: ClassVar[str]
-    #: how the viewer and the figures draw it: ``"drum"``, ``"roll"`` or ``"rider"``
+    #: the keys of ``[[TABLE]]``, each declared once (parser, messages, reference, FMU)
+    KEYS: ClassVar[Table]
+    #: its sub-tables by key (a drum's ``drive``), in the reference after its table
+    SUB_TABLES: ClassVar[Mapping[str, SubTable]] = {}
+    #: the frozen dataclass of its part (the scene's data)
+    part_cls: ClassVar[type]
+    #: how the figures draw it: ``"drum"``, ``"roll"`` or ``"rider"`` (the viewer reads
+    #: :meth:`drawing`)
     role: ClassVar[str]
     #: the scene key that places it (``centre``; a rider: ``x``)
     place_key: ClassVar[str] = "centre"
@@ -138,6 +223,32 @@ class BodyElement(ABC):
     def kind(self) -> str:
         """The part's table name (``drum``, ``roll``, ``rider``); for messages only."""
         return self.table
+
+    # ---- scene ------------------------------------------------------------------------
+    @classmethod
+    def parse(cls, reader: TableReader, label: str, raw: Any) -> Any:
+        """Its part from the raw table ``raw`` of ``[label]`` (``disc 'd1'``): each key
+        checked against :attr:`KEYS`, then :attr:`part_cls` of them (override for
+        sub-tables, defaults from ``[paper]`` and checks across keys)."""
+        return cls.part_cls(**reader.keys(label, raw, cls.KEYS))
+
+    @classmethod
+    def fixed_centre(cls, part: Any) -> bool:
+        """Whether its centre is fixed (a nip needs one body free to move): default,
+        where the part has no ``free`` axes."""
+        return not tuple(getattr(part, "free", ()))
+
+    @classmethod
+    def initial_circle(cls, part: Any) -> tuple[tuple[float, float], float] | None:
+        """Its centre ``(x, z)`` [m] and radius [m] at the start, for the scene's overlap
+        check (None: left out); default from the part's ``centre`` and ``radius``."""
+        centre, radius = getattr(part, "centre", None), getattr(part, "radius", None)
+        return None if centre is None or radius is None else (tuple(centre), radius)
+
+    def drawing(self) -> Drawing:
+        """How the viewer draws it (default: a cylinder as long as the machine, in the
+        drum's colour)."""
+        return Drawing()
 
     # ---- structure ----------------------------------------------------------------------
     @property

@@ -4,25 +4,20 @@ constant radius, driven by a speed profile or a torque."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from winder._schema import Key, Table
+from winder.parts._base import Drawing, RigidDisc, SubTable, TableReader
+from winder.parts._keys import CENTRE, NAME
 
-__all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "KEYS", "DRIVE_KEYS", "DRIVE_KINDS",
-           "NAME", "CENTRE", "MAX_COORD"]
+if TYPE_CHECKING:
+    from winder.model.machine import BodyState, Evaluation, Machine
+
+__all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "DrumBody", "KEYS", "DRIVE_KEYS",
+           "DRIVE_KINDS"]
 
 #: Drive kinds of a drum.
 DRIVE_KINDS = ("speed_profile", "torque")
-#: Largest coordinate of a centre (or of a rider's x) [m].
-MAX_COORD = 1e3
-
-#: A part's ``name`` (every part has one; a web's is optional).
-NAME = Key(name="name", kind="name", required=True,
-           doc="the part's name (unique; names its channels)")
-#: A body's ``centre``: its axis position ``[x, z]`` [m].
-CENTRE = Key(name="centre", kind="pair", required=True, doc_unit="m",
-             doc="axis position [x, z]",
-             items=(Key(name="x", doc="x of the axis", unit="m", hi=MAX_COORD),
-                    Key(name="z", doc="z of the axis", unit="m", hi=MAX_COORD)))
 
 #: The keys of ``[[drum]]``: one declaration each (units, bounds, meaning).
 KEYS = Table((
@@ -84,9 +79,8 @@ class TorqueDrive:
 
 @dataclass(frozen=True)
 class DrumPart:
-    """``[[drum]]``: name, radius [m], inertia (polar) [kg·m²], mass [kg], centre
-    ``(x, z)`` [m] (fixed), sense ±1 (operation direction, spec §1), drive; bounds and
-    meanings: :data:`KEYS`."""
+    """``[[drum]]``: a drum of fixed centre and constant radius, mass and inertia, with its
+    drive; keys, units, bounds and meanings: :data:`KEYS` (its drive: :data:`DRIVE_KEYS`)."""
 
     name: str
     radius: float
@@ -97,15 +91,6 @@ class DrumPart:
     drive: SpeedProfileDrive | TorqueDrive = SpeedProfileDrive()
 
 
-# ---- behaviour (the part protocol, :class:`~winder.parts._base.BodyElement`) -------------
-from typing import TYPE_CHECKING, Any  # noqa: E402
-
-from winder.parts._base import RigidDisc  # noqa: E402
-
-if TYPE_CHECKING:
-    from winder.model.machine import BodyState, Evaluation, Machine
-
-
 class DrumBody(RigidDisc):
     """A drum: fixed centre, constant radius, mass and inertia; driven by a speed profile
     (prescribed, machines.md §6: ``Ω = ratio · min(a_w t, v_w) / R`` [rad/s], no ``θ``
@@ -113,6 +98,32 @@ class DrumBody(RigidDisc):
 
     table = "drum"
     role = "drum"
+    KEYS = KEYS
+    SUB_TABLES = {"drive": SubTable(DRIVE_KEYS, (SpeedProfileDrive, TorqueDrive))}
+    part_cls = DrumPart
+
+    @classmethod
+    def parse(cls, reader: TableReader, label: str, raw: Any) -> DrumPart:
+        """Its keys and its drive (machines spec §6)."""
+        kw = reader.keys(label, raw, KEYS)
+        dlabel = f"{label}.drive"
+        d = reader.keys(dlabel, raw["drive"], DRIVE_KEYS)
+        reader.kinds(dlabel, d, DRIVE_KEYS)
+        if d["kind"] == "speed_profile":
+            if "web_speed" not in d:
+                raise reader.fail(dlabel, "web_speed",
+                                  "missing required key (kind = 'speed_profile')")
+            drive: SpeedProfileDrive | TorqueDrive = SpeedProfileDrive(**d)
+        else:
+            drive = TorqueDrive(**d)
+        return DrumPart(**kw, drive=drive)
+
+    @classmethod
+    def fixed_centre(cls, part: Any) -> bool:
+        return True
+
+    def drawing(self) -> Drawing:
+        return Drawing(colour="drum")
 
     def __init__(self, part: Any, placed: Any = None) -> None:
         super().__init__(part)

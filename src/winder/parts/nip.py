@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from winder._schema import Key, Table
-from winder.parts.drum import NAME
+from winder.parts._keys import NAME
 
 __all__ = ["NipPart", "ContactLaw", "FrictionLaw", "CONTACT_LAWS", "KEYS", "CONTACT_KEYS",
            "FRICTION_KEYS"]

@@ -4,11 +4,13 @@ resting on a paper roll under an applied line load."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from winder._schema import Key, Table
-from winder.parts.drum import MAX_COORD, NAME
+from winder.parts._base import Drawing, RigidDisc
+from winder.parts._keys import MAX_COORD, NAME
 
-__all__ = ["RiderPart", "KEYS"]
+__all__ = ["RiderPart", "RiderBody", "KEYS"]
 
 #: The keys of ``[[rider]]``.
 KEYS = Table((
@@ -36,11 +38,9 @@ KEYS = Table((
 
 @dataclass(frozen=True)
 class RiderPart:
-    """``[[rider]]``: name; rides (the name of the roll it rests on); radius [m], mass
-    [kg], inertia [kg·m²]; x [m] (its fixed centre ``x``); load: the line-load schedule
-    ``((radius [m], line_load [N/m]), ...)`` with strictly increasing radii of the ridden
-    roll, interpolated linearly and held beyond the ends (empty: no load); bounds and
-    meanings: :data:`KEYS`."""
+    """``[[rider]]``: a rider roll resting on the paper roll it ``rides``, its centre ``x``
+    fixed, under the line-load schedule ``load`` (``((radius, line_load), ...)``, empty:
+    no load); keys, units, bounds and meanings: :data:`KEYS`."""
 
     name: str
     rides: str
@@ -52,11 +52,6 @@ class RiderPart:
 
 
 # ---- behaviour (the part protocol, :class:`~winder.parts._base.BodyElement`) -------------
-from typing import Any  # noqa: E402
-
-from winder.parts._base import RigidDisc  # noqa: E402
-
-
 class RiderBody(RigidDisc):
     """A rider roll: free along ``z``, sense +1, its centre first guessed on top of the
     roll it rides; ``rides`` and its line-load schedule ``load`` are read by the
@@ -65,6 +60,22 @@ class RiderBody(RigidDisc):
     table = "rider"
     role = "rider"
     place_key = "x"
+    KEYS = KEYS
+    part_cls = RiderPart
+
+    @classmethod
+    def fixed_centre(cls, part: Any) -> bool:
+        return False
+
+    @classmethod
+    def initial_circle(cls, part: Any) -> None:
+        """Left out of the overlap check: the machine places a rider on top of the roll
+        it rides (the twin-drum winder of spec §10 starts it inside the drums' circles)."""
+        return None
+
+    def drawing(self) -> Drawing:
+        """As long as the roll it rides."""
+        return Drawing(colour="rider", width_of=self.rides)
 
     def __init__(self, part: Any, placed: Any) -> None:
         super().__init__(part)

@@ -4,13 +4,24 @@ inertia grow as paper is wound on (``wound``) or shrink as it is paid off
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
 
+from winder._args import show
 from winder._schema import Channel, Key, Table
-from winder.parts.drum import CENTRE, NAME
+from winder.model.com_offset import max_com_offset
+from winder.model.locked_modes import AT_CORE, CORE_AUTO, ModeKind
+from winder.model.mass_law import paper_roll_mass
+from winder.parts._base import BodyElement, Drawing, SubTable, TableReader
+from winder.parts._keys import CENTRE, NAME
 
-__all__ = ["RollPart", "ROLL_KINDS", "AXES", "UnwindTorqueDrive", "TensionControl",
-           "UNWIND_DRIVE_KINDS", "KEYS", "DRIVE_KEYS"]
+if TYPE_CHECKING:
+    from winder.model.machine import BodyState, Evaluation, Machine
+
+__all__ = ["RollPart", "RollBody", "ROLL_KINDS", "AXES", "UnwindTorqueDrive",
+           "TensionControl", "UNWIND_DRIVE_KINDS", "KEYS", "DRIVE_KEYS", "check_core"]
 
 #: Kinds of paper roll: ``wound`` (radius grows) and ``unwinding`` (radius shrinks; fixed
 #: centre, the start of a web span).
@@ -96,19 +107,11 @@ class TensionControl:
 
 @dataclass(frozen=True, kw_only=True)
 class RollPart:
-    """``[[roll]]``: a paper roll.
-
-    name; kind ``"wound"`` or ``"unwinding"``; centre ``(x, z)`` [m] (initial guess of
-    the free coordinates, value of the fixed ones); free: the axes among ``("x", "z")``
-    (in that order) its centre moves along (an unwinding roll: none); sense ±1 (default
-    −1); core_radius [m], core_mass [kg], core_inertia [kg·m²], width [m],
-    initial_radius [m] (at least core_radius), initial_speed [rad/s] (operation sense),
-    com_offset ``0 <= e < min(r_c, √(J_c/m_c))`` [m], density [kg/m³] and caliper [m]
-    (from ``[paper]`` unless given; bounds and meanings of every key:
-    :data:`KEYS`); initial_height [m]: only from the
-    single-drum format's ``[roll] initial_height`` (a fixed initial centre ``z``, no
-    static solve), else None; drive: an unwinding roll's :class:`UnwindTorqueDrive` or
-    :class:`TensionControl`, None for a free one (a wound roll has none).
+    """``[[roll]]``: a paper roll; keys, units, bounds and meanings: :data:`KEYS` (an
+    unwinding roll's drive: :data:`DRIVE_KEYS`, None for a free one). density and caliper
+    come from ``[paper]`` unless given. initial_height [m]: only from the single-drum
+    format's ``[roll] initial_height`` (a fixed initial centre ``z``, no static solve),
+    else None.
     """
 
     name: str
@@ -129,19 +132,49 @@ class RollPart:
     drive: UnwindTorqueDrive | TensionControl | None = None
 
 
+def check_core(fail: Callable[[str, str, str], Exception], table: str,
+               roll: Mapping[str, Any]) -> None:
+    """A roll's initial radius (>= core) and centre-of-mass offset (inside the core, core
+    inertia about it positive); ``roll`` holds its parsed keys with initial_radius,
+    ``fail(table, key, message)`` the error to raise."""
+    r0, rc = roll["initial_radius"], roll["core_radius"]
+    if r0 < rc:
+        raise fail(table, "initial_radius",
+                   f"{r0!r} m is below core_radius {rc!r} m; valid: >= core_radius")
+    e, mc, jc = roll.get("com_offset", 0.0), roll["core_mass"], roll["core_inertia"]
+    e_max = max_com_offset(rc, mc, jc)
+    if not e < e_max:
+        raise fail(table, "com_offset",
+                   f"{e!r} m puts the centre of mass outside the core or "
+                   f"makes the core's inertia about it, core_inertia − core_mass "
+                   f"com_offset², non-positive (core_radius {rc!r} m, "
+                   f"core_inertia {jc!r} kg·m², core_mass "
+                   f"{mc!r} kg); valid: com_offset < min(core_radius, "
+                   f"√(core_inertia/core_mass)) = {e_max:.6g} m")
+
+
+def _parse_drive(reader: TableReader, label: str, kw: Mapping[str, Any],
+                 raw: Mapping[str, Any]) -> UnwindTorqueDrive | TensionControl | None:
+    """The drive of a roll (spec §6): only an unwinding roll may have one."""
+    if "drive" not in raw:
+        return None
+    if kw["kind"] != "unwinding":
+        raise reader.fail(label, "drive",
+                          f"{show(raw['drive'])}: a drive on a {kw['kind']} roll; only "
+                          "unwinding rolls (kind = 'unwinding') have a drive; a wound roll "
+                          "is turned by its nips; valid: remove drive")
+    dlabel = f"{label}.drive"
+    d = reader.keys(dlabel, raw["drive"], DRIVE_KEYS)
+    reader.kinds(dlabel, d, DRIVE_KEYS)
+    if d["kind"] == "torque":
+        return UnwindTorqueDrive(**d)
+    if "tension" not in d:
+        raise reader.fail(dlabel, "tension",
+                          "missing required key (kind = 'tension_control': the set-point [N])")
+    return TensionControl(**d)
+
+
 # ---- behaviour (the part protocol, :class:`~winder.parts._base.BodyElement`) -------------
-import math  # noqa: E402
-from collections.abc import Mapping  # noqa: E402
-from typing import TYPE_CHECKING, Any  # noqa: E402
-
-from winder.model.locked_modes import AT_CORE, CORE_AUTO, ModeKind  # noqa: E402
-from winder.model.mass_law import paper_roll_mass  # noqa: E402
-from winder.parts._base import BodyElement  # noqa: E402
-
-if TYPE_CHECKING:
-    from winder.model.machine import BodyState, Evaluation, Machine
-
-
 class RollBody(BodyElement):
     """A paper roll: its radius is a state that grows (``wound``) or shrinks
     (``unwinding``) as paper is wound on or paid off, ``ṙ = ±h · speed / 2π`` [m/s]
@@ -155,6 +188,10 @@ class RollBody(BodyElement):
 
     table = "roll"
     role = "roll"
+    KEYS = KEYS
+    SUB_TABLES = {"drive": SubTable(DRIVE_KEYS, (UnwindTorqueDrive, TensionControl),
+                                    heading="drive (unwinding rolls)")}
+    part_cls = RollPart
     CHANNELS = (
         Channel(name="ROLL_radius", unit="m", doc="radius r of a paper roll"),
         Channel(name="ROLL_mass", unit="kg", doc="mass m(r)"),
@@ -179,6 +216,37 @@ class RollBody(BodyElement):
         self.drives = ("tension_control",) if kind == "tension_control" else ()
         self.setpoint_inputs = (f"{n}.tension_setpoint",) if self.drives else ()
         self.com_offset = part.com_offset
+
+    @classmethod
+    def parse(cls, reader: TableReader, label: str, raw: Any) -> RollPart:
+        """Its keys, paper defaults, core and drive (spec §1, §8)."""
+        kw = reader.keys(label, raw, KEYS)
+        kw.setdefault("kind", "wound")
+        if kw["kind"] == "unwinding":
+            kw.setdefault("free", ())
+            if kw["free"]:
+                raise reader.fail(label, "free",
+                                  f"{show(list(kw['free']))}: an unwinding roll's centre is "
+                                  "fixed (docs/model.md §1); valid: [] (or leave free out)")
+        kw["drive"] = _parse_drive(reader, label, kw, raw)
+        kw.setdefault("initial_radius", kw["core_radius"])
+        for key in ("density", "caliper"):
+            if key not in kw:
+                if reader.paper is None:
+                    raise reader.fail(label, key, "missing required key (the scene has no "
+                                                  f"[paper] {key} to default to)")
+                kw[key] = getattr(reader.paper, key)
+        check_core(reader.fail, label, kw)
+        return RollPart(**kw)
+
+    @classmethod
+    def initial_circle(cls, part: Any) -> tuple[tuple[float, float], float]:
+        return tuple(part.centre), part.initial_radius
+
+    def drawing(self) -> Drawing:
+        """Its core, and its paper scaled by its radius; the centre-of-mass marker."""
+        return Drawing(colour="paper", width=self.part.width,
+                       core_radius=self.part.core_radius, com_offset=self.part.com_offset)
 
     @property
     def initial_radius(self) -> float:

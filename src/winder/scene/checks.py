@@ -6,78 +6,85 @@ overlapping bodies without a nip. Each error names the file, the table and the k
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from winder._args import show
 from winder._errors import SceneError
-from winder.model.com_offset import max_com_offset
-from winder.parts import DrumPart, NipPart, RiderPart, RollPart, WebPart
+from winder.parts import PARTS, NipPart, RollPart, WebPart
+from winder.parts.roll import check_core
 from winder.scene.parse import fail
 
 __all__ = ["check_roll_core", "check_references", "check_overlaps"]
 
+#: The parts of each body type by its :data:`~winder.parts.PARTS` attribute.
+Bodies = Mapping[str, Sequence[Any]]
+
 
 def check_roll_core(source: str, table: str, roll: dict[str, Any]) -> None:
-    """A roll's initial radius (>= core) and centre-of-mass offset (inside the core, core
-    inertia about it positive); ``roll`` holds its parsed keys with initial_radius."""
-    r0, rc = roll["initial_radius"], roll["core_radius"]
-    if r0 < rc:
-        raise fail(source, table, "initial_radius",
-                    f"{r0!r} m is below core_radius {rc!r} m; valid: >= core_radius")
-    e, mc, jc = roll.get("com_offset", 0.0), roll["core_mass"], roll["core_inertia"]
-    e_max = max_com_offset(rc, mc, jc)
-    if not e < e_max:
-        raise fail(source, table, "com_offset",
-                    f"{e!r} m puts the centre of mass outside the core or "
-                    f"makes the core's inertia about it, core_inertia − core_mass "
-                    f"com_offset², non-positive (core_radius {rc!r} m, "
-                    f"core_inertia {jc!r} kg·m², core_mass "
-                    f"{mc!r} kg); valid: com_offset < min(core_radius, "
-                    f"√(core_inertia/core_mass)) = {e_max:.6g} m")
+    """A roll's initial radius (>= core) and centre-of-mass offset
+    (:func:`winder.parts.roll.check_core`); ``roll`` holds its parsed keys with
+    initial_radius."""
+    check_core(lambda t, k, m: fail(source, t, k, m), table, roll)
 
 
-def check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
-                      riders: list[RiderPart], nips: list[NipPart],
+def _types(bodies: Bodies) -> list[tuple[Any, Sequence[Any]]]:
+    """``(element class, parts)`` of each registered body type, in registration order."""
+    return [(cls, bodies.get(attr, ())) for attr, cls in PARTS.items()]
+
+
+def _tables_text() -> str:
+    """``a [[drum]], [[roll]] or [[rider]]``: the registered body types' tables."""
+    tables = [f"[[{cls.table}]]" for cls in PARTS.values()]
+    return "a " + (", ".join(tables[:-1]) + " or " + tables[-1] if len(tables) > 1
+                   else tables[0])
+
+
+def check_references(source: str, bodies: Bodies, nips: list[NipPart],
                       webs: list[tuple[str, WebPart]]) -> None:
     """Unique names, and every ``a``, ``b``, ``rides``, ``entry_nip``, ``from`` naming a
     part of the right kind; nips that can be assembled; every wound roll fed by exactly
     one web (``webs``: ``(label, web)``), one span per unwinding roll (machines spec
-    §3, §8)."""
+    §3, §8). ``bodies``: the parts of each body type (:data:`~winder.parts.PARTS`)."""
+    types = _types(bodies)
+    rolls: Sequence[RollPart] = bodies.get("rolls", ())
+    riders: Sequence[Any] = bodies.get("riders", ())
     kinds: dict[str, str] = {}
-    for kind, parts in (("drum", drums), ("roll", rolls), ("rider", riders), ("nip", nips)):
+    for kind, parts in (*((cls.table, parts) for cls, parts in types), ("nip", nips)):
         for i, p in enumerate(parts):
             if p.name in kinds:
                 raise fail(source, f"{kind} #{i + 1}", "name",
                             f"{p.name!r} is already the name of {kinds[p.name]} {p.name!r}; "
                             f"every part needs its own name (taken: {', '.join(kinds)})")
             kinds[p.name] = kind
-    bodies = [n for n, k in kinds.items() if k != "nip"]
-    if not bodies:
-        raise SceneError(f"{source}: a scene of parts needs at least one body: a [[drum]], "
-                         "[[roll]] or [[rider]]")
-    fixed = {d.name for d in drums} | {r.name for r in rolls if not r.free}
+    body_names = [n for n, k in kinds.items() if k != "nip"]
+    if not body_names:
+        raise SceneError(f"{source}: a scene of parts needs at least one body: "
+                         f"{_tables_text()}")
+    fixed = {p.name for cls, parts in types for p in parts if cls.fixed_centre(p)}
     pairs: dict[frozenset[str], str] = {}
     for nip in nips:
         label = f"nip {nip.name!r}"
         for key in ("a", "b"):
             ref = getattr(nip, key)
-            if kinds.get(ref) not in ("drum", "roll", "rider"):
+            if ref not in body_names:
                 what = f"is {kinds[ref]} {ref!r}, not a body" if ref in kinds else \
                     "is not a body of the scene"
-                raise fail(source, label, key, f"{show(ref)} {what}; a nip joins two "
-                                                f"bodies; valid names: {', '.join(bodies)}")
+                raise fail(source, label, key,
+                           f"{show(ref)} {what}; a nip joins two bodies; valid names: "
+                           f"{', '.join(body_names)}")
         if nip.a == nip.b:
             raise fail(source, label, "b",
                         f"{nip.b!r} is also a: a nip joins two different bodies; valid "
-                        f"names: {', '.join(n for n in bodies if n != nip.a) or '(none)'}")
+                        "names: "
+                        f"{', '.join(n for n in body_names if n != nip.a) or '(none)'}")
         if nip.a in fixed and nip.b in fixed:
             raise fail(source, label, "b",
                         f"{nip.b!r}: a nip between two bodies with fixed centres "
                         f"({kinds[nip.a]} {nip.a!r} and {kinds[nip.b]} {nip.b!r}) cannot be "
                         "assembled: neither can move to carry its normal force; valid "
                         "names: a roll free to move or a rider: "
-                        f"{', '.join(n for n in bodies if n not in fixed) or '(none)'}")
+                        f"{', '.join(n for n in body_names if n not in fixed) or '(none)'}")
         pair = frozenset((nip.a, nip.b))
         if pair in pairs:
             raise fail(source, label, "b", f"{nip.b!r}: nip {pairs[pair]!r} already joins "
@@ -98,6 +105,16 @@ def check_references(source: str, drums: list[DrumPart], rolls: list[RollPart],
                         f"{rider.name!r} (the rider rests on its roll through a nip); "
                         "declare one; nips: "
                         f"{', '.join(f'{n.name} ({n.a}, {n.b})' for n in nips) or '(none)'}")
+    for cls, parts in types:  # any other reference of a body type's keys: to a body
+        refs = [k.name for k in cls.KEYS if k.kind == "ref"]
+        for p in parts:
+            for key in refs:
+                ref = getattr(p, key, None)
+                if ref is not None and ref not in body_names:
+                    what = f"is {kinds[ref]} {ref!r}, not a body" if ref in kinds else \
+                        "is not a body of the scene"
+                    raise fail(source, f"{cls.table} {p.name!r}", key,
+                               f"{show(ref)} {what}; valid names: {', '.join(body_names)}")
     wound = [r.name for r in rolls if r.kind == "wound"]
     entries = [n.name for n in nips if kinds[n.a] == "drum" and n.b in wound]
     if not webs and wound:
@@ -192,18 +209,19 @@ def _check_span(source: str, kinds: Mapping[str, str], rolls: list[RollPart],
                            "feeds, or make it kind = 'wound' with a web of its own"))
 
 
-def check_overlaps(source: str, drums: list[DrumPart], rolls: list[RollPart],
-                    nips: list[NipPart]) -> None:
-    """No two drums or rolls whose circles overlap at the start (their ``centre`` and
-    initial radius) without a nip between them (spec §8): nothing would carry the force
-    between them. Riders are left out: the machine places a rider on top of the roll it
-    rides, and the twin-drum winder of spec §10 starts its rider inside the drums'
-    circles (a small set in the valley), a contact it does not model."""
+def check_overlaps(source: str, bodies: Bodies, nips: list[NipPart]) -> None:
+    """No two bodies whose circles overlap at the start (each type's ``initial_circle``:
+    its ``centre`` and initial radius) without a nip between them (spec §8): nothing would
+    carry the force between them. A type may leave its bodies out (a rider: the machine
+    places it on top of the roll it rides, and the twin-drum winder of spec §10 starts its
+    rider inside the drums' circles, a contact it does not model)."""
     circles: list[tuple[str, str, float, float, float]] = []  # kind, name, x, z, radius
-    for d in drums:
-        circles.append(("drum", d.name, *d.centre, d.radius))
-    for r in rolls:
-        circles.append(("roll", r.name, *r.centre, r.initial_radius))
+    for cls, parts in _types(bodies):
+        for p in parts:
+            circle = cls.initial_circle(p)
+            if circle is not None:
+                (x, z), r = circle
+                circles.append((cls.table, p.name, x, z, r))
     joined = {frozenset((n.a, n.b)) for n in nips}
     for i, (ka, a, xa, za, ra) in enumerate(circles):
         for kb, b, xb, zb, rb in circles[i + 1:]:

@@ -10,13 +10,13 @@ from winder._errors import ArgumentError
 from winder._schema import Key, Table
 from winder.scene.legacy import LEGACY_TABLES
 from winder.scene.paths import get_path
-from winder.scene.schema import ARRAYS, TABLES, effect_settings
+from winder.scene.schema import ARRAYS, TABLES, Live, effect_settings
 
 __all__ = ["ALL_TABLES", "find_key", "key_unit", "key_doc"]
 
 #: Every table of both formats by schema name (``drum`` the single-drum table, ``drum[]``
-#: an element of ``[[drum]]``).
-ALL_TABLES: dict[str, Table] = {**LEGACY_TABLES, **TABLES}
+#: an element of ``[[drum]]``; live, like :data:`~winder.scene.schema.TABLES`).
+ALL_TABLES: Mapping[str, Table] = Live(lambda: {**LEGACY_TABLES, **TABLES})
 
 
 def find_key(table: str, key: str) -> Key:

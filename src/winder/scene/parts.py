@@ -1,43 +1,48 @@
-"""Parsing a scene of parts (machines spec §8): the arrays of tables ``[[drum]]``,
-``[[roll]]``, ``[[rider]]``, ``[[nip]]`` and the webs ``[web]``/``[[web]]`` with their
-``[web.span]``, each against its part's declared keys, then the checks across them
-(:mod:`winder.scene.checks`)."""
+"""Parsing a scene of parts (machines spec §8): the arrays of tables of the registered body
+types (``[[drum]]``, ``[[roll]]``, ``[[rider]]``, ...: :data:`winder.parts.PARTS`, each
+parsed by its element class's ``parse``), ``[[nip]]`` and the webs ``[web]``/``[[web]]``
+with their ``[web.span]``, each against its part's declared keys, then the checks across
+them (:mod:`winder.scene.checks`)."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 from winder._args import show
 from winder._errors import SceneError
-from winder.parts import (
-    ContactLaw,
-    DrumPart,
-    FrictionLaw,
-    NipPart,
-    RiderPart,
-    RollPart,
-    SpanPart,
-    SpeedProfileDrive,
-    TensionControl,
-    TorqueDrive,
-    UnwindTorqueDrive,
-    WebPart,
-)
-from winder.parts.drum import DRIVE_KEYS as DRUM_DRIVE_KEYS
-from winder.parts.drum import KEYS as DRUM_KEYS
+from winder._schema import Table
+from winder.parts import PARTS, ContactLaw, FrictionLaw, NipPart, SpanPart, WebPart
 from winder.parts.nip import CONTACT_KEYS, FRICTION_KEYS
 from winder.parts.nip import KEYS as NIP_KEYS
-from winder.parts.rider import KEYS as RIDER_KEYS
-from winder.parts.roll import DRIVE_KEYS as UNWIND_DRIVE_KEYS
-from winder.parts.roll import KEYS as ROLL_KEYS
 from winder.parts.web import KEYS as WEB_KEYS
 from winder.parts.web import SPAN_KEYS
-from winder.scene.checks import check_overlaps, check_references, check_roll_core
+from winder.scene.checks import check_overlaps, check_references
 from winder.scene.parse import check_drive_keys, check_part_name, fail, parse_table
 from winder.scene.tables import Effects, Paper
 
-__all__ = ["parse_parts"]
+__all__ = ["parse_parts", "Reader"]
+
+
+@dataclass(frozen=True)
+class Reader:
+    """What a body type's ``parse`` reads its table with
+    (:class:`winder.parts.TableReader`): the scene's file, ``[paper]`` and ``[effects]``,
+    and the parser of :mod:`winder.scene.parse`."""
+
+    source: str
+    paper: Paper | None
+    effects: Effects
+
+    def keys(self, label: str, raw: Any, table: Table) -> dict[str, Any]:
+        return parse_table(self.source, label, raw, table)
+
+    def kinds(self, label: str, parsed: Mapping[str, Any], table: Table) -> None:
+        check_drive_keys(self.source, label, parsed, table)
+
+    def fail(self, label: str, key: str, message: str) -> SceneError:
+        return fail(self.source, label, key, message)
 
 
 def _elements(source: str, data: Mapping[str, Any], array: str, *, named: bool = True
@@ -64,50 +69,6 @@ def _elements(source: str, data: Mapping[str, Any], array: str, *, named: bool =
         name = check_part_name(source, label, element["name"])
         out.append((f"{array} {name!r}", element))
     return out
-
-
-def _parse_roll_drive(source: str, label: str, kw: dict[str, Any], raw: Mapping[str, Any]
-                      ) -> UnwindTorqueDrive | TensionControl | None:
-    """The drive of a roll (spec §6): only an unwinding roll may have one."""
-    if "drive" not in raw:
-        return None
-    if kw["kind"] != "unwinding":
-        raise fail(source, label, "drive",
-                    f"{show(raw['drive'])}: a drive on a {kw['kind']} roll; only unwinding "
-                    "rolls (kind = 'unwinding') have a drive; a wound roll is turned by its "
-                    "nips; valid: remove drive")
-    dlabel = f"{label}.drive"
-    d = parse_table(source, dlabel, raw["drive"], UNWIND_DRIVE_KEYS)
-    check_drive_keys(source, dlabel, d, UNWIND_DRIVE_KEYS)
-    if d["kind"] == "torque":
-        return UnwindTorqueDrive(**d)
-    if "tension" not in d:
-        raise fail(source, dlabel, "tension",
-                    "missing required key (kind = 'tension_control': the set-point [N])")
-    return TensionControl(**d)
-
-
-def _parse_roll(source: str, label: str, raw: Mapping[str, Any], paper: Paper | None
-                ) -> RollPart:
-    """One ``[[roll]]`` element: its keys, paper defaults, core and drive (spec §1, §8)."""
-    kw = parse_table(source, label, raw, ROLL_KEYS)
-    kw.setdefault("kind", "wound")
-    if kw["kind"] == "unwinding":
-        kw.setdefault("free", ())
-        if kw["free"]:
-            raise fail(source, label, "free",
-                        f"{show(list(kw['free']))}: an unwinding roll's centre is fixed "
-                        "(docs/model.md §1); valid: [] (or leave free out)")
-    kw["drive"] = _parse_roll_drive(source, label, kw, raw)
-    kw.setdefault("initial_radius", kw["core_radius"])
-    for key in ("density", "caliper"):
-        if key not in kw:
-            if paper is None:
-                raise fail(source, label, key, "missing required key (the scene has no "
-                                                f"[paper] {key} to default to)")
-            kw[key] = getattr(paper, key)
-    check_roll_core(source, label, kw)
-    return RollPart(**kw)
 
 
 def _parse_webs(source: str, data: Mapping[str, Any]) -> list[tuple[str, WebPart]]:
@@ -144,25 +105,12 @@ def _parse_webs(source: str, data: Mapping[str, Any]) -> list[tuple[str, WebPart
 def parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
                  paper: Paper | None) -> dict[str, Any]:
     """The parts of a scene (machines spec §8): each element's keys, then names and
-    references."""
-    drums = []
-    for label, raw in _elements(source, data, "drum"):
-        kw = parse_table(source, label, raw, DRUM_KEYS)
-        dlabel = f"{label}.drive"
-        d = parse_table(source, dlabel, raw["drive"], DRUM_DRIVE_KEYS)
-        check_drive_keys(source, dlabel, d, DRUM_DRIVE_KEYS)
-        if d["kind"] == "speed_profile":
-            if "web_speed" not in d:
-                raise fail(source, dlabel, "web_speed",
-                            "missing required key (kind = 'speed_profile')")
-            drive: SpeedProfileDrive | TorqueDrive = SpeedProfileDrive(**d)
-        else:
-            drive = TorqueDrive(**d)
-        drums.append(DrumPart(**kw, drive=drive))
-    rolls = [_parse_roll(source, label, raw, paper)
-             for label, raw in _elements(source, data, "roll")]
-    riders = [RiderPart(**parse_table(source, label, raw, RIDER_KEYS))
-              for label, raw in _elements(source, data, "rider")]
+    references; the keyword arguments ``bodies`` (by :data:`~winder.parts.PARTS`
+    attribute), ``nips`` and ``webs`` of :class:`~winder.scene.scene.Scene`."""
+    reader = Reader(source, paper, effects)
+    bodies = {attr: tuple(cls.parse(reader, label, raw)
+                          for label, raw in _elements(source, data, cls.table))
+              for attr, cls in PARTS.items()}
     nips = []
     for label, raw in _elements(source, data, "nip"):
         kw = parse_table(source, label, raw, NIP_KEYS)
@@ -174,7 +122,6 @@ def parse_parts(source: str, data: Mapping[str, Any], effects: Effects,
             kw[key] = law(**parse_table(source, f"{label}.{key}", raw.get(key, {}), keys))
         nips.append(NipPart(**kw))
     webs = _parse_webs(source, data)
-    check_references(source, drums, rolls, riders, nips, webs)
-    check_overlaps(source, drums, rolls, nips)
-    return {"drums": tuple(drums), "rolls": tuple(rolls), "riders": tuple(riders),
-            "nips": tuple(nips), "webs": tuple(w for _, w in webs)}
+    check_references(source, bodies, nips, webs)
+    check_overlaps(source, bodies, nips)
+    return {"bodies": bodies, "nips": tuple(nips), "webs": tuple(w for _, w in webs)}

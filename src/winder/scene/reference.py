@@ -26,23 +26,7 @@ from winder._schema import NO_DEFAULT, Channel, Key, Table
 from winder._schema import format_number as _num
 from winder.forces import DRIVES, FORCES
 from winder.model.channels import GENERIC_CHANNELS, TIME
-from winder.parts import (
-    PARTS,
-    ContactLaw,
-    DrumPart,
-    FrictionLaw,
-    NipPart,
-    RiderPart,
-    RollPart,
-    SpanPart,
-    SpeedProfileDrive,
-    TensionControl,
-    TorqueDrive,
-    UnwindTorqueDrive,
-    WebPart,
-)
-from winder.parts.drum import DRIVE_KEYS as DRUM_DRIVE_KEYS
-from winder.parts.roll import DRIVE_KEYS as UNWIND_DRIVE_KEYS
+from winder.parts import PARTS, ContactLaw, FrictionLaw, NipPart, SpanPart, WebPart
 from winder.scene.keys import ALL_TABLES
 from winder.scene.legacy import COLUMNS, Drive, Drum, Roll
 from winder.scene.schema import effect_names, effect_settings
@@ -52,27 +36,46 @@ __all__ = ["reference", "main", "CHANNEL_DECLARATIONS", "channel_declarations",
            "channel_pattern"]
 
 #: The dataclasses whose defaults a schema table's keys take (the first that has the
-#: field; ``from`` of ``[web.span]`` is the field ``source``).
+#: field; ``from`` of ``[web.span]`` is the field ``source``); the body types' from
+#: :data:`PARTS` (:func:`_defaults_from`).
 _DEFAULTS_FROM: dict[str, tuple[type, ...]] = {
     "scene": (SceneInfo,), "effects": (Effects,), "drum": (Drum,),
     "drum.drive": (Drive,), "roll": (Roll,), "paper": (Paper,),
     "contact": (ContactLaw,), "friction": (FrictionLaw,), "solver": (Solver,),
-    "drum[]": (DrumPart,), "drum[].drive": (SpeedProfileDrive, TorqueDrive),
-    "roll[]": (RollPart,), "roll[].drive": (UnwindTorqueDrive, TensionControl),
-    "rider[]": (RiderPart,), "nip[]": (NipPart,), "nip[].contact": (ContactLaw,),
+    "nip[]": (NipPart,), "nip[].contact": (ContactLaw,),
     "nip[].friction": (FrictionLaw,), "web": (WebPart,), "web.span": (SpanPart,),
 }
 
-#: Every result channel's declaration (:class:`~winder._schema.Channel`): the machine's
-#: generic ones (:mod:`winder.model.channels`), then each body's (:data:`PARTS`), each
-#: force element's (:data:`FORCES`, :data:`DRIVES`), in that order.
-CHANNEL_DECLARATIONS: tuple[Channel, ...] = (
-    *GENERIC_CHANNELS, *(c for cls in PARTS.values() for c in cls.CHANNELS),
-    *(c for cls in (*FORCES.values(), *DRIVES.values()) for c in cls.CHANNELS))
 
-#: What each placeholder of a channel's name stands for: the kinds of part it names.
-_PLACEHOLDER_KINDS = {"BODY": ("drum", "roll", "rider"), "ROLL": ("roll",),
-                      "RIDER": ("rider",), "NIP": ("nip",)}
+def _defaults_from(table: str) -> tuple[type, ...]:
+    for cls in PARTS.values():
+        if table == f"{cls.table}[]":
+            return (cls.part_cls,)
+        for key, sub in cls.SUB_TABLES.items():
+            if table == f"{cls.table}[].{key}":
+                return sub.defaults
+    return _DEFAULTS_FROM.get(table, ())
+
+
+def _declarations() -> tuple[Channel, ...]:
+    """Every result channel's declaration now registered: the machine's generic ones
+    (:mod:`winder.model.channels`), then each body's (:data:`PARTS`), each force
+    element's (:data:`FORCES`, :data:`DRIVES`), in that order."""
+    return (*GENERIC_CHANNELS, *(c for cls in PARTS.values() for c in cls.CHANNELS),
+            *(c for cls in (*FORCES.values(), *DRIVES.values()) for c in cls.CHANNELS))
+
+
+#: Every result channel's declaration (:class:`~winder._schema.Channel`) of the built-in
+#: parts and effects (:func:`_declarations` at import).
+CHANNEL_DECLARATIONS: tuple[Channel, ...] = _declarations()
+
+
+def _placeholder_kinds(placeholder: str) -> tuple[str, ...]:
+    """The kinds of part a placeholder of a channel's name stands for (``BODY``: every
+    registered body type's table)."""
+    if placeholder == "BODY":
+        return tuple(cls.table for cls in PARTS.values())
+    return {"ROLL": ("roll",), "RIDER": ("rider",), "NIP": ("nip",)}[placeholder]
 
 
 def _kind_text(key: Key) -> str:
@@ -105,7 +108,7 @@ def _default_text(table: str, key: Key) -> str:
     if key.default is not NO_DEFAULT:
         return _value_text(key.default)
     field = "source" if key.name == "from" else key.name
-    for cls in _DEFAULTS_FROM.get(table, ()):
+    for cls in _defaults_from(table):
         for f in dataclasses.fields(cls):
             if f.name == field and f.default is not dataclasses.MISSING:
                 return _value_text(f.default)
@@ -127,35 +130,56 @@ def _table(table: str, keys: Table) -> list[str]:
     return lines
 
 
-#: Headings of the schema tables (TOML spelling).
+#: Headings of the schema tables (TOML spelling); the body types' from :data:`PARTS`
+#: (:func:`_heading`).
 _HEADINGS = {
     "scene": "[scene]", "effects": "[effects]", "solver": "[solver]", "paper": "[paper]",
     "drum": "[drum]", "drum.drive": "[drum.drive]", "roll": "[roll]",
     "contact": "[contact]", "friction": "[friction]",
-    "drum[]": "[[drum]]", "drum[].drive": "[[drum]] drive",
-    "roll[]": "[[roll]]", "roll[].drive": "[[roll]] drive (unwinding rolls)",
-    "rider[]": "[[rider]]", "nip[]": "[[nip]]", "nip[].contact": "[[nip]] contact",
+    "nip[]": "[[nip]]", "nip[].contact": "[[nip]] contact",
     "nip[].friction": "[[nip]] friction", "web": "[web] or [[web]] (one per wound roll)",
     "web.span": "[web.span]",
 }
-_DRIVE_NOTE = {
+_NOTES = {
     "paper": "The default paper of every roll: optional in a scene of parts (each "
              "`[[roll]]` may give its own `density` and `caliper`), required in the "
              "single-drum format. Where the table is given, both keys are required.",
     "drum.drive": "Keys by kind: " + "; ".join(
         f"`{k}`: {', '.join(v)}" for k, v in reversed(ALL_TABLES["drum.drive"].kinds.items()))
     + ".",
-    "drum[].drive": "Keys by kind: " + "; ".join(
-        f"`{k}`: {', '.join(v)}" for k, v in DRUM_DRIVE_KEYS.kinds.items()) + ".",
-    "roll[].drive": "Keys by kind: " + "; ".join(
-        f"`{k}`: {', '.join(v)}" for k, v in UNWIND_DRIVE_KEYS.kinds.items()) + ".",
 }
 
 
+def _heading(table: str) -> str:
+    for cls in PARTS.values():
+        if table == f"{cls.table}[]":
+            return f"[[{cls.table}]]"
+        for key, sub in cls.SUB_TABLES.items():
+            if table == f"{cls.table}[].{key}":
+                return f"[[{cls.table}]] {sub.heading or key}"
+    return _HEADINGS[table]
+
+
+def _note(table: str) -> str | None:
+    """The note under a heading: a table's own, else its keys by kind (a drive)."""
+    if table in _NOTES:
+        return _NOTES[table]
+    kinds = ALL_TABLES[table].kinds
+    return "Keys by kind: " + "; ".join(
+        f"`{k}`: {', '.join(v)}" for k, v in kinds.items()) + "." if kinds else None
+
+
+def _body_sections() -> tuple[str, ...]:
+    """Each registered body type's table, then its sub-tables."""
+    return tuple(t for cls in PARTS.values()
+                 for t in (f"{cls.table}[]", *(f"{cls.table}[].{k}" for k in cls.SUB_TABLES)))
+
+
 def _section(table: str) -> list[str]:
-    out = [f"### `{_HEADINGS[table]}`", ""]
-    if table in _DRIVE_NOTE:
-        out += [_DRIVE_NOTE[table], ""]
+    out = [f"### `{_heading(table)}`", ""]
+    note = _note(table)
+    if note is not None:
+        out += [note, ""]
     return out + _table(table, ALL_TABLES[table]) + [""]
 
 
@@ -175,6 +199,9 @@ def _effect_sections() -> list[str]:
 
 def reference() -> str:
     """The text of ``docs/scene-reference.md`` (Markdown)."""
+    arrays = ", ".join(f"`[[{cls.table}]]`" for cls in PARTS.values()) + ", `[[nip]]`"
+    tables = [cls.table for cls in PARTS.values()]
+    bodies = ", ".join(tables[:-1]) + " or " + tables[-1] if len(tables) > 1 else tables[0]
     lines = [
         "# Scene reference",
         "",
@@ -183,7 +210,7 @@ def reference() -> str:
         "schema.py, the effects' settings); do not edit by hand. -->",
         "",
         "Scene files are TOML. There are two formats: **scenes of parts** (arrays of "
-        "tables `[[drum]]`, `[[roll]]`, `[[rider]]`, `[[nip]]` and a `[web]` table) and "
+        f"tables {arrays} and a `[web]` table) and "
         "the **single-drum format** (single tables `[drum]`, `[roll]`, `[contact]`, "
         "`[friction]`: one drum, one roll, one nip). `[scene]`, `[effects]` and `[solver]` "
         "are common to both. Units are SI; the physics behind each key (frames, senses, "
@@ -208,8 +235,8 @@ def reference() -> str:
               "(`nip.rear_nip.contact.stiffness`). References (`a`, `b`, `rides`, "
               "`entry_nip`, `from`) must name an existing part of the right kind. Every "
               "wound roll needs a web entering it at a nip whose `a` is a drum.", ""]
-    for t in ("paper", "drum[]", "drum[].drive", "roll[]", "roll[].drive", "rider[]",
-              "nip[]", "nip[].contact", "nip[].friction", "web", "web.span"):
+    for t in ("paper", *_body_sections(), "nip[]", "nip[].contact", "nip[].friction", "web",
+              "web.span"):
         lines += _section(t)
     lines += ["## Single-drum format", "",
               "Means: drum \"drum\" at the origin (sense +1), roll \"roll\" free along z "
@@ -231,7 +258,7 @@ def reference() -> str:
     for column, (decl, owner) in COLUMNS.items():
         lines.append(f"| `{column}` | {decl.unit} | `{decl.of(owner)}` | {_cell(decl.doc)} |")
     lines += ["", "### Scenes of parts", "",
-              "`BODY` is the name of any drum, roll or rider, `ROLL` of a paper roll, "
+              f"`BODY` is the name of any {bodies}, `ROLL` of a paper roll, "
               "`RIDER` of a rider, `NIP` of a nip; `web_speed` and `web_force` exist with a "
               "web, `span_tension` with `[web.span]`, `tension_error` with an unwind of kind "
               "`tension_control`. With several webs, `web_speed` and `web_force` are "
@@ -239,21 +266,21 @@ def reference() -> str:
               "spans, `span_tension` and `tension_error` are `WEB_span_tension` and "
               "`WEB_tension_error`.", "",
               "| channel | unit | meaning |", "|---|---|---|"]
-    for decl in CHANNEL_DECLARATIONS:
+    for decl in _declarations():
         lines.append(f"| `{decl.name}` | {decl.unit} | {_cell(decl.doc)} |")
     return "\n".join(lines) + "\n"
 
 
 def channel_declarations(name: str, parts: dict[str, str], webs: Iterable[str] = ()
                          ) -> list[Channel]:
-    """The declarations (:data:`CHANNEL_DECLARATIONS`) the channel ``name`` of a scene of
+    """The declarations (:func:`_declarations`) the channel ``name`` of a scene of
     parts matches: a placeholder's with the name of a part of its kind, a web's alone or
     after the name of one of ``webs`` (``WEB_web_speed``); ``parts`` maps every part name
     to its kind (``drum``, ``roll``, ``rider``, ``nip``)."""
     out = []
-    for decl in CHANNEL_DECLARATIONS:
+    for decl in _declarations():
         if decl.placeholder:
-            owners = [p for p, k in parts.items() if k in _PLACEHOLDER_KINDS[decl.placeholder]]
+            owners = [p for p, k in parts.items() if k in _placeholder_kinds(decl.placeholder)]
             if any(name == decl.of(p) for p in owners):
                 out.append(decl)
         elif name == decl.name or any(name == decl.of(f"{w}_") for w in webs):

@@ -11,7 +11,7 @@ from typing import Any
 
 from winder._args import show
 from winder._errors import ArgumentError, ArgumentTypeError
-from winder.parts import DrumPart, NipPart, RiderPart, RollPart, WebPart
+from winder.parts import PARTS, DrumPart, NipPart, RiderPart, RollPart, WebPart
 from winder.scene.legacy import (
     OWN_TABLES,
     SINGLE_DRUM,
@@ -32,8 +32,11 @@ __all__ = ["Scene", "scene_from_dict"]
 class Scene:
     """A complete winder scene. Build one with :func:`load_scene` or :func:`scene_from_dict`.
 
-    The parts (``drums``, ``rolls``, ``riders``, ``nips``, ``webs``) describe every scene;
-    ``web`` is the first (or only) web, or None.
+    The parts describe every scene: ``bodies``, the parts of each registered body type by
+    its :data:`winder.parts.PARTS` attribute (``{"drums": (...), "rolls": (...), ...}``,
+    each also an attribute: ``scene.drums``, ``scene.rolls``, ``scene.riders``, and
+    ``scene.discs`` for a type registered as ``"discs"``), ``nips`` and ``webs``; ``web``
+    is the first (or only) web, or None.
     A scene in the single-drum format (``legacy``) also has ``drum``, ``roll``,
     ``contact`` and ``friction``, and its parts are derived from them (machines spec §8):
     drum "drum" at the origin, sense +1; roll "roll" free in ``z`` at ``(0, R + r0)``,
@@ -53,9 +56,7 @@ class Scene:
     friction: LegacyFriction | None
     solver: Solver
     source: str = "<scene>"
-    drums: tuple[DrumPart, ...] = ()
-    rolls: tuple[RollPart, ...] = ()
-    riders: tuple[RiderPart, ...] = ()
+    bodies: Mapping[str, tuple[Any, ...]] = field(default_factory=dict, hash=False)
     nips: tuple[NipPart, ...] = ()
     web: WebPart | None = None
     webs: tuple[WebPart, ...] = ()
@@ -68,13 +69,45 @@ class Scene:
             assert self.roll is not None and self.paper is not None
             assert self.contact is not None and self.friction is not None
             parts = legacy_parts(self.drum, self.roll, self.paper, self.contact, self.friction)
+            bodies = {n: v for n, v in parts.items() if n in PARTS}
             for name, value in parts.items():
-                object.__setattr__(self, name, value)
+                if name not in bodies:
+                    object.__setattr__(self, name, value)
+        else:
+            bodies = dict(self.bodies)
+        unknown = [a for a in bodies if a not in PARTS]
+        if unknown:
+            raise ArgumentError(f"Scene: bodies {', '.join(map(repr, unknown))}: not a body "
+                                f"type; valid: {', '.join(PARTS)} (winder.parts.PARTS)")
+        # every registered type, in registration order (the machine builds them so)
+        object.__setattr__(self, "bodies", {a: tuple(bodies.get(a, ())) for a in PARTS})
         # ``webs`` is every web; ``web`` the first (or only) one, kept for code that reads a
         # single web; given only ``web``, ``webs`` is that one
         webs = tuple(self.webs) or ((self.web,) if self.web is not None else ())
         object.__setattr__(self, "webs", webs)
         object.__setattr__(self, "web", webs[0] if webs else None)
+
+    @property
+    def drums(self) -> tuple[DrumPart, ...]:
+        """The ``[[drum]]`` parts."""
+        return self.bodies.get("drums", ())
+
+    @property
+    def rolls(self) -> tuple[RollPart, ...]:
+        """The ``[[roll]]`` parts."""
+        return self.bodies.get("rolls", ())
+
+    @property
+    def riders(self) -> tuple[RiderPart, ...]:
+        """The ``[[rider]]`` parts."""
+        return self.bodies.get("riders", ())
+
+    def __getattr__(self, name: str) -> tuple[Any, ...]:
+        """``scene.ATTRIBUTE``: the parts of a body type registered as ``ATTRIBUTE``."""
+        bodies = self.__dict__.get("bodies", {})
+        if name in bodies or (name in PARTS and not name.startswith("_")):
+            return tuple(bodies.get(name, ()))
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @property
     def name(self) -> str:
@@ -121,8 +154,8 @@ class Scene:
                     "solver": _table_dict(self.solver)}
         if self.paper is not None:
             out["paper"] = _table_dict(self.paper)
-        for key, parts in (("drum", self.drums), ("roll", self.rolls), ("rider", self.riders),
-                           ("nip", self.nips)):
+        for key, parts in (*((cls.table, self.bodies.get(attr, ()))
+                             for attr, cls in PARTS.items()), ("nip", self.nips)):
             if parts:
                 out[key] = [_table_dict(p) for p in parts]
         for roll in out.get("roll", ()):

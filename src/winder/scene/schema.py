@@ -4,20 +4,24 @@ A part's keys are declared in its module under ``winder/parts/`` (``KEYS``), an 
 flag, meaning, default and settings on its force element (``[effects]`` is read from the
 registry :data:`winder.forces.FORCES`); this module declares the tables that are no
 part's (``[scene]``, ``[paper]``, ``[solver]``) and gathers every table of
-a scene of parts by its schema name (``drum[]``, ``drum[].drive``, ..., :data:`TABLES`).
+a scene of parts by its schema name (``drum[]``, ``drum[].drive``, ..., :data:`TABLES`):
+the body types' from the registry :data:`winder.parts.PARTS` (a type registered later is
+a table at once).
 The single-drum format's tables are :data:`winder.scene.legacy.LEGACY_TABLES`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator, Mapping, Sequence
+
 from winder._args import ATOL_MAX, RTOL_MAX
 from winder._schema import Key, Table
 from winder.forces import FORCES
-from winder.parts import drum, nip, rider, roll, web
+from winder.parts import PARTS, drum, nip, roll, web
 
 __all__ = ["EFFECT_NAMES", "METHODS", "BACKENDS", "DRIVE_KINDS", "MAX_SAMPLES", "MAX_NAME",
            "SCENE_KEYS", "EFFECTS_KEYS", "PAPER_KEYS", "SOLVER_KEYS", "TABLES", "ARRAYS",
-           "EffectsTable", "effect_names", "effect_settings"]
+           "EffectsTable", "effect_names", "effect_settings", "Live", "body_tables"]
 
 #: The built-in effects of ``[effects]``, in spec order: the force elements of
 #: :data:`winder.forces.FORCES` (:func:`effect_names` also those registered later).
@@ -96,18 +100,68 @@ SOLVER_KEYS = Table((
     Key(name="max_wall", unit="s", **_POS, doc="budget: most wall-clock time of a run"),
 ))
 
+class Live(Mapping[str, Table]):
+    """A mapping computed each time it is read (from the registries, so that a body type
+    or an effect registered later is in it at once)."""
+
+    def __init__(self, build: Callable[[], dict[str, Table]]) -> None:
+        self._build = build
+
+    def __getitem__(self, name: str) -> Table:
+        return self._build()[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._build())
+
+    def __len__(self) -> int:
+        return len(self._build())
+
+    def __repr__(self) -> str:
+        return f"Live({', '.join(self)})"
+
+
+def body_tables() -> dict[str, Table]:
+    """The tables of the registered body types (:data:`winder.parts.PARTS`) by schema
+    name: ``TABLE[]`` and each sub-table ``TABLE[].KEY``, in registration order."""
+    out: dict[str, Table] = {}
+    for cls in PARTS.values():
+        out[f"{cls.table}[]"] = cls.KEYS
+        for key, sub in cls.SUB_TABLES.items():
+            out[f"{cls.table}[].{key}"] = sub.keys
+    return out
+
+
+def _tables() -> dict[str, Table]:
+    return {"scene": SCENE_KEYS, "effects": EFFECTS_KEYS, "paper": PAPER_KEYS,
+            "solver": SOLVER_KEYS, **body_tables(),
+            "nip[]": nip.KEYS, "nip[].contact": nip.CONTACT_KEYS,
+            "nip[].friction": nip.FRICTION_KEYS, "web": web.KEYS, "web.span": web.SPAN_KEYS}
+
+
 #: Every table of a scene of parts by its schema name: ``NAME[]`` an element of the array
-#: of tables ``[[NAME]]``, ``.SUB`` its sub-table.
-TABLES: dict[str, Table] = {
-    "scene": SCENE_KEYS, "effects": EFFECTS_KEYS, "paper": PAPER_KEYS, "solver": SOLVER_KEYS,
-    "drum[]": drum.KEYS, "drum[].drive": drum.DRIVE_KEYS,
-    "roll[]": roll.KEYS, "roll[].drive": roll.DRIVE_KEYS,
-    "rider[]": rider.KEYS,
-    "nip[]": nip.KEYS, "nip[].contact": nip.CONTACT_KEYS, "nip[].friction": nip.FRICTION_KEYS,
-    "web": web.KEYS, "web.span": web.SPAN_KEYS,
-}
-#: Arrays of tables of a scene of parts.
-ARRAYS = ("drum", "roll", "rider", "nip")
+#: of tables ``[[NAME]]``, ``.SUB`` its sub-table (live: from the body registry).
+TABLES: Mapping[str, Table] = Live(_tables)
+
+
+class _Arrays(Sequence[str]):
+    """The arrays of tables of a scene of parts: each body type's table (registration
+    order), then ``nip`` (live, like :data:`TABLES`)."""
+
+    def _names(self) -> tuple[str, ...]:
+        return (*(cls.table for cls in PARTS.values()), "nip")
+
+    def __getitem__(self, i):  # type: ignore[no-untyped-def]
+        return self._names()[i]
+
+    def __len__(self) -> int:
+        return len(self._names())
+
+    def __repr__(self) -> str:
+        return repr(self._names())
+
+
+#: Arrays of tables of a scene of parts (``drum``, ``roll``, ``rider``, ..., ``nip``).
+ARRAYS: Sequence[str] = _Arrays()
 
 
 def effect_settings(effect: str) -> Table:

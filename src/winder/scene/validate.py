@@ -24,10 +24,12 @@ from winder.scene.schema import (
 )
 from winder.scene.tables import Effects, Paper, SceneInfo, Solver
 
-__all__ = ["scene_kwargs", "PART_TABLE_NAMES"]
+__all__ = ["scene_kwargs", "part_table_names"]
 
-#: The top-level tables of a scene of parts.
-PART_TABLE_NAMES = ("scene", "effects", "paper", *ARRAYS, "web", "solver")
+
+def part_table_names() -> tuple[str, ...]:
+    """The top-level tables of a scene of parts (a body type's from the registry)."""
+    return ("scene", "effects", "paper", *ARRAYS, "web", "solver")
 
 
 def _is_parts(source: str, data: Mapping[str, Any]) -> bool:
@@ -36,8 +38,9 @@ def _is_parts(source: str, data: Mapping[str, Any]) -> bool:
     ``[[rider]]``, ``[[nip]]`` or ``[web]`` makes it of parts. A table of the other format
     is an error."""
     old = legacy.is_legacy(data)
-    parts = not old and (any(isinstance(data.get(a), list) for a in ("drum", "roll"))
-                         or any(t in data for t in ("rider", "nip", "web")))
+    parts = not old and (any(isinstance(data.get(a), list) for a in ARRAYS)
+                         or any(t in data for t in (*ARRAYS, "web")
+                                if t not in legacy.TABLE_NAMES))
     for table in data:
         if old and table not in legacy.TABLE_NAMES:
             raise SceneError(
@@ -45,11 +48,11 @@ def _is_parts(source: str, data: Mapping[str, Any]) -> bool:
                 f"single-drum format ([drum] or [roll] is a single table); build a machine "
                 f"from parts with [[drum]] and [[roll]] (arrays of tables, each with a "
                 f"name); valid tables here: {', '.join(legacy.TABLE_NAMES)}")
-        if parts and table not in PART_TABLE_NAMES:
+        if parts and table not in part_table_names():
             raise SceneError(
                 f"{source}: [{table}]: a table of the single-drum format in a scene of "
                 f"parts; each [[nip]] has its own contact and friction; valid tables: "
-                f"{', '.join(PART_TABLE_NAMES)}")
+                f"{', '.join(part_table_names())}")
     return parts
 
 
@@ -60,9 +63,9 @@ def scene_kwargs(data: Any, *, source: str = "<scene>") -> dict[str, Any]:
     if not isinstance(data, dict):
         raise SceneError(f"{source}: a scene is a set of TOML tables, got {show(data)} "
                          f"({type(data).__name__})")
-    valid = ", ".join(dict.fromkeys((*legacy.TABLE_NAMES, *PART_TABLE_NAMES)))
+    valid = ", ".join(dict.fromkeys((*legacy.TABLE_NAMES, *part_table_names())))
     for table in data:
-        if table not in legacy.TABLE_NAMES and table not in PART_TABLE_NAMES:
+        if table not in legacy.TABLE_NAMES and table not in part_table_names():
             raise SceneError(f"{source}: [{name_text(table)}]: unknown table; valid "
                              f"tables: {valid}")
     parts = _is_parts(source, data)
