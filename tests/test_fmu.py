@@ -42,7 +42,9 @@ def test_interface(fmu_path, paper_scene) -> None:
     """The model description lists exactly the Stepper's inputs and outputs (plus the
     profile reference) and the FMU parameters, with start values from the scene."""
     from winder.fmu.build import FMU_PARAMETERS
-    from winder.solve.stepper import INPUTS, OUTPUTS
+    from winder.scene.legacy import COLUMNS, SINGLE_DRUM
+
+    OUTPUTS, INPUTS = tuple(COLUMNS), tuple(SINGLE_DRUM.inputs({}))
 
     md = fmpy.read_model_description(str(fmu_path))
     by = {v.name: v for v in md.modelVariables}

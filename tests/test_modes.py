@@ -54,7 +54,7 @@ def test_jacobian_matches_finite_differences(paper_scene, models_dir, name) -> N
     scene = _variants(paper_scene, models_dir)[name]
     system = MachineSystem(scene)
     if name == "torque_drive":
-        system.set_drum_torque(150.0)
+        system.set_input("drum.torque", 150.0)
     rng = np.random.default_rng(5)
     y0 = system.initial_state()
     names = system.state_names

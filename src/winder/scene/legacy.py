@@ -166,6 +166,10 @@ class SingleDrumNaming(Naming):
             drive.update(kind="torque", web_acceleration=a, web_speed=0.0 if a > 0 else v,
                          torque=0.0)
 
+    def result_meta(self, scene: Any) -> dict[str, Any]:
+        """``drum_radius`` [m]: the paper figures mark where the roll passes it."""
+        return {"drum_radius": scene.drum.radius}
+
 
 _COLUMN_OF = {decl.of(owner): column for column, (decl, owner) in COLUMNS.items()}
 #: The naming of every single-drum scene (and of a result without its scene).

@@ -87,6 +87,11 @@ class Naming:
         drive's table."""
         return " ".join((f"[[{table}]] {part!r}", *path))
 
+    def result_meta(self, scene: Any) -> dict[str, Any]:
+        """What a result of ``scene`` carries in its ``meta`` for the figures of this
+        naming (none for a scene of parts)."""
+        return {}
+
 
 #: The naming of every scene of parts.
 BY_PARTS = Naming()
