@@ -18,7 +18,7 @@ from scipy.optimize import brentq
 import winder
 from winder.analysis.linearise import jacobian
 from winder.analysis.modes import mode_map, modes_at, operating_point
-from winder.model.machine import paper_roll_mass
+from winder.model.mass_law import paper_roll_mass
 from winder.solve.system import MachineSystem
 
 # central-difference steps by the kind of state (its name's ending)

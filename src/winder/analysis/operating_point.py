@@ -204,7 +204,7 @@ class _Linearisation:
 
     # ---- the operating point ------------------------------------------------------------
     def _radius_of(self, y: np.ndarray, name: str) -> float:
-        return self.machine.radius(y, self.machine.body[name])
+        return self.machine.body[name].radius_of(y, self.machine)
 
     def _speed_radius(self, y: np.ndarray) -> np.ndarray:
         """Radius [m] of each body whose speed is an unknown."""

@@ -38,21 +38,9 @@ import pinocchio as pin
 from winder._schema import Channel
 from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, WEB_SPEED
 from winder.model.element_order import order_elements
-from winder.model.locked_modes import (
-    AT_CORE,
-    AUTO,
-    CORE_AUTO,
-    FREE,
-    IN_CONTACT,
-    WINDING,
-    Mode,
-    ModeKind,
-)
-from winder.model.mass_law import paper_roll_mass
+from winder.model.locked_modes import FREE, ModeKind, ModeSlot
 
-__all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState", "AUTO", "FREE",
-           "IN_CONTACT", "CORE_AUTO", "WINDING", "AT_CORE", "Mode", "ModeKind",
-           "paper_roll_mass"]
+__all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState"]
 
 _COORDS = ("x", "z")
 
@@ -118,7 +106,8 @@ class Machine:
                      for i, n in enumerate(scene.nips)]
         self.nip = {n.name: n for n in self.nips}
         self._assemble_webs(scene)
-        self.rolls = [b for b in self.bodies if b.variable_mass]
+        #: the bodies whose mass properties change in time (:attr:`BodyElement.variable_mass`)
+        self.variable_bodies = [b for b in self.bodies if b.variable_mass]
         if self.span is not None and not effects.web_tension:
             from winder._errors import ModelError
 
@@ -132,7 +121,7 @@ class Machine:
         self.state_initial: list[float] = []
         self.channel_names: list[str] = []
         self.channel_units: dict[str, str] = {}
-        self.modes: list[Mode] = []
+        self.modes: list[ModeSlot] = []
         self.mode_names: list[str] = []
         self.switch_names: list[str] = []
         self._declare_base()
@@ -213,8 +202,8 @@ class Machine:
     def mode(self, name: str, switches: tuple[str, ...], kind: ModeKind, *, owner: str,
              state: str | None = None, param: str | None = None) -> None:
         """Register a locked mode slot of ``kind`` belonging to the part ``owner`` and its
-        switching functions (see :class:`~winder.model.locked_modes.Mode`)."""
-        mode = Mode(name, kind, owner, tuple(switches), state, param)
+        switching functions (see :class:`~winder.model.locked_modes.ModeSlot`)."""
+        mode = ModeSlot(name, kind, owner, tuple(switches), state, param)
         self.modes.append(mode)
         self.mode_names.append(name)
         self.switch_names.extend(switches)
@@ -261,10 +250,6 @@ class Machine:
             raise KeyError(f"no state {name!r}; states: {', '.join(self.state_names)}") \
                 from None
 
-    def radius(self, y: Any, body: Any) -> float:
-        """Radius [m] of ``body`` in state ``y`` (a state, or its part's)."""
-        return body.radius_of(y, self)
-
     def param_index(self, name: str) -> int:
         """Position of parameter ``name`` in the parameter vector."""
         try:
@@ -287,11 +272,10 @@ class Machine:
                      f"{self.model.parents[i]}:{placement.translation.tolist()}".encode())
         for group in (self.state_names, self.param_names, self.mode_names,
                       self.switch_names, self.channel_names,
-                      [f.name for f in self.forces],
+                      [f"{f.name}:{f.structure_tag(self)}" for f in self.forces],
                       [f"{b.name}:{b.structure_tag()}" for b in self.bodies],
                       [self.span.source if self.span is not None else ""],
-                      [f"{n.name}:{n.a.name}:{n.b.name}:{n.part.contact.law}"
-                       for n in self.nips],
+                      [f"{n.name}:{n.a.name}:{n.b.name}" for n in self.nips],
                       [self.entry.name if self.entry else ""],
                       *([f"{w.name}:{w.entry.name}:{w.unwind.name if w.unwind else ''}"
                          for w in self.webs],) * (len(self.webs) > 1)):

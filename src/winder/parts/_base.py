@@ -134,11 +134,6 @@ class BodyElement(ABC):
         #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine
         self.joints: dict[str, int] = {}
 
-    @property
-    def kind(self) -> str:
-        """The part's table name (``drum``, ``roll``, ``rider``); for messages only."""
-        return self.table
-
     # ---- structure ----------------------------------------------------------------------
     @property
     @abstractmethod

@@ -225,7 +225,7 @@ class MachineSystem:
                 continue
             over = float(g[m.switch_names.index(name)])
             if not over <= 0.0:
-                radii = [m.radius(y, b) for b in (nip.a, nip.b)]
+                radii = [b.radius_of(y, m) for b in (nip.a, nip.b)]
                 out.append((nip.name, over + min(radii), min(radii)))
         return out
 
