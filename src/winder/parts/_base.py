@@ -200,6 +200,35 @@ class BodyElement(ABC):
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r})"
 
+    # ---- for the analyses (operating point, resonance map, sweep bands) ----------------
+    #: the scene key of its smallest radius (:attr:`least_radius`), for messages
+    least_radius_key: ClassVar[str] = "radius"
+
+    @property
+    def least_radius(self) -> float:
+        """Its smallest radius [m] (a wound roll's core; default: its initial radius)."""
+        return self.initial_radius
+
+    def radius_after(self, length: float) -> float:
+        """Its radius [m] once ``length`` [m] of web has wound onto it at no slip (default:
+        constant, :attr:`initial_radius`)."""
+        return self.initial_radius
+
+    def drive_web_speed(self) -> float | None:
+        """The surface (web) speed [m/s] its drive names (a speed profile's full speed, a
+        torque drive's initial one), or None (no drive speed)."""
+        return None
+
+    def surface_speed(self, web_speed: float) -> float:
+        """Its surface speed [m/s] when its prescribed drive runs at ``web_speed`` [m/s]
+        (:meth:`operating_speed` times its radius); only where it has a drive speed."""
+        raise NotImplementedError(f"{self!r} has no drive speed")
+
+    def web_length(self, duration: float, web_speed: float) -> float:
+        """Web [m] its drive brings in over ``duration`` [s] at ``web_speed`` [m/s]; only
+        where it has a drive speed."""
+        raise NotImplementedError(f"{self!r} has no drive speed")
+
 
 class RigidDisc(BodyElement):
     """A body of constant radius, mass and inertia: parameters ``NAME.radius`` [m],

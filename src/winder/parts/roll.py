@@ -251,3 +251,17 @@ class RollBody(BodyElement):
 
     def structure_tag(self) -> str:
         return f"{super().structure_tag()}:{self.unwinding}"
+
+    # ---- for the analyses ---------------------------------------------------------------
+    least_radius_key = "core_radius"
+
+    @property
+    def least_radius(self) -> float:
+        """Its core radius ``r_c`` [m]."""
+        return float(self.part.core_radius)
+
+    def radius_after(self, length: float) -> float:
+        """The growth law (machines.md §1, one caliper ``h`` per revolution) integrated:
+        ``r² = r₀² + h L/π`` [m] once ``L`` = ``length`` [m] of paper is wound on."""
+        part = self.part
+        return math.sqrt(part.initial_radius**2 + part.caliper * length / math.pi)
