@@ -36,6 +36,7 @@ from winder.analysis.operating_point import (
 )
 from winder.parts.roll import KEYS as ROLL_KEYS
 from winder.scene.load import Scene
+from winder.scene.naming import BY_PARTS, Naming, naming_of
 
 __all__ = ["Mode", "ModeMap", "operating_point", "modes_at", "mode_map", "MAX_POINTS"]
 
@@ -80,9 +81,9 @@ class ModeMap:
     web_speed: float
     roll: str
     drum_rotation: dict[str, float] = field(default_factory=dict)
-    #: whether the table has a machine from parts' columns (every bounce mode, the drums'
-    #: rotations): the scene's :attr:`Naming.by_parts <winder.scene.Naming.by_parts>`
-    by_parts: bool = True
+    #: the scene's naming: which columns its table has (:meth:`as_columns`,
+    #: :meth:`Naming.mode_map_columns <winder.scene.Naming.mode_map_columns>`)
+    naming: Naming = BY_PARTS
     #: per bounce mode its natural frequency ``|λ|/2π`` [Hz] (also where it is overdamped)
     natural: dict[str, np.ndarray] = field(default_factory=dict)
 
@@ -168,24 +169,23 @@ class ModeMap:
                 for rc in self.critical_radii(h, c)]
 
     def as_columns(self) -> dict[str, np.ndarray]:
-        """The CSV table: the historic columns (a single-drum scene's); by parts also every
-        bounce mode (``BODY_x_frequency``, ``BODY_x_damping``, ...) and the drums'
-        rotation frequencies."""
+        """The CSV table: the main bounce mode, every bounce mode (``BODY_x_frequency``,
+        ``BODY_x_damping``, ...), the slip mode, the harmonics and the drums' rotation
+        frequencies, as the scene's naming has them (a single-drum scene: the historic
+        columns)."""
         cols = {"radius": self.radius, "bounce_frequency": self.bounce_frequency,
                 "bounce_damping": self.bounce_damping}
-        if self.by_parts:
-            for c in self.coordinates:
-                key = c.replace(".", "_")
-                cols[f"{key}_frequency"] = self.frequencies[c]
-                cols[f"{key}_damping"] = self.dampings[c]
+        for c in self.coordinates:
+            key = c.replace(".", "_")
+            cols[f"{key}_frequency"] = self.frequencies[c]
+            cols[f"{key}_damping"] = self.dampings[c]
         cols.update({"slip_frequency": self.slip_frequency, "slip_damping": self.slip_damping,
-                     "rotation_1x": self.rotation_1x, "rotation_2x": self.rotation_2x})
-        if self.by_parts:
-            cols["rotation_3x"] = 3 * self.rotation_1x
-            for name, f in self.drum_rotation.items():
-                cols[f"{name}_rotation"] = np.full(len(self.radius), f)
+                     "rotation_1x": self.rotation_1x, "rotation_2x": self.rotation_2x,
+                     "rotation_3x": 3 * self.rotation_1x})
+        for name, f in self.drum_rotation.items():
+            cols[f"{name}_rotation"] = np.full(len(self.radius), f)
         cols["critical_web_speed"] = self.critical_web_speed
-        return cols
+        return self.naming.mode_map_columns(cols)
 
 
 def wound_length(scene: Scene, v: float) -> float:
@@ -287,4 +287,4 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),
                    dict(zip(lin.coords, damp, strict=True)), slip[0], slip[1],
                    surface / (2 * math.pi * radii), v, lin.roll.name, drums,
-                   scene.naming.by_parts, dict(zip(lin.coords, natural, strict=True)))
+                   naming_of(scene), dict(zip(lin.coords, natural, strict=True)))

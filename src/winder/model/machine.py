@@ -375,6 +375,11 @@ class Evaluation:
     def set_channel(self, name: str, value: Any) -> None:
         self.channels[name] = value
 
+    def output(self, declared: Channel, owner: str, value: Any) -> None:
+        """Write the channel ``declared`` of ``owner`` (its name
+        :meth:`~winder._schema.Channel.of`, as :meth:`Machine.channel` registered it)."""
+        self.channels[declared.of(owner)] = value
+
     def provide(self, quantity: str, key: str, value: Any) -> None:
         """Write ``quantity`` of ``key`` (a body's, a web's; ``""`` for the machine's), as
         the element declared in its ``provides``."""
@@ -521,32 +526,35 @@ class Evaluation:
             if b.prescribed:
                 acc[b.joints["theta"] - 1] = self.bodies[b.name].alpha_prescribed
         tau = be.rnea(self.q, self.v, acc, self.dyn, self.fext, self.g)
-        ch = self.set_channel
+        out = self.output
+        speed, angle, torque, accel = BODY_CHANNELS
         for b in mach.bodies:
             bs, n, s = self.bodies[b.name], b.name, b.sense
             j = b.joints["theta"] - 1
-            ch(f"{n}_speed", s * bs.omega)
-            ch(f"{n}_angle", s * bs.theta)
-            ch(f"{n}_accel", s * acc[j])
+            out(speed, n, s * bs.omega)
+            out(angle, n, s * bs.theta)
+            out(accel, n, s * acc[j])
             drive = self.provided("drive_torque", b.name)
             if b.prescribed:
-                ch(f"{n}_torque", s * tau[j])  # inverse dynamics (RNEA)
+                out(torque, n, s * tau[j])  # inverse dynamics (RNEA)
             elif drive is not None:
-                ch(f"{n}_torque", drive)  # the input or the controller
+                out(torque, n, drive)  # the input or the controller
             else:
-                ch(f"{n}_torque", s * bs.ty)
+                out(torque, n, s * bs.ty)
             for c in b.free:
                 jc = b.joints[c] - 1
-                ch(f"{n}_{c}", self.q[jc])
-                ch(f"{n}_{c}_dot", self.v[jc])
-                ch(f"{n}_{c}_accel", acc[jc])
+                position, rate, acceleration = COORD_CHANNELS[c]
+                out(position, n, self.q[jc])
+                out(rate, n, self.v[jc])
+                out(acceleration, n, acc[jc])
             b.outputs(self, bs)
+        normal, friction, slip, penetration = NIP_CHANNELS
         for nip in mach.nips:
             ns = self.nips[nip.name]
-            ch(f"{nip.name}_normal_force", ns.normal_force)
-            ch(f"{nip.name}_friction_force", ns.friction_force)
-            ch(f"{nip.name}_slip_velocity", ns.v_s)
-            ch(f"{nip.name}_penetration", ns.delta)
+            out(normal, nip.name, ns.normal_force)
+            out(friction, nip.name, ns.friction_force)
+            out(slip, nip.name, ns.v_s)
+            out(penetration, nip.name, ns.delta)
         for w in mach.webs:
             a = self.bodies[w.entry.a.name]
-            ch(f"{w.channel}web_speed", a.omega * a.r)
+            out(WEB_SPEED, w.channel, a.omega * a.r)

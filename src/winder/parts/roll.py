@@ -242,12 +242,9 @@ class RollBody(BodyElement):
         return ev.p(f"{self.name}.torque") if self.torque_inputs else None
 
     def outputs(self, ev: Evaluation, bs: BodyState) -> None:
-        n, ch = self.name, ev.set_channel
-        ch(f"{n}_radius", bs.r)
-        ch(f"{n}_mass", bs.mass)
-        ch(f"{n}_inertia", bs.inertia)
-        ch(f"{n}_mass_rate", bs.mass_rate)
-        ch(f"{n}_inertia_rate", bs.inertia_rate)
+        values = (bs.r, bs.mass, bs.inertia, bs.mass_rate, bs.inertia_rate)
+        for declared, value in zip(self.CHANNELS, values, strict=True):
+            ev.output(declared, self.name, value)
 
     def structure_tag(self) -> str:
         return f"{super().structure_tag()}:{self.unwinding}"

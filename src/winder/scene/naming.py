@@ -87,6 +87,11 @@ class Naming:
         drive's table."""
         return " ".join((f"[[{table}]] {part!r}", *path))
 
+    def mode_map_columns(self, columns: Mapping[str, Any]) -> dict[str, Any]:
+        """The resonance map's table (:meth:`winder.ModeMap.as_columns`) from all its
+        ``columns``: every one."""
+        return dict(columns)
+
     def result_meta(self, scene: Any) -> dict[str, Any]:
         """What a result of ``scene`` carries in its ``meta`` for the figures of this
         naming (none for a scene of parts)."""
