@@ -68,7 +68,7 @@ def random_state(m: Machine, rng: np.random.Generator) -> tuple[float, np.ndarra
     ±2 cm/s (δ̇ of both signs), spins up to ±1000 rad/s (slip of both signs), friction
     states ±2 kN, modes drawn from all three of each kind; ``t`` on the ramp and after."""
     x = np.array(m.state_initial, dtype=float)
-    for b in m.rolls:
+    for b in m.variable_bodies:
         rc = b.part.core_radius
         u = rng.uniform()
         x[m.index(f"{b.name}.radius")] = rc - 1e-4 if u < 0.1 else (
@@ -142,7 +142,7 @@ def test_generated_equals_pinocchio_path(variant: str) -> None:
             seen.add(("slip", str(np.sign(float(ns.v_s)))))
             seen.add(("contact mode", str(int(ns.mode))))
             seen.add(("pressing" if float(ns.normal_force) > 0 else "no force",))
-        for b in m.rolls:
+        for b in m.variable_bodies:
             seen.add(("core mode", str(int(ev.mode(f"{b.name}.core")))))
             seen.add(("r_dot", "zero" if ev.bodies[b.name].r_dot == 0.0 else "winding"))
     modes_drawn = (AUTO, FREE, IN_CONTACT) if m.scene.effects.contact else (FREE,)
@@ -242,7 +242,7 @@ def test_jacobian_against_finite_differences(variant: str) -> None:
     worst = 0.0
     for _ in range(20):
         t, x, modes = random_state(m, rng)
-        for b in m.rolls:
+        for b in m.variable_bodies:
             x[m.index(f"{b.name}.radius")] = rng.uniform(0.06, 0.29)
         modes = np.array([rng.choice([IN_CONTACT, FREE]) if n.endswith(".contact")
                           else WINDING for n in m.mode_names], dtype=float)
