@@ -74,7 +74,9 @@ class BodyElement(ABC):
        [s] where its prescribed motion has a kink), :meth:`operating_speed` and
        :meth:`hold_operating_speed` (a prescribed drive at a given web speed, for the
        resonance map), :meth:`structure_tag`
-       (what changes its generated code beyond its names).
+       (what changes its generated code beyond its names); for the analyses
+       :attr:`least_radius`, :meth:`radius_after` (its growth law integrated),
+       :meth:`drive_web_speed`, :meth:`surface_speed` and :meth:`web_length`.
     6. Register it: one line in :data:`winder.parts.PARTS` (scene attribute → class).
 
     Example: a free disc of constant radius under a constant torque, as a scene's
