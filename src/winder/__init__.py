@@ -28,7 +28,7 @@ _LAZY = {
     **dict.fromkeys(("Scene", "load_scene", "scene_from_dict"), ".scene"),
     **dict.fromkeys(("DEFAULT_METHOD", "simulate"), ".solve.simulate"),
     **dict.fromkeys(("Stepper",), ".solve.stepper"),
-    **dict.fromkeys(("CHANNELS", "EXTRA_CHANNELS"), ".scene.legacy"),  # single-drum columns
+    **dict.fromkeys(("CHANNELS", "EXTRA_CHANNELS"), ".scene"),
     **dict.fromkeys(("MachineSystem",), ".solve.system"),
     **dict.fromkeys(("Machine",), ".model.machine"),
     **dict.fromkeys(("VariableMassModel",), ".model.variable_body"),
@@ -49,8 +49,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from winder.model.machine import Machine
     from winder.model.mass_law import FunctionMassLaw, MassLaw, MassProperties, PaperRollLaw
     from winder.model.variable_body import VariableMassModel
-    from winder.scene import Scene, load_scene, scene_from_dict
-    from winder.scene.legacy import CHANNELS, EXTRA_CHANNELS
+    from winder.scene import CHANNELS, EXTRA_CHANNELS, Scene, load_scene, scene_from_dict
     from winder.solve.simulate import DEFAULT_METHOD, simulate
     from winder.solve.stepper import Stepper
     from winder.solve.system import MachineSystem
