@@ -80,7 +80,7 @@ def wound_roll(name: str, centre: tuple[float, float], free: Iterable[str] = ("z
     return _set(NS(name=name, kind="wound", centre=tuple(centre), free=tuple(free), sense=-1,
                    core_radius=0.05, core_mass=40.0, core_inertia=0.1, width=5.0,
                    initial_radius=0.05, initial_speed=0.0, com_offset=0.0005, density=650.0,
-                   caliper=70e-6, initial_height=None), kw)
+                   caliper=70e-6, held_z=None), kw)
 
 
 def rider(name: str, rides: str, **kw: Any) -> NS:

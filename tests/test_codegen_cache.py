@@ -18,7 +18,8 @@ import pytest
 
 from winder.model import codegen
 from winder.model.backends import NumericBackend
-from winder.model.machine import AUTO, CORE_AUTO, Machine
+from winder.model.locked_modes import AUTO, CORE_AUTO
+from winder.model.machine import Machine
 
 pytest.importorskip("casadi")
 

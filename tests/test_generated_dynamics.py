@@ -22,7 +22,8 @@ import pinocchio as pin
 import pytest
 
 from winder.model.backends import NumericBackend
-from winder.model.machine import AT_CORE, AUTO, CORE_AUTO, FREE, IN_CONTACT, WINDING, Machine
+from winder.model.locked_modes import AT_CORE, AUTO, CORE_AUTO, FREE, IN_CONTACT, WINDING
+from winder.model.machine import Machine
 
 casadi = pytest.importorskip("casadi")
 
@@ -46,12 +47,12 @@ def _touching_centre(m: Machine, x: np.ndarray, body: str) -> tuple[float, float
     positions in ``x``: the drums below a roll (one: on top; two: in the valley), the roll
     below a rider."""
     b = m.body[body]
-    r = x[m.index(f"{body}.radius")] if b.kind == "roll" else b.part.radius
-    if b.kind == "rider":
+    r = x[m.index(f"{body}.radius")] if b.table == "roll" else b.part.radius
+    if b.table == "rider":
         ridden = m.body[b.part.rides]
         cz = x[m.index(f"{ridden.name}.z")] if "z" in ridden.free else ridden.centre[1]
         return b.part.x, cz + x[m.index(f"{ridden.name}.radius")] + r
-    drums = [n.a for n in m.nips if n.b is b and n.a.kind == "drum"]
+    drums = [n.a for n in m.nips if n.b is b and n.a.table == "drum"]
     if len(drums) == 1:
         d = drums[0]
         return d.centre[0], d.centre[1] + d.part.radius + r
@@ -67,7 +68,7 @@ def random_state(m: Machine, rng: np.random.Generator) -> tuple[float, np.ndarra
     ±2 cm/s (δ̇ of both signs), spins up to ±1000 rad/s (slip of both signs), friction
     states ±2 kN, modes drawn from all three of each kind; ``t`` on the ramp and after."""
     x = np.array(m.state_initial, dtype=float)
-    for b in m.rolls:
+    for b in m.variable_bodies:
         rc = b.part.core_radius
         u = rng.uniform()
         x[m.index(f"{b.name}.radius")] = rc - 1e-4 if u < 0.1 else (
@@ -141,7 +142,7 @@ def test_generated_equals_pinocchio_path(variant: str) -> None:
             seen.add(("slip", str(np.sign(float(ns.v_s)))))
             seen.add(("contact mode", str(int(ns.mode))))
             seen.add(("pressing" if float(ns.normal_force) > 0 else "no force",))
-        for b in m.rolls:
+        for b in m.variable_bodies:
             seen.add(("core mode", str(int(ev.mode(f"{b.name}.core")))))
             seen.add(("r_dot", "zero" if ev.bodies[b.name].r_dot == 0.0 else "winding"))
     modes_drawn = (AUTO, FREE, IN_CONTACT) if m.scene.effects.contact else (FREE,)
@@ -241,7 +242,7 @@ def test_jacobian_against_finite_differences(variant: str) -> None:
     worst = 0.0
     for _ in range(20):
         t, x, modes = random_state(m, rng)
-        for b in m.rolls:
+        for b in m.variable_bodies:
             x[m.index(f"{b.name}.radius")] = rng.uniform(0.06, 0.29)
         modes = np.array([rng.choice([IN_CONTACT, FREE]) if n.endswith(".contact")
                           else WINDING for n in m.mode_names], dtype=float)
@@ -310,7 +311,7 @@ def _spec_body(m: Machine, b: Any, t: float,
         w = b.sense * dr.ratio * min(dr.web_acceleration * t, dr.web_speed) / b.part.radius
     else:
         w = x[m.index(f"{b.name}.theta_dot")]
-    if b.kind == "roll":
+    if b.table == "roll":
         return c, cd, w, x[m.index(f"{b.name}.radius")], \
             b.part.caliper / (2 * math.pi) * b.sense * w
     return c, cd, w, b.part.radius, 0.0
@@ -540,7 +541,7 @@ def test_drive_torques(drive: str) -> None:
         ev, num = _numeric(m, be, t, x, p, modes)
         out = dict(zip(m.channel_names, g.call("out", t, x, p, modes), strict=True))
         for d in m.bodies:
-            if d.kind != "drum":
+            if d.table != "drum":
                 continue
             n = d.name
             nip = next(k for k in m.nips if k.a is d)

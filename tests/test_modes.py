@@ -18,7 +18,7 @@ from scipy.optimize import brentq
 import winder
 from winder.analysis.linearise import jacobian
 from winder.analysis.modes import mode_map, modes_at, operating_point
-from winder.model.machine import paper_roll_mass
+from winder.model.mass_law import paper_roll_mass
 from winder.solve.system import MachineSystem
 
 # central-difference steps by the kind of state (its name's ending)
@@ -54,7 +54,7 @@ def test_jacobian_matches_finite_differences(paper_scene, models_dir, name) -> N
     scene = _variants(paper_scene, models_dir)[name]
     system = MachineSystem(scene)
     if name == "torque_drive":
-        system.set_drum_torque(150.0)
+        system.set_input("drum.torque", 150.0)
     rng = np.random.default_rng(5)
     y0 = system.initial_state()
     names = system.state_names

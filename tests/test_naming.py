@@ -85,17 +85,9 @@ def test_scene_naming_and_single_drum_columns():
     assert list(system.channel_units)[1:] == system.machine.channel_names
 
 
-#: Modules outside ``winder/scene`` that still name the single-drum format's names, each
-#: with the names it still uses. Another branch of #22 removes these (solve/, analysis/,
-#: cli.py, parts/roll.py): this allow-list only shrinks, and an entry that no longer
-#: violates fails the test, so the merge empties it.
-STILL_NAMING = {
-    "src/winder/cli.py": {"by_parts"},
-    "src/winder/analysis/modes.py": {"by_parts"},
-    "src/winder/parts/roll.py": {"initial_height"},
-    "src/winder/solve/system.py": {"CHANNELS", "EXTRA_CHANNELS"},
-    "src/winder/solve/stepper.py": {"CHANNELS", "EXTRA_CHANNELS"},
-}
+#: Modules outside ``winder/scene`` allowed to name the single-drum format's names, each
+#: with the names it may use: none (an entry that no longer violates fails the test).
+STILL_NAMING: dict[str, set[str]] = {}
 #: The package's public names of the single-drum columns (``winder.CHANNELS``, lazily from
 #: :mod:`winder.scene`): the one place outside the scene package that names them.
 PUBLIC = {"src/winder/__init__.py": {"CHANNELS", "EXTRA_CHANNELS"}}

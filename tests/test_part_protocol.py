@@ -372,3 +372,30 @@ def test_mode_kinds_are_typed() -> None:
     assert core.owner == "set"
     with pytest.raises(TypeError, match="ModeKind"):
         m.mode("x.contact", ("x.g",), "contact", owner="x")  # type: ignore[arg-type]
+
+
+def test_growth_law_and_drive_length_are_the_bodies(paper_scene) -> None:
+    """The analyses ask the body elements (#22 D18): a wound roll's radius after ``L`` of
+    paper is ``√(r₀² + h L/π)`` (machines.md §1 integrated), a drum's web over ``T`` at
+    ``v`` follows its ramp ``a_w``; the resonance map's end radius and the sweep bands'
+    no-slip end radius both come from ``radius_after``."""
+    import math
+
+    from winder.analysis.modes import wound_length
+    from winder.analysis.sweep_summary import end_radius
+    from winder.parts import body_elements
+
+    drum, roll = body_elements(paper_scene)
+    r0, h = paper_scene.roll.initial_radius, paper_scene.paper.caliper
+    assert roll.radius_after(0.0) == r0
+    assert roll.radius_after(100.0) == pytest.approx(math.sqrt(r0**2 + h * 100.0 / math.pi),
+                                                     rel=1e-15)
+    assert roll.least_radius == paper_scene.roll.core_radius and not drum.radius_state
+    a, v = paper_scene.drum.drive.web_acceleration, 20.0
+    tr = v / a
+    assert drum.web_length(tr / 2, v) == pytest.approx(a * (tr / 2) ** 2 / 2, rel=1e-15)
+    assert drum.web_length(3 * tr, v) == pytest.approx(v * 3 * tr - v * tr / 2, rel=1e-15)
+    assert wound_length(paper_scene, v) == drum.web_length(paper_scene.scene.duration, v)
+    T = paper_scene.scene.duration
+    vd = paper_scene.drum.drive.web_speed  # the bands: full speed from t = 0 (documented)
+    assert end_radius(paper_scene) == pytest.approx(roll.radius_after(vd * T), rel=1e-14)

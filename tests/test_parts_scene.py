@@ -158,7 +158,7 @@ def test_single_drum_scene_as_parts(name) -> None:
         sense=-1, core_radius=ro.core_radius, core_mass=ro.core_mass,
         core_inertia=ro.core_inertia, width=ro.width, initial_radius=ro.initial_radius,
         initial_speed=ro.initial_speed, com_offset=ro.com_offset, density=pa.density,
-        caliper=pa.caliper, initial_height=ro.initial_height),)
+        caliper=pa.caliper, held_z=ro.initial_height),)
     assert s.riders == ()
     assert s.nips == (NipPart("nip", "drum", "roll",
                               ContactLaw(**dataclasses.asdict(s.contact)),
@@ -175,7 +175,7 @@ def test_single_drum_parts_follow_replace(paper_scene) -> None:
                                             "web_speed": 3.0}},
                             roll={"initial_height": 0.7}, contact={"stiffness": 3e7})
     assert s.drums[0].drive == TorqueDrive(torque=50.0, web_speed=3.0)
-    assert s.rolls[0].initial_height == 0.7
+    assert s.rolls[0].held_z == 0.7
     assert s.nips[0].contact.stiffness == 3e7
     r = dataclasses.replace(s, friction=LegacyFriction(mu=0.5))
     assert r.nips[0].friction == FrictionLaw(mu=0.5) and r.legacy

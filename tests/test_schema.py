@@ -81,9 +81,8 @@ def test_scene_code_writes_no_bound():
 
 
 def test_single_drum_channels_are_documented_in_their_order():
-    from winder.scene.legacy import COLUMNS
+    from winder.scene.legacy import CHANNELS, COLUMNS, EXTRA_CHANNELS
     from winder.scene.reference import reference
-    from winder.solve.system import CHANNELS, EXTRA_CHANNELS
 
     assert ("t", *COLUMNS) == (*CHANNELS, *EXTRA_CHANNELS)
     text = reference()

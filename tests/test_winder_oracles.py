@@ -77,7 +77,7 @@ def test_pinocchio_equals_spec_equations(paper_scene, variant) -> None:
     scene = scene_variant(paper_scene, variant)
     sys_ = MachineSystem(scene, backend="pinocchio")
     if scene.drum.drive.kind == "torque":
-        sys_.set_drum_torque(DRUM_TORQUE)
+        sys_.set_input("drum.torque", DRUM_TORQUE)
     states = list(random_states(sys_, np.random.default_rng(3), 150))
     regions = state_regions(sys_, states)
     assert min(regions.values()) >= 150 // 40, regions  # every region of the nip drawn

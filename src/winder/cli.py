@@ -340,9 +340,9 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         if args.simulate:
             print("  simulating the scene for the normal-force envelope ...", file=sys.stderr)
             result = simulate(scene, progress=sys.stderr.isatty())
-        nips = {} if not scene.naming.by_parts else {
-            n.name: (f"{n.name}_normal_force", f"{mm.roll}_radius") for n in scene.nips
-            if mm.roll in (n.a, n.b)}
+        out = scene.naming.output_name  # the result's channels as the scene names them
+        nips = {n.name: (out(f"{n.name}_normal_force"), out(f"{mm.roll}_radius"))
+                for n in scene.nips if mm.roll in (n.a, n.b)}
         path = campbell_figure(mm, plot, result=result, envelopes=nips or None,
                                title=f"Resonance map of {scene.name}",
                                colours=nip_colours(scene))

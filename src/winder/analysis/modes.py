@@ -28,7 +28,7 @@ from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.operating_point import (
     Mode,
     _core_key,
-    _entry_drum,
+    _entry_drive,
     _Linearisation,
     _linearisation,
     _radius,
@@ -36,6 +36,7 @@ from winder.analysis.operating_point import (
 )
 from winder.parts.roll import KEYS as ROLL_KEYS
 from winder.scene.load import Scene
+from winder.scene.naming import BY_PARTS, Naming, naming_of
 
 __all__ = ["Mode", "ModeMap", "operating_point", "modes_at", "mode_map", "MAX_POINTS"]
 
@@ -80,9 +81,9 @@ class ModeMap:
     web_speed: float
     roll: str
     drum_rotation: dict[str, float] = field(default_factory=dict)
-    #: whether the table has a machine from parts' columns (every bounce mode, the drums'
-    #: rotations): the scene's :attr:`Naming.by_parts <winder.scene.Naming.by_parts>`
-    by_parts: bool = True
+    #: the scene's naming: which columns its table has (:meth:`as_columns`,
+    #: :meth:`Naming.mode_map_columns <winder.scene.Naming.mode_map_columns>`)
+    naming: Naming = BY_PARTS
     #: per bounce mode its natural frequency ``|λ|/2π`` [Hz] (also where it is overdamped)
     natural: dict[str, np.ndarray] = field(default_factory=dict)
 
@@ -168,36 +169,30 @@ class ModeMap:
                 for rc in self.critical_radii(h, c)]
 
     def as_columns(self) -> dict[str, np.ndarray]:
-        """The CSV table: the historic columns (a single-drum scene's); by parts also every
-        bounce mode (``BODY_x_frequency``, ``BODY_x_damping``, ...) and the drums'
-        rotation frequencies."""
+        """The CSV table: the main bounce mode, every bounce mode (``BODY_x_frequency``,
+        ``BODY_x_damping``, ...), the slip mode, the harmonics and the drums' rotation
+        frequencies, as the scene's naming has them (a single-drum scene: the historic
+        columns)."""
         cols = {"radius": self.radius, "bounce_frequency": self.bounce_frequency,
                 "bounce_damping": self.bounce_damping}
-        if self.by_parts:
-            for c in self.coordinates:
-                key = c.replace(".", "_")
-                cols[f"{key}_frequency"] = self.frequencies[c]
-                cols[f"{key}_damping"] = self.dampings[c]
+        for c in self.coordinates:
+            key = c.replace(".", "_")
+            cols[f"{key}_frequency"] = self.frequencies[c]
+            cols[f"{key}_damping"] = self.dampings[c]
         cols.update({"slip_frequency": self.slip_frequency, "slip_damping": self.slip_damping,
-                     "rotation_1x": self.rotation_1x, "rotation_2x": self.rotation_2x})
-        if self.by_parts:
-            cols["rotation_3x"] = 3 * self.rotation_1x
-            for name, f in self.drum_rotation.items():
-                cols[f"{name}_rotation"] = np.full(len(self.radius), f)
+                     "rotation_1x": self.rotation_1x, "rotation_2x": self.rotation_2x,
+                     "rotation_3x": 3 * self.rotation_1x})
+        for name, f in self.drum_rotation.items():
+            cols[f"{name}_rotation"] = np.full(len(self.radius), f)
         cols["critical_web_speed"] = self.critical_web_speed
-        return cols
+        return self.naming.mode_map_columns(cols)
 
 
 def wound_length(scene: Scene, v: float) -> float:
     """Paper [m] the web brings in over the scene's duration at web speed ``v`` [m/s]:
     the drum the web wraps ramps at its ``web_acceleration`` to ``v`` (none: ``v`` from
     the start)."""
-    drive, T = _entry_drum(scene).drive, scene.scene.duration
-    a = drive.web_acceleration
-    if a > 0.0 and v > 0.0:
-        tr = v / a
-        return a * T * T / 2 if T <= tr else v * T - v * tr / 2
-    return v * T
+    return _entry_drive(scene).web_length(scene.scene.duration, v)
 
 
 def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
@@ -205,7 +200,7 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
                   names: tuple[str, str]) -> tuple[float, float]:
     """``(r_min, r_max)`` [m] of a map: the arguments (``names`` in messages) or the
     roll's initial radius and its radius at the end of the scene's run."""
-    roll, rc = lin.roll.part, lin.rc
+    roll, rc = lin.roll, lin.rc
     key = _core_key(lin)
     hi = ROLL_KEYS["initial_radius"].hi
     if radius_min is None:
@@ -214,8 +209,7 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
         lo = number(where, names[0], radius_min, lo=rc, hi=hi, unit="m",
                     valid=f"a finite radius >= {key} = {rc:g} m and <= {hi:g} m")
     if radius_max is None:
-        end = math.sqrt(roll.initial_radius**2
-                        + roll.caliper * wound_length(scene, v) / math.pi)
+        end = roll.radius_after(wound_length(scene, v))
         if not end > lo:
             raise ArgumentError(f"{where}: {names[0]} = {lo:g} m is not below the wound "
                                 f"roll's radius at the end of the run ({end:g} m, from the "
@@ -289,8 +283,8 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
             slip[:, i] = ms[nt].natural_frequency, ms[nt].damping_ratio
     drums = {b.name: b.operating_speed(v) / (2 * math.pi)
              for b in lin.machine.bodies if b.prescribed}
-    ratio = _entry_drum(scene).drive.ratio  # the roll's surface runs at ratio · v
+    surface = lin.machine.entry.a.surface_speed(v)  # the roll's surface: ratio · v
     return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),
                    dict(zip(lin.coords, damp, strict=True)), slip[0], slip[1],
-                   ratio * v / (2 * math.pi * radii), v, lin.roll.name, drums,
-                   scene.naming.by_parts, dict(zip(lin.coords, natural, strict=True)))
+                   surface / (2 * math.pi * radii), v, lin.roll.name, drums,
+                   naming_of(scene), dict(zip(lin.coords, natural, strict=True)))

@@ -40,6 +40,7 @@ from winder._args import number, show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.linearise import jacobian
 from winder.model.locked_modes import AUTO, IN_CONTACT, ModeKind
+from winder.parts import BodyElement, body_elements
 from winder.parts.drum import DRIVE_KEYS
 from winder.scene.load import Scene
 from winder.solve.equilibrium import EquilibriumError, nip_key, resting_state
@@ -83,8 +84,8 @@ class Mode:
         return -lam.real / abs(lam) if abs(lam) > 0 else 0.0
 
 
-def _where_drum(scene: Scene, name: str) -> str:
-    return scene.naming.key("drum", name, "drive")
+def _where_drive(scene: Scene, body: BodyElement) -> str:
+    return scene.naming.key(body.table, body.name, "drive")
 
 
 def _check_scene(scene: Scene, where: str) -> None:
@@ -99,11 +100,12 @@ def _check_scene(scene: Scene, where: str) -> None:
         raise ArgumentError(f"{where}: {scene.source}: the resonance map needs a wound roll "
                             "and the web entering it ([web] entry_nip); this scene has no "
                             "[web]")
-    for d in scene.drums:
-        if d.drive.kind != "speed_profile":
+    for b in body_elements(scene):  # a body with a drive speed runs prescribed
+        if b.drive_web_speed() is not None and not b.prescribed:
             raise ArgumentError(f"{where}: {scene.source}: the resonance map needs "
-                                f"{_where_drum(scene, d.name)} kind = 'speed_profile' (its "
-                                f"web speed is the operating speed), got {d.drive.kind!r}")
+                                f"{_where_drive(scene, b)} kind = 'speed_profile' (its "
+                                f"web speed is the operating speed), got "
+                                f"{b.part.drive.kind!r}")
     if not scene.effects.gravity or scene.scene.gravity == 0.0:
         raise ArgumentError(f"{where}: {scene.source}: the resonance map needs the roll's "
                             "weight on the nip, but [effects] gravity = "
@@ -117,19 +119,20 @@ def _check_scene(scene: Scene, where: str) -> None:
                                 "operating point and no slip mode; valid: mu > 0")
 
 
-def _entry_drum(scene: Scene):  # noqa: ANN202 - a DrumPart
+def _entry_drive(scene: Scene) -> BodyElement:
+    """The body element the web wraps before its entry nip (side ``a``: the drum)."""
     nip = next(n for n in scene.nips if n.name == scene.web.entry_nip)
-    return next(d for d in scene.drums if d.name == nip.a)
+    return next(b for b in body_elements(scene) if b.name == nip.a)
 
 
 def _web_speed(where: str, scene: Scene, web_speed: float | None, lo_open: bool) -> float:
     """The operating web speed [m/s]: the argument, or the ``web_speed`` of the drum the web
     wraps; finite, ``> 0`` (``>= 0`` where ``lo_open`` is false)."""
     if web_speed is None:
-        drum = _entry_drum(scene)
-        v = drum.drive.web_speed
+        drum = _entry_drive(scene)
+        v = drum.drive_web_speed()
         if lo_open and not v > 0.0:
-            key = _where_drum(scene, drum.name)
+            key = _where_drive(scene, drum)
             raise ArgumentError(f"{where}: web_speed is not given and the scene's {key} "
                                 f"web_speed is {v!r} ({scene.source}); valid: a web speed "
                                 "> 0 m/s")
@@ -147,7 +150,7 @@ class _Linearisation:
         self.system = sys_ = MachineSystem(scene)
         m = self.machine = sys_.machine
         p = sys_.params
-        for b in m.rolls:
+        for b in m.bodies:
             if f"{b.name}.com_offset" in m.param_names:
                 p[m.param_index(f"{b.name}.com_offset")] = 0.0
         for b in m.bodies:  # the prescribed ones at full speed from t = 0
@@ -155,14 +158,14 @@ class _Linearisation:
         self.t = 0.0
         self.roll = m.entry.b
         self.i_r = m.index(f"{self.roll.name}.radius")
-        self.rc = self.roll.part.core_radius
+        self.rc = self.roll.least_radius
         names = m.state_names
         self.positions = [m.index(f"{b.name}.{c}") for b in m.bodies for c in b.free]
         self.coords = [f"{b.name}.{c}" for b in m.bodies for c in b.free]
         self.velocities = [m.index(f"{n}_dot") for n in self.coords]
         self.speeds = [m.index(f"{b.name}.theta_dot") for b in m.bodies if not b.prescribed]
         slow = {m.index(f"{b.name}.theta") for b in m.bodies if not b.prescribed}
-        slow |= {m.index(f"{b.name}.radius") for b in m.rolls}
+        slow |= {m.index(f"{b.name}.radius") for b in m.bodies if b.radius_state}
         taken = set(self.positions) | set(self.velocities) | set(self.speeds) | slow
         self.others = [i for i in range(len(names)) if i not in taken]  # friction, ...
         # unknowns of the balance and their equations (rates)
@@ -170,7 +173,7 @@ class _Linearisation:
         self.equations = self.velocities + self.speeds + self.others
         self.fast = self.positions + self.velocities + self.speeds + self.others
         self.paper = {m.index(f"{b.name}.theta_dot"): m.index(f"{b.name}.radius")
-                      for b in m.rolls}
+                      for b in m.bodies if b.radius_state}
         self._speed_slots = np.arange(len(self.positions),
                                       len(self.positions) + len(self.speeds))
         self.v_ref = min(n.part.friction.slip_velocity for n in m.nips)
@@ -204,7 +207,7 @@ class _Linearisation:
 
     # ---- the operating point ------------------------------------------------------------
     def _radius_of(self, y: np.ndarray, name: str) -> float:
-        return self.machine.radius(y, self.machine.body[name])
+        return self.machine.body[name].radius_of(y, self.machine)
 
     def _speed_radius(self, y: np.ndarray) -> np.ndarray:
         """Radius [m] of each body whose speed is an unknown."""
@@ -476,7 +479,7 @@ def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: b
 
 def _core_key(lin: _Linearisation) -> str:
     """The scene key of the wound roll's core radius, the smallest radius of a map."""
-    return lin.scene.naming.key("roll", lin.roll.name, "core_radius")
+    return lin.scene.naming.key(lin.roll.table, lin.roll.name, lin.roll.least_radius_key)
 
 
 def _radius(where: str, lin: _Linearisation, radius: float) -> float:

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from winder.io.result import Result
-from winder.parts import RollPart, body_elements
+from winder.parts import BodyElement, body_elements
 from winder.scene.load import Scene
 
 __all__ = ["BAND_COLUMNS", "SCALAR_COLUMNS", "NIP_SCALAR_COLUMNS", "default_band_edges",
@@ -70,23 +70,20 @@ def scene_nip_names(scene_dict: Mapping[str, Any]) -> tuple[str, ...]:
     return tuple(str(n["name"]) for n in nips) if isinstance(nips, list) else ()
 
 
-def _winds(scene: Scene, name: str) -> bool:
-    """Whether paper winds onto the body ``name`` (its body element's ``winds``)."""
-    return next(b for b in body_elements(scene) if b.name == name).winds
-
-
-def wound_roll(scene: Scene) -> RollPart:
-    """The roll whose radius the bands split: the roll at the web's entry nip, else the
-    first wound roll, else the first roll."""
-    rolls = {r.name: r for r in scene.rolls}
+def wound_roll(scene: Scene) -> BodyElement:
+    """The body element whose radius the bands split (among those whose radius is a
+    state, :attr:`~winder.parts.BodyElement.radius_state`): the one at the web's entry nip,
+    else the first that winds, else the first."""
+    bodies = body_elements(scene)
+    rolls = {b.name: b for b in bodies if b.radius_state}
     if scene.web is not None:
         for nip in scene.nips:
             if nip.name == scene.web.entry_nip:
                 for side in (nip.b, nip.a):
                     if side in rolls:
                         return rolls[side]
-    wound = [r for r in scene.rolls if _winds(scene, r.name)]
-    return (wound or list(scene.rolls))[0]
+    wound = [b for b in rolls.values() if b.winds]
+    return (wound or list(rolls.values()))[0]
 
 
 def end_radius(scene: Scene, t_end: float | None = None) -> float:
@@ -95,11 +92,11 @@ def end_radius(scene: Scene, t_end: float | None = None) -> float:
     T = scene.scene.duration if t_end is None else float(t_end)
     # the roll the web enters, at the largest drum web speed
     roll = wound_roll(scene)
-    r0, h = roll.initial_radius, roll.caliper
-    v = max((abs(d.drive.web_speed) for d in scene.drums), default=0.0)
-    if not _winds(scene, roll.name):
-        return r0
-    return math.sqrt(r0**2 + h * v * T / math.pi)
+    speeds = (b.drive_web_speed() for b in body_elements(scene))
+    v = max((abs(s) for s in speeds if s is not None), default=0.0)
+    if not roll.winds:
+        return roll.initial_radius
+    return roll.radius_after(v * T)  # the full web speed from t = 0 (no ramp)
 
 
 def default_band_edges(scenes: Sequence[Scene], t_end: float | None, n: int) -> np.ndarray:
@@ -147,15 +144,18 @@ def empty_summary(n_bands: int, nips: Sequence[str] = ()) -> dict[str, Any]:
 
 
 def _layout(result: Result) -> tuple[str, dict[str, tuple[str, str]], tuple[str, ...]]:
-    """``(radius channel, {nip: (normal force, penetration channel)}, per-nip names)``."""
-    if "normal_force" in result:  # single-drum scene: the old channel names
-        return "radius", {"nip": ("normal_force", "penetration")}, ()
+    """``(radius channel, {nip: (normal force, penetration channel)}, per-nip names)``:
+    the channels as the scene's naming calls them in the result (a single-drum scene:
+    ``radius``, ``normal_force``, ``penetration``), the nips with their own columns
+    (:func:`scene_nip_names`)."""
     from winder.scene.load import scene_from_dict
 
-    scene = scene_from_dict(result.meta["scene_dict"])
-    nips = tuple(n.name for n in scene.nips)
-    return (f"{wound_roll(scene).name}_radius",
-            {n: (f"{n}_normal_force", f"{n}_penetration") for n in nips}, nips)
+    scene_dict = result.meta["scene_dict"]
+    scene = scene_from_dict(scene_dict)
+    out = scene.naming.output_name
+    return (out(f"{wound_roll(scene).name}_radius"),
+            {n.name: (out(f"{n.name}_normal_force"), out(f"{n.name}_penetration"))
+             for n in scene.nips}, scene_nip_names(scene_dict))
 
 
 def _nip_summary(t: np.ndarray, r: np.ndarray, fn: np.ndarray, pen: np.ndarray,

@@ -120,6 +120,11 @@ class ForceElement(ABC):
         same)."""
         self.apply(ev)
 
+    def structure_tag(self, machine: Machine) -> str:
+        """Everything about it in ``machine`` that changes the generated code beyond its
+        name and the names it registers (default: nothing)."""
+        return ""
+
     @classmethod
     def summary(cls) -> str:
         """Its meaning in one line: :attr:`doc`, else the first line of its docstring."""

@@ -69,6 +69,10 @@ class Contact(ForceElement):
                 f"{nip.name}.{g}" for g in ("contact", "overlap", "dx", "dz")),
                 ModeKind.CONTACT, owner=nip.name)
 
+    def structure_tag(self, machine: Machine) -> str:
+        """Each nip's contact law (its code differs by law)."""
+        return ",".join(f"{nip.name}:{nip.part.contact.law}" for nip in machine.nips)
+
     def apply(self, ev: Evaluation) -> None:
         mathns = ev.mathns
         for ns in ev.nips.values():

@@ -38,7 +38,7 @@ class VariableMass(ForceElement):
     provides = frozenset({"spatial_force"})
 
     def apply(self, ev: Evaluation) -> None:
-        for b in ev.machine.rolls:
+        for b in ev.machine.variable_bodies:
             bs = ev.bodies[b.name]
             rate = ev.inertia_parameters(bs, rate=True)
             yv = inertia_times(rate, ev.joint_velocity(b.name))

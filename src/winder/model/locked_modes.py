@@ -19,7 +19,7 @@ import enum
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["ModeKind", "Mode", "AUTO", "FREE", "IN_CONTACT", "CORE_AUTO", "WINDING",
+__all__ = ["ModeKind", "ModeSlot", "AUTO", "FREE", "IN_CONTACT", "CORE_AUTO", "WINDING",
            "AT_CORE"]
 
 AUTO, FREE, IN_CONTACT = -1, 0, 1
@@ -45,7 +45,7 @@ class ModeKind(enum.IntEnum):
 
 
 @dataclass(frozen=True)
-class Mode:
+class ModeSlot:
     """A locked mode slot: ``name`` (``NIP.contact``, ``ROLL.core``, ``ROLL.end``), its
     ``kind``, the part it belongs to (``owner``), its switching functions and, for a
     roll's core or end, the radius state and the core-radius parameter the event lands

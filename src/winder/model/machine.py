@@ -38,21 +38,9 @@ import pinocchio as pin
 from winder._schema import Channel
 from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, WEB_SPEED
 from winder.model.element_order import order_elements
-from winder.model.locked_modes import (
-    AT_CORE,
-    AUTO,
-    CORE_AUTO,
-    FREE,
-    IN_CONTACT,
-    WINDING,
-    Mode,
-    ModeKind,
-)
-from winder.model.mass_law import paper_roll_mass
+from winder.model.locked_modes import FREE, ModeKind, ModeSlot
 
-__all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState", "AUTO", "FREE",
-           "IN_CONTACT", "CORE_AUTO", "WINDING", "AT_CORE", "Mode", "ModeKind",
-           "paper_roll_mass"]
+__all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState"]
 
 _COORDS = ("x", "z")
 
@@ -118,7 +106,8 @@ class Machine:
                      for i, n in enumerate(scene.nips)]
         self.nip = {n.name: n for n in self.nips}
         self._assemble_webs(scene)
-        self.rolls = [b for b in self.bodies if b.variable_mass]
+        #: the bodies whose mass properties change in time (:attr:`BodyElement.variable_mass`)
+        self.variable_bodies = [b for b in self.bodies if b.variable_mass]
         if self.span is not None and not effects.web_tension:
             from winder._errors import ModelError
 
@@ -132,7 +121,7 @@ class Machine:
         self.state_initial: list[float] = []
         self.channel_names: list[str] = []
         self.channel_units: dict[str, str] = {}
-        self.modes: list[Mode] = []
+        self.modes: list[ModeSlot] = []
         self.mode_names: list[str] = []
         self.switch_names: list[str] = []
         self._declare_base()
@@ -213,8 +202,8 @@ class Machine:
     def mode(self, name: str, switches: tuple[str, ...], kind: ModeKind, *, owner: str,
              state: str | None = None, param: str | None = None) -> None:
         """Register a locked mode slot of ``kind`` belonging to the part ``owner`` and its
-        switching functions (see :class:`~winder.model.locked_modes.Mode`)."""
-        mode = Mode(name, kind, owner, tuple(switches), state, param)
+        switching functions (see :class:`~winder.model.locked_modes.ModeSlot`)."""
+        mode = ModeSlot(name, kind, owner, tuple(switches), state, param)
         self.modes.append(mode)
         self.mode_names.append(name)
         self.switch_names.extend(switches)
@@ -261,10 +250,6 @@ class Machine:
             raise KeyError(f"no state {name!r}; states: {', '.join(self.state_names)}") \
                 from None
 
-    def radius(self, y: Any, body: Any) -> float:
-        """Radius [m] of ``body`` in state ``y`` (a state, or its part's)."""
-        return body.radius_of(y, self)
-
     def param_index(self, name: str) -> int:
         """Position of parameter ``name`` in the parameter vector."""
         try:
@@ -287,11 +272,10 @@ class Machine:
                      f"{self.model.parents[i]}:{placement.translation.tolist()}".encode())
         for group in (self.state_names, self.param_names, self.mode_names,
                       self.switch_names, self.channel_names,
-                      [f.name for f in self.forces],
+                      [f"{f.name}:{f.structure_tag(self)}" for f in self.forces],
                       [f"{b.name}:{b.structure_tag()}" for b in self.bodies],
                       [self.span.source if self.span is not None else ""],
-                      [f"{n.name}:{n.a.name}:{n.b.name}:{n.part.contact.law}"
-                       for n in self.nips],
+                      [f"{n.name}:{n.a.name}:{n.b.name}" for n in self.nips],
                       [self.entry.name if self.entry else ""],
                       *([f"{w.name}:{w.entry.name}:{w.unwind.name if w.unwind else ''}"
                          for w in self.webs],) * (len(self.webs) > 1)):
@@ -390,6 +374,11 @@ class Evaluation:
 
     def set_channel(self, name: str, value: Any) -> None:
         self.channels[name] = value
+
+    def output(self, declared: Channel, owner: str, value: Any) -> None:
+        """Write the channel ``declared`` of ``owner`` (its name
+        :meth:`~winder._schema.Channel.of`, as :meth:`Machine.channel` registered it)."""
+        self.channels[declared.of(owner)] = value
 
     def provide(self, quantity: str, key: str, value: Any) -> None:
         """Write ``quantity`` of ``key`` (a body's, a web's; ``""`` for the machine's), as
@@ -537,32 +526,35 @@ class Evaluation:
             if b.prescribed:
                 acc[b.joints["theta"] - 1] = self.bodies[b.name].alpha_prescribed
         tau = be.rnea(self.q, self.v, acc, self.dyn, self.fext, self.g)
-        ch = self.set_channel
+        out = self.output
+        speed, angle, torque, accel = BODY_CHANNELS
         for b in mach.bodies:
             bs, n, s = self.bodies[b.name], b.name, b.sense
             j = b.joints["theta"] - 1
-            ch(f"{n}_speed", s * bs.omega)
-            ch(f"{n}_angle", s * bs.theta)
-            ch(f"{n}_accel", s * acc[j])
+            out(speed, n, s * bs.omega)
+            out(angle, n, s * bs.theta)
+            out(accel, n, s * acc[j])
             drive = self.provided("drive_torque", b.name)
             if b.prescribed:
-                ch(f"{n}_torque", s * tau[j])  # inverse dynamics (RNEA)
+                out(torque, n, s * tau[j])  # inverse dynamics (RNEA)
             elif drive is not None:
-                ch(f"{n}_torque", drive)  # the input or the controller
+                out(torque, n, drive)  # the input or the controller
             else:
-                ch(f"{n}_torque", s * bs.ty)
+                out(torque, n, s * bs.ty)
             for c in b.free:
                 jc = b.joints[c] - 1
-                ch(f"{n}_{c}", self.q[jc])
-                ch(f"{n}_{c}_dot", self.v[jc])
-                ch(f"{n}_{c}_accel", acc[jc])
+                position, rate, acceleration = COORD_CHANNELS[c]
+                out(position, n, self.q[jc])
+                out(rate, n, self.v[jc])
+                out(acceleration, n, acc[jc])
             b.outputs(self, bs)
+        normal, friction, slip, penetration = NIP_CHANNELS
         for nip in mach.nips:
             ns = self.nips[nip.name]
-            ch(f"{nip.name}_normal_force", ns.normal_force)
-            ch(f"{nip.name}_friction_force", ns.friction_force)
-            ch(f"{nip.name}_slip_velocity", ns.v_s)
-            ch(f"{nip.name}_penetration", ns.delta)
+            out(normal, nip.name, ns.normal_force)
+            out(friction, nip.name, ns.friction_force)
+            out(slip, nip.name, ns.v_s)
+            out(penetration, nip.name, ns.delta)
         for w in mach.webs:
             a = self.bodies[w.entry.a.name]
-            ch(f"{w.channel}web_speed", a.omega * a.r)
+            out(WEB_SPEED, w.channel, a.omega * a.r)

@@ -135,7 +135,9 @@ class BodyElement(ABC):
        [s] where its prescribed motion has a kink), :meth:`operating_speed` and
        :meth:`hold_operating_speed` (a prescribed drive at a given web speed, for the
        resonance map), :meth:`structure_tag`
-       (what changes its generated code beyond its names).
+       (what changes its generated code beyond its names); for the analyses
+       :attr:`least_radius`, :meth:`radius_after` (its growth law integrated),
+       :meth:`drive_web_speed`, :meth:`surface_speed` and :meth:`web_length`.
     6. Scene side, where the defaults do not do: :meth:`parse` (its part from its raw
        table: the default checks :attr:`KEYS` and builds :attr:`part_cls`; sub-tables and
        checks across keys need their own), :meth:`fixed_centre` and
@@ -218,11 +220,6 @@ class BodyElement(ABC):
         self.com_offset: float | None = None
         #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine
         self.joints: dict[str, int] = {}
-
-    @property
-    def kind(self) -> str:
-        """The part's table name (``drum``, ``roll``, ``rider``); for messages only."""
-        return self.table
 
     # ---- scene ------------------------------------------------------------------------
     @classmethod
@@ -315,6 +312,35 @@ class BodyElement(ABC):
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r})"
+
+    # ---- for the analyses (operating point, resonance map, sweep bands) ----------------
+    #: the scene key of its smallest radius (:attr:`least_radius`), for messages
+    least_radius_key: ClassVar[str] = "radius"
+
+    @property
+    def least_radius(self) -> float:
+        """Its smallest radius [m] (a wound roll's core; default: its initial radius)."""
+        return self.initial_radius
+
+    def radius_after(self, length: float) -> float:
+        """Its radius [m] once ``length`` [m] of web has wound onto it at no slip (default:
+        constant, :attr:`initial_radius`)."""
+        return self.initial_radius
+
+    def drive_web_speed(self) -> float | None:
+        """The surface (web) speed [m/s] its drive names (a speed profile's full speed, a
+        torque drive's initial one), or None (no drive speed)."""
+        return None
+
+    def surface_speed(self, web_speed: float) -> float:
+        """Its surface speed [m/s] when its prescribed drive runs at ``web_speed`` [m/s]
+        (:meth:`operating_speed` times its radius); only where it has a drive speed."""
+        raise NotImplementedError(f"{self!r} has no drive speed")
+
+    def web_length(self, duration: float, web_speed: float) -> float:
+        """Web [m] its drive brings in over ``duration`` [s] at ``web_speed`` [m/s]; only
+        where it has a drive speed."""
+        raise NotImplementedError(f"{self!r} has no drive speed")
 
 
 class RigidDisc(BodyElement):

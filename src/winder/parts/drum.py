@@ -181,3 +181,22 @@ class DrumBody(RigidDisc):
 
     def drive_torque(self, ev: Evaluation) -> Any:
         return None if self.prescribed else ev.p(f"{self.name}.torque")
+
+    # ---- for the analyses ---------------------------------------------------------------
+    def drive_web_speed(self) -> float | None:
+        """Its drive's ``web_speed`` [m/s]."""
+        return float(self.part.drive.web_speed)
+
+    def surface_speed(self, web_speed: float) -> float:
+        """``ratio · v`` [m/s] (a speed profile's ``ratio``; a torque drive: ``v``)."""
+        return getattr(self.part.drive, "ratio", 1.0) * web_speed
+
+    def web_length(self, duration: float, web_speed: float) -> float:
+        """Web [m] over ``duration`` ``T`` [s] at ``web_speed`` ``v`` [m/s] along its
+        profile: the ramp at ``web_acceleration`` ``a_w`` to ``v`` (none: ``v`` from the
+        start), ``a_w T²/2`` within the ramp, else ``v T − v t_r/2`` with ``t_r = v/a_w``."""
+        a, v, T = getattr(self.part.drive, "web_acceleration", 0.0), web_speed, duration
+        if a > 0.0 and v > 0.0:
+            tr = v / a
+            return a * T * T / 2 if T <= tr else v * T - v * tr / 2
+        return v * T

@@ -109,9 +109,8 @@ class TensionControl:
 class RollPart:
     """``[[roll]]``: a paper roll; keys, units, bounds and meanings: :data:`KEYS` (an
     unwinding roll's drive: :data:`DRIVE_KEYS`, None for a free one). density and caliper
-    come from ``[paper]`` unless given. initial_height [m]: only from the single-drum
-    format's ``[roll] initial_height`` (a fixed initial centre ``z``, no static solve),
-    else None.
+    come from ``[paper]`` unless given. held_z [m]: a given initial centre ``z`` that the
+    static balance leaves as it is (no scene key of a roll sets it; None: solved).
     """
 
     name: str
@@ -128,7 +127,7 @@ class RollPart:
     com_offset: float = 0.0
     density: float
     caliper: float
-    initial_height: float | None = None
+    held_z: float | None = None
     drive: UnwindTorqueDrive | TensionControl | None = None
 
 
@@ -275,8 +274,8 @@ class RollBody(BodyElement):
         return self.sense * self.part.initial_speed if coord == "theta" else 0.0
 
     def fixed_at_rest(self) -> Mapping[str, float]:
-        """The single-drum format's ``[roll] initial_height``: a given centre ``z``."""
-        h = getattr(self.part, "initial_height", None)
+        """A given initial centre ``z`` (:attr:`RollPart.held_z`), held out of the balance."""
+        h = getattr(self.part, "held_z", None)
         return {} if h is None else {"z": h}
 
     def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
@@ -310,12 +309,23 @@ class RollBody(BodyElement):
         return ev.p(f"{self.name}.torque") if self.torque_inputs else None
 
     def outputs(self, ev: Evaluation, bs: BodyState) -> None:
-        n, ch = self.name, ev.set_channel
-        ch(f"{n}_radius", bs.r)
-        ch(f"{n}_mass", bs.mass)
-        ch(f"{n}_inertia", bs.inertia)
-        ch(f"{n}_mass_rate", bs.mass_rate)
-        ch(f"{n}_inertia_rate", bs.inertia_rate)
+        values = (bs.r, bs.mass, bs.inertia, bs.mass_rate, bs.inertia_rate)
+        for declared, value in zip(self.CHANNELS, values, strict=True):
+            ev.output(declared, self.name, value)
 
     def structure_tag(self) -> str:
         return f"{super().structure_tag()}:{self.unwinding}"
+
+    # ---- for the analyses ---------------------------------------------------------------
+    least_radius_key = "core_radius"
+
+    @property
+    def least_radius(self) -> float:
+        """Its core radius ``r_c`` [m]."""
+        return float(self.part.core_radius)
+
+    def radius_after(self, length: float) -> float:
+        """The growth law (machines.md §1, one caliper ``h`` per revolution) integrated:
+        ``r² = r₀² + h L/π`` [m] once ``L`` = ``length`` [m] of paper is wound on."""
+        part = self.part
+        return math.sqrt(part.initial_radius**2 + part.caliper * length / math.pi)

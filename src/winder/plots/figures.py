@@ -312,9 +312,9 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     paths: list[Path] = []
     color = nip_colours(scene)
     nip_label = {n.name: f"nip {n.name} ({n.a}–{n.b})" for n in scene.nips}
-    bodies = body_elements(scene)  # drawn by their role, in the machine's order
-    drums = [b for b in bodies if b.role == "drum"]
-    turning = [b for b in bodies if b.role != "drum"]  # rolls, riders, ...
+    bodies = body_elements(scene)  # in the machine's order
+    drums = [b for b in bodies if _drive(b)]
+    turning = [b for b in bodies if not _drive(b)]  # rolls, riders, ...
     wound = [b for b in bodies if b.radius_state]  # their radius is a channel
 
     # drums: speeds, then one torque row per drum
@@ -423,6 +423,12 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
             paths.append(_span_figure(result, scene, bodies, w, pre,
                                       out / f"{stem}_{pre}span.png", name))
     return paths
+
+
+def _drive(body: BodyElement) -> bool:
+    """Whether ``body`` is a drive of constant radius (a drum: prescribed or on a torque
+    input, its radius no state), drawn with its drive torque."""
+    return (body.prescribed or bool(body.torque_inputs)) and not body.radius_state
 
 
 def _body_label(body: BodyElement) -> str:

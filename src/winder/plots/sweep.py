@@ -33,12 +33,11 @@ from winder.io.files import atomic_write  # noqa: E402
 from winder.scene.keys import key_unit  # noqa: E402
 from winder.scene.load import scene_from_dict  # noqa: E402
 
-__all__ = ["runnability_map", "map_layout", "axis_label", "SPEED_KEY"]
+__all__ = ["runnability_map", "map_layout", "axis_label"]
 
-#: The key path of the web speed of a single-drum scene. An axis whose keys are all drums'
-#: web speeds (``drum.drive.web_speed``, ``drum.NAME.drive.web_speed``, tied or not) is the
-#: map's vertical axis when it is swept.
-SPEED_KEY = "drum.drive.web_speed"
+#: An axis whose keys are all drives' web speeds (``drum.drive.web_speed``,
+#: ``drum.NAME.drive.web_speed``, tied or not) is the map's vertical axis when it is swept.
+_SPEED_PATH = ("drive", "web_speed")
 _ORDERS = ((1, "-"), (2, "--"), (3, ":"))
 _MAX_PANELS = 12
 
@@ -69,8 +68,8 @@ def _critical_lines(table: SweepTable, fixed: dict, speeds: np.ndarray,
 
 
 def _is_speed(axis: str) -> bool:
-    """Whether every key of ``axis`` (``"k1,k2"``) is a drum's web speed."""
-    return all(k.startswith("drum.") and k.endswith(".drive.web_speed")
+    """Whether every key of ``axis`` (``"k1,k2"``) is a drive's web speed."""
+    return all(tuple(k.split(".")[-2:]) == _SPEED_PATH and k.count(".") >= 2
                for k in split_keys(axis))
 
 

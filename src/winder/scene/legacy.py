@@ -102,6 +102,10 @@ CHANNELS = ("t", *list(COLUMNS)[:15])
 #: web momentum force, penetration.
 EXTRA_CHANNELS = tuple(list(COLUMNS)[15:])
 
+#: The resonance map's table of a single-drum scene (:meth:`winder.ModeMap.as_columns`).
+MODE_MAP_COLUMNS = ("radius", "bounce_frequency", "bounce_damping", "slip_frequency",
+                    "slip_damping", "rotation_1x", "rotation_2x", "critical_web_speed")
+
 #: The keys that place the drum and the roll (their parts' ``centre``).
 _PLACE_KEYS = {("drum", "centre"): "[drum] radius", ("roll", "centre"): "[roll] initial_radius"}
 
@@ -170,6 +174,14 @@ class SingleDrumNaming(Naming):
         else:  # free drum, started at the profile's initial speed
             drive.update(kind="torque", web_acceleration=a, web_speed=0.0 if a > 0 else v,
                          torque=0.0)
+
+    def result_meta(self, scene: Any) -> dict[str, Any]:
+        """``drum_radius`` [m]: the paper figures mark where the roll passes it."""
+        return {"drum_radius": scene.drum.radius}
+
+    def mode_map_columns(self, columns: Mapping[str, Any]) -> dict[str, Any]:
+        """The historic columns only (:data:`MODE_MAP_COLUMNS`)."""
+        return {k: v for k, v in columns.items() if k in MODE_MAP_COLUMNS}
 
 
 _COLUMN_OF = {decl.of(owner): column for column, (decl, owner) in COLUMNS.items()}
@@ -254,7 +266,7 @@ def legacy_parts(drum: Drum, roll: Roll, paper: Paper, contact: LegacyContact,
                            initial_radius=roll.initial_radius,
                            initial_speed=roll.initial_speed, com_offset=roll.com_offset,
                            density=paper.density, caliper=paper.caliper,
-                           initial_height=roll.initial_height),),
+                           held_z=roll.initial_height),),
         "riders": (),
         "nips": (NipPart(name="nip", a="drum", b="roll",
                          contact=ContactLaw(**dataclasses.asdict(contact)),

@@ -98,6 +98,16 @@ class Naming:
     #: scene (:func:`naming_of` ``(None)`` is the naming that has them)
     bodies_without_scene: ClassVar[Mapping[str, tuple[str, ...]]] = {}
 
+    def mode_map_columns(self, columns: Mapping[str, Any]) -> dict[str, Any]:
+        """The resonance map's table (:meth:`winder.ModeMap.as_columns`) from all its
+        ``columns``: every one."""
+        return dict(columns)
+
+    def result_meta(self, scene: Any) -> dict[str, Any]:
+        """What a result of ``scene`` carries in its ``meta`` for the figures of this
+        naming (none for a scene of parts)."""
+        return {}
+
 
 #: The naming of every scene of parts.
 BY_PARTS = Naming()

@@ -15,6 +15,7 @@ from winder._args import real_argument
 from winder._errors import ArgumentError, ArgumentTypeError, SimulationError
 from winder.io.result import Result
 from winder.model.locked_modes import CORE_AUTO
+from winder.scene import naming_of
 from winder.scene.load import Scene, load_scene
 from winder.scene.schema import BACKENDS, MAX_SAMPLES, METHODS
 from winder.solve import integrators as integ
@@ -314,7 +315,7 @@ def _meta(scene: Scene, system: MachineSystem, meth: str, rtol: float, atol: flo
             "backend": system.backend, "rtol": rtol, "atol": atol,
             "rhs_evaluations": system.nfev, "wall_time": wall, "events": n_events,
             "t_start": t_s, "t_end": T, "effects": list(scene.effects.enabled()),
-            "drum_radius": scene.drums[0].radius, "scene_dict": scene.to_dict(),
+            **naming_of(scene).result_meta(scene), "scene_dict": scene.to_dict(),
             "static_residual": None if eq is None else eq.residual,
             "ended": system.end[2] if system.end is not None else None,
             "static_scale": None if eq is None else eq.scale,

@@ -12,7 +12,7 @@ import numpy as np
 from winder._args import real_argument
 from winder._errors import ArgumentError, SimulationError, state_text
 from winder.io.result import Result
-from winder.scene import CHANNELS, EXTRA_CHANNELS, naming_of
+from winder.scene import naming_of
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
 from winder.solve.budgets import budget_error, check_budgets, check_tolerances
@@ -20,13 +20,7 @@ from winder.solve.dopri5 import dopri5
 from winder.solve.simulate import _as_scene
 from winder.solve.system import MachineSystem
 
-__all__ = ["Stepper", "INPUTS", "OUTPUTS", "inputs_of", "outputs_of"]
-
-#: Input of a single-drum scene's :class:`Stepper`: ``drum_torque`` [N·m] (drive kind
-#: ``torque`` only). A machine from parts has ``DRUM_torque`` per torque-driven drum.
-INPUTS = ("drum_torque",)
-#: Outputs of a single-drum scene: every result channel but ``t``.
-OUTPUTS = (*CHANNELS[1:], *EXTRA_CHANNELS)
+__all__ = ["Stepper", "inputs_of", "outputs_of"]
 
 
 def inputs_of(system: MachineSystem) -> dict[str, str]:

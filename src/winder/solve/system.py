@@ -21,13 +21,14 @@ from winder._errors import ArgumentError, SimulationError, state_text
 from winder.model.backends import NumericBackend
 from winder.model.channels import TIME
 from winder.model.codegen import CompilerMissing, Generated, generate
-from winder.model.machine import AT_CORE, AUTO, CORE_AUTO, WINDING, Machine
-from winder.scene import CHANNELS, EXTRA_CHANNELS, naming_of  # (public: the single-drum columns)
+from winder.model.locked_modes import AT_CORE, AUTO, CORE_AUTO, WINDING, ModeKind
+from winder.model.machine import Machine
+from winder.scene import naming_of
 from winder.solve import integrators as integ
 from winder.solve._jit import njit
 from winder.solve.equilibrium import Equilibrium, static_state
 
-__all__ = ["MachineSystem", "CHANNELS", "EXTRA_CHANNELS", "NoCompilerWarning"]
+__all__ = ["MachineSystem", "NoCompilerWarning"]
 
 class NoCompilerWarning(UserWarning):
     """The generated path is unavailable (no C compiler): the numeric Pinocchio path runs."""
@@ -120,14 +121,6 @@ class MachineSystem:
         unwinding roll)."""
         return [name for b in self.machine.bodies for name in b.torque_inputs]
 
-    def set_drum_torque(self, torque: float) -> None:
-        """Input torque [N·m] of the torque-driven drum (scenes with exactly one)."""
-        names = self.torque_inputs()
-        if len(names) != 1:
-            raise ArgumentError("drum_torque is an input only with one drum of drive kind "
-                                f"'torque'; this scene has {len(names)}")
-        self.set_input(names[0], torque)
-
     def set_core_mode(self, core: int) -> None:
         """Lock the core mode of every wound roll (``CORE_AUTO``, ``WINDING``,
         ``AT_CORE``) for :meth:`rhs`."""
@@ -137,13 +130,15 @@ class MachineSystem:
         self.modes[self.table[:, 0] == integ.K_CORE] = core
 
     def ended(self, t: float, y: np.ndarray) -> None:
-        """Record that the run ends at ``t`` [s] in state ``y``: an unwinding roll reached
-        its core (machines.md §1)."""
+        """Record that the run ends at ``t`` [s] in state ``y``: the state of an END mode
+        (:attr:`~winder.model.locked_modes.ModeKind.END`: an unwinding roll's radius)
+        reached its parameter (the core radius, machines.md §1)."""
         m = self.machine
-        spent = [w.unwind.name for w in m.webs if w.unwind is not None
-                 and y[m.index(f"{w.unwind.name}.radius")]
-                 <= w.unwind.part.core_radius * (1.0 + 1e-9)]
-        roll = spent[0] if spent else (m.unwind.name if m.unwind is not None else "?")
+        ends = [mode for mode in m.modes if mode.kind is ModeKind.END]
+        spent = [mode.owner for mode in ends
+                 if y[m.index(mode.state)]
+                 <= self.params[m.param_index(mode.param)] * (1.0 + 1e-9)]
+        roll = spent[0] if spent else (ends[0].owner if ends else "?")
         self.end = (float(t), np.array(y, dtype=float),
                     f"the unwinding roll {roll!r} ran out of web (its radius reached the "
                     f"core) at t = {t:.6g} s: the run ends there")
@@ -230,7 +225,7 @@ class MachineSystem:
                 continue
             over = float(g[m.switch_names.index(name)])
             if not over <= 0.0:
-                radii = [m.radius(y, b) for b in (nip.a, nip.b)]
+                radii = [b.radius_of(y, m) for b in (nip.a, nip.b)]
                 out.append((nip.name, over + min(radii), min(radii)))
         return out
 
