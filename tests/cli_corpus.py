@@ -1,5 +1,5 @@
 """A corpus of bad command lines, output paths, scene names and result files for the CLI's
-error contract, shared by tests/test_cli_contract.py.
+error contract, shared by tests/cli/test_cli_contract.py.
 
 Each :class:`Case` builds its inputs in a fresh folder and gives an argument list. It ends
 *cleanly* when ``main`` returns 2 (or 0 where a sane run is allowed) without an exception,

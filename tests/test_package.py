@@ -251,3 +251,13 @@ def test_no_lower_module_imports_the_package_root() -> None:
             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
             if pattern.match(line)]
     assert hits == []
+
+
+def test_tests_mirror_the_package() -> None:
+    """Each layer package of src/winder (and viewer/) has its test folder tests/NAME, and
+    every test folder is such a package (the whole-package tests stay in tests/)."""
+    packages = {p.name for p in (ROOT / "src" / "winder").iterdir()
+                if p.is_dir() and (p / "__init__.py").exists()} | {"viewer", "cli"}
+    folders = {p.name for p in (ROOT / "tests").iterdir()
+               if p.is_dir() and any(p.glob("test_*.py"))}
+    assert folders == packages

@@ -14,7 +14,7 @@ from winder.scene import Naming, naming_of
 from winder.scene.legacy import COLUMNS, SINGLE_DRUM
 from winder.solve.system import MachineSystem
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_channel_declaration_names_its_channels():

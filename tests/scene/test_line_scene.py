@@ -28,7 +28,7 @@ from winder.parts import (
 )
 from winder.scene import EFFECT_NAMES
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 LINE = MODELS / "winder_line.toml"
 SMALL = MODELS / "winder_line_small.toml"
 TWO_DRUM = MODELS / "two_drum_winder.toml"

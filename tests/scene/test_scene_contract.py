@@ -4,7 +4,7 @@ names the file and the key, or a scene that loads and runs sanely for a moment (
 state and channels, the roll axis above the drum, positive mass and inertia), or a clean
 winder error from the run itself. Nothing else: no other exception, no impossible answer.
 
-``python tests/test_scene_contract.py`` runs the whole corpus (every scene, key and
+``python tests/scene/test_scene_contract.py`` runs the whole corpus (every scene, key and
 category) and prints how many cases end cleanly per category.
 """
 
@@ -25,7 +25,7 @@ from hypothesis import strategies as st
 import winder
 from winder.scene.legacy import LEGACY_TABLES
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 #: The shipped scenes in the single-drum format (the keys below are its tables).
 SCENES = sorted(p for p in MODELS.glob("*.toml")
                 if isinstance(tomllib.loads(p.read_text("utf-8")).get("drum"), dict))

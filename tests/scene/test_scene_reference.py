@@ -22,7 +22,7 @@ from winder.scene.reference import (
 )
 from winder.solve.system import MachineSystem
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "scene-reference.md"
 
 

@@ -24,7 +24,7 @@ from winder.scene.legacy import LEGACY_TABLES
 from winder.scene.reference import reference
 from winder.scene.schema import PAPER_KEYS, TABLES, effect_settings
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "models"
 #: The parts' own declarations, by module.
 PART_TABLES = {drum: (drum.KEYS, drum.DRIVE_KEYS), roll: (roll.KEYS, roll.DRIVE_KEYS),

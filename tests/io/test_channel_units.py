@@ -15,7 +15,7 @@ import winder
 from winder.model.units import DIMENSIONS, dimensions, fmi_name
 from winder.solve.system import MachineSystem
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = sorted(p.stem for p in (ROOT / "models").glob("*.toml"))
 N = {"kg": 1, "m": 1, "s": -2}  # the newton, by hand
 

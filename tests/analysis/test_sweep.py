@@ -35,7 +35,7 @@ from winder.scene import key_unit
 # with 0.5 mm.
 VARY = {"drum.drive.web_speed": "12:24:4", "roll.com_offset": [0.5e-3, 1e-3]}
 RUN = {"t_end": 30.0, "output_step": 2e-3, "bands": 6}
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 # Per-run columns that depend on the machine, not on the physics.
 MACHINE = ("wall_time", "task_time", "worker")
 

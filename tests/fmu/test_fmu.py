@@ -134,7 +134,7 @@ def test_200_instantiate_simulate_free_cycles(fmu_path, tmp_path) -> None:
 
 def test_closed_loop_example_writes_its_plot(tmp_path) -> None:
     """examples/speed_control_fmu.py: the PI loop holds the web speed on the ramp."""
-    example = Path(__file__).resolve().parents[1] / "examples" / "speed_control_fmu.py"
+    example = Path(__file__).resolve().parents[2] / "examples" / "speed_control_fmu.py"
     proc = subprocess.run([sys.executable, str(example), "--t-end", "8", "--out",
                            str(tmp_path)], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr[-3000:]
@@ -272,16 +272,15 @@ def test_parameters_are_the_keys_declared_for_the_fmu(models_dir, monkeypatch) -
 
     from winder._schema import Table
     from winder.fmu.build import fmu_parameters, parameter_units, parameter_value
-    from winder.scene.schema import TABLES
+    from winder.parts.roll import RollBody
 
     scene = winder.load_scene(models_dir / "winder_line.toml")
     names = set(fmu_parameters(scene))
     assert {"front_web_acceleration", "set_width", "parent_bandwidth", "rider_nip_mu",
             "span_EA"} <= names
     assert not {"set_bandwidth", "web_tension", "rider_radius"} & names
-    keys = TABLES["roll[]"]
-    monkeypatch.setitem(TABLES, "roll[]", Table(tuple(
-        replace(k, fmu="core_mass") if k.name == "core_mass" else k for k in keys)))
+    monkeypatch.setattr(RollBody, "KEYS", Table(tuple(  # the roll's own declaration
+        replace(k, fmu="core_mass") if k.name == "core_mass" else k for k in RollBody.KEYS)))
     params = fmu_parameters(scene)
     assert set(params) == names | {"set_core_mass", "parent_core_mass"}
     assert parameter_units(scene)["set_core_mass"] == "kg"
@@ -341,7 +340,7 @@ def test_two_drum_example_tracks_and_conserves_paper(tmp_path) -> None:
     drum on the 0.7 m/s² ramp, and the paper the set winds by its surface speed equals
     the paper its radius holds, π (r² − r_c²) / h (measured 3e-5 relative: the
     trapezoidal sum over 10 ms samples)."""
-    example = Path(__file__).resolve().parents[1] / "examples" / "two_drum_speed_control_fmu.py"
+    example = Path(__file__).resolve().parents[2] / "examples" / "two_drum_speed_control_fmu.py"
     proc = subprocess.run([sys.executable, str(example), "--t-end", "8", "--out",
                            str(tmp_path)], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr[-3000:]
@@ -491,7 +490,7 @@ def test_tension_control_example_equals_the_model_controller(tmp_path, models_di
     T* = 1000 N from the start (measured 1.80 N at 0.2 s, 0.013 N after 1 s)."""
     from winder.model.mass_law import paper_roll_mass
 
-    example = Path(__file__).resolve().parents[1] / "examples" / "tension_control_fmu.py"
+    example = Path(__file__).resolve().parents[2] / "examples" / "tension_control_fmu.py"
     proc = subprocess.run([sys.executable, str(example), "--t-end", "5", "--out",
                            str(tmp_path)], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr[-3000:]
@@ -552,7 +551,7 @@ def test_outputs_declare_their_units(fmu_path, two_drum_fmu, two_drum_scene) -> 
 
     legacy = _model_description(fmu_path)
     _check_output_units(legacy, {**MachineSystem(winder.load_scene(
-        Path(__file__).resolve().parents[1] / "models" / "paper_winding.toml"),
+        Path(__file__).resolve().parents[2] / "models" / "paper_winding.toml"),
         backend="pinocchio").channel_units, "web_speed_reference": "m/s"})
     unit = {v.get("name"): v.find("Real").get("unit") for v in legacy.iter("ScalarVariable")
             if v.find("Real") is not None}
@@ -573,7 +572,7 @@ def test_parameters_declare_their_units(fmu_path, two_drum_fmu, two_drum_scene) 
     from winder.model.units import fmi_name
     from winder.scene import key_unit
 
-    paper = winder.load_scene(Path(__file__).resolve().parents[1] / "models"
+    paper = winder.load_scene(Path(__file__).resolve().parents[2] / "models"
                               / "paper_winding.toml")
     for path, scene in ((fmu_path, paper), (two_drum_fmu, two_drum_scene)):
         root = _model_description(path)

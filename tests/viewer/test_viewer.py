@@ -211,7 +211,7 @@ def test_meshcat_server_stopped_on_error_and_on_success(tmp_path: Path, paper_sc
 
 # ---- machines of parts: the two-drum winder ----------------------------------------------
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
 @pytest.fixture(scope="module")

@@ -29,7 +29,7 @@ from winder.parts import (
 )
 from winder.scene import EFFECT_NAMES, Effects, LegacyContact, LegacyFriction
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 TWO_DRUM = MODELS / "two_drum_winder.toml"
 LEGACY = ("paper_winding", "paper_winding_no_web", "paper_winding_smooth", "free_spin")
 

@@ -11,7 +11,7 @@ from winder.viewer import motion, readout_text
 
 import winder
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
 @pytest.fixture(scope="module")

@@ -21,7 +21,7 @@ from winder.analysis.modes import _Linearisation, mode_map
 from winder.cli import main
 from winder.solve.equilibrium import EquilibriumError, resting_state
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 HC = {"law": "hunt_crossley", "stiffness": 1e9, "exponent": 1.5, "hc_damping": 0.3}
 
 

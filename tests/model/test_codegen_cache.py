@@ -23,7 +23,7 @@ from winder.model.machine import Machine
 
 pytest.importorskip("casadi")
 
-TESTS = Path(__file__).resolve().parent
+TESTS = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture()

@@ -29,7 +29,7 @@ from winder.analysis.sweep_grid import build_grid
 from winder.cli import main
 from winder.scene.load import scene_from_dict
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 V = 5.0  # [m/s] the web speed of every station, from t = 0
 T_END = 0.1  # [s]
 STEP = 2e-4  # [s] RK4 step (1 ms makes the stiff nips of the line ring and amplify round-off)

@@ -22,7 +22,7 @@ import tomli_w
 import winder
 from winder.solve.system import MachineSystem
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 TWO_DRUM = MODELS / "two_drum_winder.toml"
 FRONT_TORQUE = 500.0  # input torque of the torque-driven front drum of variant "mixed" [N·m]
 
