@@ -1,0 +1,106 @@
+"""The integrators in C (``solve/c/integrators.c``), next to the generated functions:
+DOPRI5 (and, to come, RK4) with the contract of the numba kernels
+(:func:`winder.solve.dopri5.dopri5`): the same arguments, statuses, counters and results,
+bit for bit (issue #23, step 1).
+
+For now a separate small shared library, compiled with the flags of the generated code
+(:data:`winder.model.codegen.CFLAGS`, plus ``-ffp-contract=off`` so that no fused
+multiply–add changes a rounding), cached under :func:`~winder.model.codegen.cache_dir`
+keyed by its source and the flags, loaded with ctypes; it takes the generated functions'
+addresses (``MachineSystem.fns``). The one library per machine comes later.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from winder.model.codegen import CFLAGS, CompileError, _compiler, cache_dir
+
+__all__ = ["dopri5", "library", "SOURCE", "EXTRA_CFLAGS"]
+
+SOURCE = Path(__file__).resolve().parent / "c" / "integrators.c"
+#: Flags beyond the generated code's: no contraction into FMA (bit-equality with numba).
+EXTRA_CFLAGS = ("-ffp-contract=off", "-std=c99")
+
+_LIB: Any = None
+
+_dp = ctypes.POINTER(ctypes.c_double)
+_ip = ctypes.POINTER(ctypes.c_int64)
+_i64, _f64 = ctypes.c_int64, ctypes.c_double
+
+
+def _build(directory: Path | None = None) -> Path:
+    flags = (*CFLAGS, *EXTRA_CFLAGS)
+    src = SOURCE.read_bytes()
+    key = hashlib.sha256(src + " ".join(flags).encode()).hexdigest()[:20]
+    root = Path(directory) if directory is not None else cache_dir() / "integrators"
+    lib = root / f"integrators-{key}.so"
+    if lib.exists():
+        return lib
+    cc = _compiler()
+    root.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
+        tmp_lib = Path(tmp) / lib.name
+        proc = subprocess.run([cc, *flags, str(SOURCE), "-o", str(tmp_lib), "-lm"],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise CompileError(f"compiling the C integrators failed ({cc}):\n"
+                               + proc.stderr[-2000:])
+        os.replace(tmp_lib, lib)
+    return lib
+
+
+def library() -> Any:
+    """The loaded C integrators (built and cached on first use)."""
+    global _LIB
+    if _LIB is None:
+        handle = ctypes.CDLL(str(_build()))
+        fn = handle.winder_dopri5
+        fn.restype = ctypes.c_int
+        fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
+                       _f64, _dp, _i64, _dp, _i64, _i64, _ip, _i64, _dp, _dp, _ip]
+        _LIB = handle
+    return _LIB
+
+
+def _ptr(a: np.ndarray, dtype: Any, name: str, writable: bool = False) -> Any:
+    if a.dtype != dtype or not a.flags.c_contiguous or (writable and not a.flags.writeable):
+        raise TypeError(f"{name}: a C-contiguous{' writable' if writable else ''} {dtype} "
+                        f"array is needed, got {a.dtype} {a.shape}")
+    return a.ctypes.data_as(_ip if dtype == np.int64 else _dp)
+
+
+def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
+           p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
+           max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
+           stats: np.ndarray) -> tuple[int, float, float, int]:
+    """:func:`winder.solve.dopri5.dopri5` in C: the same arguments and results
+    (``(status, t, h, k)``; ``y``, ``m``, ``Y_out`` and ``stats`` updated in place)."""
+    lib = library()
+    n = y.shape[0]
+    if Y_out.ndim != 2 or Y_out.shape[0] != n or Y_out.shape[1] != t_out.shape[0]:
+        raise ValueError(f"Y_out must be ({n}, {t_out.shape[0]}), got {Y_out.shape}")
+    if table.ndim != 2 or table.shape[1] != 5 or m.shape[0] != table.shape[0]:
+        raise ValueError("table must be (slots, 5) with one mode per slot")
+    if fns.shape[0] < 4:
+        raise ValueError("fns must hold the 4 generated functions' addresses")
+    tr, hr, kr = _f64(), _f64(), _i64()
+    status = lib.winder_dopri5(
+        _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+        float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+        _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol), float(atol),
+        float(h), float(max_step), _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
+        _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
+        _ptr(stats, np.int64, "stats", True), stats.shape[0], ctypes.byref(tr),
+        ctypes.byref(hr), ctypes.byref(kr))
+    if status == 6:
+        raise MemoryError("the C integrator could not allocate its work buffers")
+    return int(status), tr.value, hr.value, int(kr.value)
