@@ -20,6 +20,7 @@ import winder
 from winder.solve import cint
 from winder.solve import integrators as integ
 from winder.solve.dopri5 import dopri5 as dopri5_numba
+from winder.solve.rk4 import rk4 as rk4_numba
 from winder.solve.system import MachineSystem
 
 
@@ -135,4 +136,68 @@ def test_guard_without_error_control(paper_scene) -> None:
     """``atol = 1e300``: DOPRI5 steps the axis into the drum; the guard stops it."""
     system, y0 = _system(paper_scene.replace(roll={"com_offset": 0.0}))
     trace = _compare(system, y0, 0.5, 1e-6, 1e300, 10**7, n_out=51)
+    assert trace[-1][0] == integ.PENETRATED
+
+
+# ---- RK4 ------------------------------------------------------------------------------
+
+def _run_rk4(kernel, system: MachineSystem, y0: np.ndarray, t1: float, step: float,
+             window: float, n_out: int) -> tuple[list, np.ndarray, np.ndarray]:
+    """RK4 in windows of ``window`` seconds (as simulate chunks it): the trace after
+    every call, the final state and samples."""
+    y, m = y0.copy(), system.modes.copy()
+    t_out = np.linspace(0.0, t1, n_out)
+    Y = np.full((len(y), n_out), np.nan)
+    stats = np.zeros(5, dtype=np.int64)
+    t, k, trace = 0.0, 0, []
+    while t < t1:
+        t_next = min(t1, t + window)
+        status, t, h, k = kernel(system.fns, system.table, t, t_next, y, system.params, m,
+                                 step, t_out, Y, k, stats)
+        trace.append((status, t, h, k, stats.copy(), m.copy(), y.copy()))
+        if status != integ.DONE:
+            break
+    return trace, y, Y
+
+
+def _compare_rk4(system: MachineSystem, y0: np.ndarray, t1: float, step: float,
+                 window: float, n_out: int = 101) -> list:
+    a, ya, Ya = _run_rk4(rk4_numba, system, y0, t1, step, window, n_out)
+    b, yb, Yb = _run_rk4(cint.rk4, system, y0, t1, step, window, n_out)
+    assert len(a) == len(b)
+    for i, (ra, rb) in enumerate(zip(a, b, strict=True)):
+        assert ra[0] == rb[0] and ra[3] == rb[3], (i, ra[:4], rb[:4])
+        np.testing.assert_array_equal(ra[4], rb[4], err_msg=f"call {i}: stats")
+        np.testing.assert_array_equal(ra[5], rb[5], err_msg=f"call {i}: modes")
+        _close(ra[1], rb[1], f"call {i}: t")
+        _close(ra[2], rb[2], f"call {i}: h")
+        _close(ra[6], rb[6], f"call {i}: y")
+    _close(ya, yb, "final state")
+    _close(Ya, Yb, "samples")
+    return a
+
+
+def test_rk4_paper_and_two_drum_scenes(paper_scene, models_dir) -> None:
+    system, y0 = _system(paper_scene)
+    trace = _compare_rk4(system, y0, 2.0, 1e-3, 0.7)
+    assert trace[-1][0] == integ.DONE and trace[-1][4][1] >= 2000
+    system, y0 = _system(winder.load_scene(models_dir / "two_drum_winder.toml"))
+    trace = _compare_rk4(system, y0, 1.0, 1e-3, 0.3)
+    assert trace[-1][0] == integ.DONE and trace[-1][4][1] >= 1000
+
+
+def test_rk4_core_events(paper_scene) -> None:
+    """The core events on the step's Hermite interpolant: lands on the core, winds again."""
+    rc = paper_scene.roll.core_radius
+    scene = paper_scene.replace(roll={"initial_radius": rc + 2e-6, "initial_speed": -5.0})
+    system, y0 = _system(scene)
+    trace = _compare_rk4(system, y0, 0.3, 1e-4, 0.05)
+    assert trace[-1][4][3] >= 2
+
+
+@pytest.mark.parametrize("step", [0.02, 0.05])
+def test_rk4_guard(paper_scene, step) -> None:
+    """Dropped from 20 m with coarse steps: the guard stops on the drum (PENETRATED)."""
+    system, y0 = _system(paper_scene.replace(roll={"initial_height": 20.0}))
+    trace = _compare_rk4(system, y0, 3.0, step, 1.0)
     assert trace[-1][0] == integ.PENETRATED

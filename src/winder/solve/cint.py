@@ -1,7 +1,7 @@
-"""The integrators in C (``solve/c/integrators.c``), next to the generated functions:
-DOPRI5 (and, to come, RK4) with the contract of the numba kernels
-(:func:`winder.solve.dopri5.dopri5`): the same arguments, statuses, counters and results,
-bit for bit (issue #23, step 1).
+"""The integrators in C (``solve/c/``: ``events.h`` the shared mode table, event location
+and guard; ``dopri5.c``, ``rk4.c``), next to the generated functions: the contract of the
+numba kernels (:func:`winder.solve.dopri5.dopri5`, :func:`winder.solve.rk4.rk4`): the
+same arguments, statuses, counters and results, bit for bit (issue #23, step 1).
 
 For now a separate small shared library, compiled with the flags of the generated code
 (:data:`winder.model.codegen.CFLAGS`, plus ``-ffp-contract=off`` so that no fused
@@ -24,9 +24,11 @@ import numpy as np
 
 from winder.model.codegen import CFLAGS, CompileError, _compiler, cache_dir
 
-__all__ = ["dopri5", "library", "SOURCE", "EXTRA_CFLAGS"]
+__all__ = ["dopri5", "rk4", "library", "SOURCES", "EXTRA_CFLAGS"]
 
-SOURCE = Path(__file__).resolve().parent / "c" / "integrators.c"
+_DIR = Path(__file__).resolve().parent / "c"
+#: The translation units of the library (each includes ``events.h``).
+SOURCES = (_DIR / "dopri5.c", _DIR / "rk4.c")
 #: Flags beyond the generated code's: no contraction into FMA (bit-equality with numba).
 EXTRA_CFLAGS = ("-ffp-contract=off", "-std=c99")
 
@@ -39,8 +41,10 @@ _i64, _f64 = ctypes.c_int64, ctypes.c_double
 
 def _build(directory: Path | None = None) -> Path:
     flags = (*CFLAGS, *EXTRA_CFLAGS)
-    src = SOURCE.read_bytes()
-    key = hashlib.sha256(src + " ".join(flags).encode()).hexdigest()[:20]
+    h = hashlib.sha256(" ".join(flags).encode())
+    for f in sorted(_DIR.glob("*.[ch]")):  # every source and header: the key
+        h.update(f.name.encode() + b"\0" + f.read_bytes())
+    key = h.hexdigest()[:20]
     root = Path(directory) if directory is not None else cache_dir() / "integrators"
     lib = root / f"integrators-{key}.so"
     if lib.exists():
@@ -49,7 +53,7 @@ def _build(directory: Path | None = None) -> Path:
     root.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
         tmp_lib = Path(tmp) / lib.name
-        proc = subprocess.run([cc, *flags, str(SOURCE), "-o", str(tmp_lib), "-lm"],
+        proc = subprocess.run([cc, *flags, *map(str, SOURCES), "-o", str(tmp_lib), "-lm"],
                               capture_output=True, text=True)
         if proc.returncode != 0:
             raise CompileError(f"compiling the C integrators failed ({cc}):\n"
@@ -67,6 +71,10 @@ def library() -> Any:
         fn.restype = ctypes.c_int
         fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
                        _f64, _dp, _i64, _dp, _i64, _i64, _ip, _i64, _dp, _dp, _ip]
+        fn = handle.winder_rk4
+        fn.restype = ctypes.c_int
+        fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _dp, _i64,
+                       _dp, _i64, _ip, _dp, _dp, _ip]
         _LIB = handle
     return _LIB
 
@@ -85,13 +93,7 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
     """:func:`winder.solve.dopri5.dopri5` in C: the same arguments and results
     (``(status, t, h, k)``; ``y``, ``m``, ``Y_out`` and ``stats`` updated in place)."""
     lib = library()
-    n = y.shape[0]
-    if Y_out.ndim != 2 or Y_out.shape[0] != n or Y_out.shape[1] != t_out.shape[0]:
-        raise ValueError(f"Y_out must be ({n}, {t_out.shape[0]}), got {Y_out.shape}")
-    if table.ndim != 2 or table.shape[1] != 5 or m.shape[0] != table.shape[0]:
-        raise ValueError("table must be (slots, 5) with one mode per slot")
-    if fns.shape[0] < 4:
-        raise ValueError("fns must hold the 4 generated functions' addresses")
+    n = _check(fns, table, y, m, t_out, Y_out, stats)
     tr, hr, kr = _f64(), _f64(), _i64()
     status = lib.winder_dopri5(
         _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
@@ -101,6 +103,42 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
         _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
         _ptr(stats, np.int64, "stats", True), stats.shape[0], ctypes.byref(tr),
         ctypes.byref(hr), ctypes.byref(kr))
+    return _result(status, tr, hr, kr)
+
+
+def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
+        p: np.ndarray, m: np.ndarray, h: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
+        stats: np.ndarray) -> tuple[int, float, float, int]:
+    """:func:`winder.solve.rk4.rk4` in C: the same arguments and results."""
+    lib = library()
+    n = _check(fns, table, y, m, t_out, Y_out, stats)
+    tr, hr, kr = _f64(), _f64(), _i64()
+    status = lib.winder_rk4(
+        _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+        float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+        _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(h),
+        _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
+        _ptr(Y_out, np.float64, "Y_out", True), int(k),
+        _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
+        ctypes.byref(kr))
+    return _result(status, tr, hr, kr)
+
+
+def _check(fns: np.ndarray, table: np.ndarray, y: np.ndarray, m: np.ndarray,
+           t_out: np.ndarray, Y_out: np.ndarray, stats: np.ndarray) -> int:
+    n = y.shape[0]
+    if stats.shape[0] < 4:
+        raise ValueError("stats must hold at least 4 counters")
+    if Y_out.ndim != 2 or Y_out.shape[0] != n or Y_out.shape[1] != t_out.shape[0]:
+        raise ValueError(f"Y_out must be ({n}, {t_out.shape[0]}), got {Y_out.shape}")
+    if table.ndim != 2 or table.shape[1] != 5 or m.shape[0] != table.shape[0]:
+        raise ValueError("table must be (slots, 5) with one mode per slot")
+    if fns.shape[0] < 4:
+        raise ValueError("fns must hold the 4 generated functions' addresses")
+    return n
+
+
+def _result(status: int, tr: Any, hr: Any, kr: Any) -> tuple[int, float, float, int]:
     if status == 6:
         raise MemoryError("the C integrator could not allocate its work buffers")
     return int(status), tr.value, hr.value, int(kr.value)
