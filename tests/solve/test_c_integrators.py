@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import MODELS
 
 import winder
 from winder.solve import cint
@@ -201,3 +202,35 @@ def test_rk4_guard(paper_scene, step) -> None:
     system, y0 = _system(paper_scene.replace(roll={"initial_height": 20.0}))
     trace = _compare_rk4(system, y0, 3.0, step, 1.0)
     assert trace[-1][0] == integ.PENETRATED
+
+
+@pytest.fixture(scope="module")
+def short_parent(models_dir, tmp_path_factory) -> MachineSystem:
+    """The small winder line with 0.1 mm of paper on the parent: it runs out at ≈ 1.9 s
+    (the END slot: EXHAUSTED); three nips, a core and an end slot in one table."""
+    text = (models_dir / "winder_line_small.toml").read_text()
+    old = "initial_radius = 0.45   #"
+    assert text.count(old) == 1
+    path = tmp_path_factory.mktemp("short_parent") / "short_parent.toml"
+    path.write_text(text.replace(old, "initial_radius = 0.4001 #"))
+    return MachineSystem(winder.load_scene(path))
+
+
+def test_exhausted_parent(short_parent) -> None:
+    y0 = short_parent.initial_state()
+    trace = _compare(short_parent, y0, 2.5, 1e-6, 1e-8, 5_000)
+    assert trace[-1][0] == integ.EXHAUSTED and 1.8 < trace[-1][1] < 2.0
+    trace = _compare_rk4(short_parent, y0, 2.5, 1e-3, 0.5)
+    assert trace[-1][0] == integ.EXHAUSTED and 1.8 < trace[-1][1] < 2.0
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in MODELS.glob("*.toml")))
+def test_every_shipped_scene(name) -> None:
+    """The first half second of every shipped scene, DOPRI5 at its tolerances and RK4 at
+    1 ms."""
+    scene = winder.load_scene(MODELS / f"{name}.toml")
+    system, y0 = _system(scene)
+    trace = _compare(system, y0, 0.5, scene.solver.rtol, scene.solver.atol, 5_000)
+    assert trace[-1][0] == integ.DONE
+    trace = _compare_rk4(system, y0, 0.5, 1e-3, 0.2)
+    assert trace[-1][0] == integ.DONE
