@@ -24,7 +24,11 @@ import numpy as np
 
 from winder.model.codegen import CFLAGS, CompileError, _compiler, cache_dir
 
-__all__ = ["dopri5", "rk4", "library", "SOURCES", "EXTRA_CFLAGS"]
+__all__ = ["dopri5", "rk4", "library", "kernels", "SOURCES", "EXTRA_CFLAGS", "ENV"]
+
+#: ``WINDER_INTEGRATORS=c`` runs simulate and the Stepper on these kernels (opt-in while
+#: they are compared with the numba ones; the default stays numba).
+ENV = "WINDER_INTEGRATORS"
 
 _DIR = Path(__file__).resolve().parent / "c"
 #: The translation units of the library (each includes ``events.h``).
@@ -77,6 +81,17 @@ def library() -> Any:
                        _dp, _i64, _ip, _dp, _dp, _ip]
         _LIB = handle
     return _LIB
+
+
+def kernels() -> tuple[Any, Any]:
+    """``(dopri5, rk4)``: the C kernels where ``$WINDER_INTEGRATORS`` is ``c``, else the
+    numba ones (the default until the numba code is deleted)."""
+    if os.environ.get(ENV, "numba") == "c":
+        return dopri5, rk4
+    from winder.solve.dopri5 import dopri5 as dopri5_numba
+    from winder.solve.rk4 import rk4 as rk4_numba
+
+    return dopri5_numba, rk4_numba
 
 
 def _ptr(a: np.ndarray, dtype: Any, name: str, writable: bool = False) -> Any:

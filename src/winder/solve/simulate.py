@@ -20,8 +20,7 @@ from winder.scene.load import Scene, load_scene
 from winder.scene.schema import BACKENDS, MAX_SAMPLES, METHODS
 from winder.solve import integrators as integ
 from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances
-from winder.solve.dopri5 import dopri5
-from winder.solve.rk4 import rk4
+from winder.solve.cint import kernels
 from winder.solve.rosenbrock import ros2
 from winder.solve.stepwise import run_stepwise
 from winder.solve.system import MachineSystem
@@ -114,6 +113,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
     fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
+    dopri5, rk4 = kernels()  # numba, or C where WINDER_INTEGRATORS=c (issue #23)
     for tb in breaks:
         while t < tb:
             budget = min(integ.CHUNK, guards.limit - int(stats[0]))
