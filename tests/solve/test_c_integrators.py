@@ -22,6 +22,7 @@ from winder.solve import cint
 from winder.solve import integrators as integ
 from winder.solve.dopri5 import dopri5 as dopri5_numba
 from winder.solve.rk4 import rk4 as rk4_numba
+from winder.solve.rosenbrock import ros2 as ros2_numba
 from winder.solve.system import MachineSystem
 
 
@@ -55,10 +56,15 @@ def _run(kernel, system: MachineSystem, y0: np.ndarray, t1: float, rtol: float,
     return trace, y, Y
 
 
+#: The adaptive kernels: numba (the reference) and C.
+ADAPTIVE = {"DOPRI5": (dopri5_numba, cint.dopri5), "ROS2": (ros2_numba, cint.ros2)}
+
+
 def _compare(system: MachineSystem, y0: np.ndarray, t1: float, rtol: float, atol: float,
-             chunk: int, n_out: int = 101) -> list:
-    a, ya, Ya = _run(dopri5_numba, system, y0, t1, rtol, atol, chunk, n_out)
-    b, yb, Yb = _run(cint.dopri5, system, y0, t1, rtol, atol, chunk, n_out)
+             chunk: int, n_out: int = 101, method: str = "DOPRI5") -> list:
+    reference, kernel = ADAPTIVE[method]
+    a, ya, Ya = _run(reference, system, y0, t1, rtol, atol, chunk, n_out)
+    b, yb, Yb = _run(kernel, system, y0, t1, rtol, atol, chunk, n_out)
     assert len(a) == len(b)
     for i, (ra, rb) in enumerate(zip(a, b, strict=True)):
         assert ra[0] == rb[0], (i, "status", ra[0], rb[0])
@@ -227,10 +233,44 @@ def test_exhausted_parent(short_parent) -> None:
 @pytest.mark.parametrize("name", sorted(p.stem for p in MODELS.glob("*.toml")))
 def test_every_shipped_scene(name) -> None:
     """The first half second of every shipped scene, DOPRI5 at its tolerances and RK4 at
-    1 ms."""
+    1 ms; 0.2 s with ROS2."""
     scene = winder.load_scene(MODELS / f"{name}.toml")
     system, y0 = _system(scene)
     trace = _compare(system, y0, 0.5, scene.solver.rtol, scene.solver.atol, 5_000)
     assert trace[-1][0] == integ.DONE
     trace = _compare_rk4(system, y0, 0.5, 1e-3, 0.2)
     assert trace[-1][0] == integ.DONE
+    trace = _compare(system, y0, 0.2, scene.solver.rtol, scene.solver.atol, 5_000,
+                     method="ROS2")
+    assert trace[-1][0] == integ.DONE
+
+
+# ---- ROS2 -----------------------------------------------------------------------------
+
+def test_ros2_scenes(paper_scene, models_dir) -> None:
+    """The paper and two-drum scenes, and the landing (contact events), with ROS2."""
+    system, y0 = _system(paper_scene)
+    trace = _compare(system, y0, 2.0, 1e-6, 1e-8, 5_000, method="ROS2")
+    assert trace[-1][0] == integ.DONE and trace[-1][4][4] > 100  # Jacobians
+    system, y0 = _system(winder.load_scene(models_dir / "two_drum_winder.toml"))
+    trace = _compare(system, y0, 0.5, 1e-6, 1e-8, 5_000, method="ROS2")
+    assert trace[-1][0] == integ.DONE
+    system, y0 = _system(paper_scene.replace(roll={"com_offset": 0.0,
+                                                   "initial_height": 0.625}))
+    trace = _compare(system, y0, 1.0, 1e-6, 1e-8, integ.CHUNK, method="ROS2")
+    assert trace[-1][4][3] >= 5
+
+
+def test_ros2_core_guard_and_end(paper_scene, short_parent) -> None:
+    """The core events, the guard (dropped from 20 m) and the exhausted parent, ROS2."""
+    rc = paper_scene.roll.core_radius
+    scene = paper_scene.replace(roll={"initial_radius": rc + 2e-6, "initial_speed": -5.0})
+    system, y0 = _system(scene)
+    trace = _compare(system, y0, 0.3, 1e-8, 1e-10, integ.CHUNK, method="ROS2")
+    assert trace[-1][4][3] >= 2
+    system, y0 = _system(paper_scene.replace(roll={"initial_height": 20.0}))
+    trace = _compare(system, y0, 3.0, 1e-8, 1e-10, integ.CHUNK, n_out=3, method="ROS2")
+    assert trace[-1][0] == integ.PENETRATED
+    trace = _compare(short_parent, short_parent.initial_state(), 2.5, 1e-6, 1e-8, 5_000,
+                     method="ROS2")
+    assert trace[-1][0] == integ.EXHAUSTED and 1.8 < trace[-1][1] < 2.0

@@ -1,6 +1,7 @@
 """The integrators in C (``solve/c/``: ``events.h`` the shared mode table, event location
-and guard; ``dopri5.c``, ``rk4.c``), next to the generated functions: the contract of the
-numba kernels (:func:`winder.solve.dopri5.dopri5`, :func:`winder.solve.rk4.rk4`): the
+and guard; ``dopri5.c``, ``rk4.c``, ``ros2.c``), next to the generated functions: the contract of
+the numba kernels (:func:`winder.solve.dopri5.dopri5`, :func:`winder.solve.rk4.rk4`,
+:func:`winder.solve.rosenbrock.ros2`): the
 same arguments, statuses, counters and results, bit for bit (issue #23, step 1).
 
 For now a separate small shared library, compiled with the flags of the generated code
@@ -24,7 +25,7 @@ import numpy as np
 
 from winder.model.codegen import CFLAGS, CompileError, _compiler, cache_dir
 
-__all__ = ["dopri5", "rk4", "library", "kernels", "SOURCES", "EXTRA_CFLAGS", "ENV"]
+__all__ = ["dopri5", "rk4", "ros2", "library", "kernels", "SOURCES", "EXTRA_CFLAGS", "ENV"]
 
 #: ``WINDER_INTEGRATORS=c`` runs simulate and the Stepper on these kernels (opt-in while
 #: they are compared with the numba ones; the default stays numba).
@@ -32,7 +33,7 @@ ENV = "WINDER_INTEGRATORS"
 
 _DIR = Path(__file__).resolve().parent / "c"
 #: The translation units of the library (each includes ``events.h``).
-SOURCES = (_DIR / "dopri5.c", _DIR / "rk4.c")
+SOURCES = (_DIR / "dopri5.c", _DIR / "rk4.c", _DIR / "ros2.c")
 #: Flags beyond the generated code's: no contraction into FMA (bit-equality with numba).
 EXTRA_CFLAGS = ("-ffp-contract=off", "-std=c99")
 
@@ -75,6 +76,10 @@ def library() -> Any:
         fn.restype = ctypes.c_int
         fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
                        _f64, _dp, _i64, _dp, _i64, _i64, _ip, _i64, _dp, _dp, _ip]
+        fn = handle.winder_ros2
+        fn.restype = ctypes.c_int
+        fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
+                       _f64, _dp, _i64, _dp, _i64, _i64, _ip, _dp, _dp, _ip]
         fn = handle.winder_rk4
         fn.restype = ctypes.c_int
         fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _dp, _i64,
@@ -83,15 +88,16 @@ def library() -> Any:
     return _LIB
 
 
-def kernels() -> tuple[Any, Any]:
-    """``(dopri5, rk4)``: the C kernels where ``$WINDER_INTEGRATORS`` is ``c``, else the
+def kernels() -> tuple[Any, Any, Any]:
+    """``(dopri5, rk4, ros2)``: the C kernels where ``$WINDER_INTEGRATORS`` is ``c``, else the
     numba ones (the default until the numba code is deleted)."""
     if os.environ.get(ENV, "numba") == "c":
-        return dopri5, rk4
+        return dopri5, rk4, ros2
     from winder.solve.dopri5 import dopri5 as dopri5_numba
     from winder.solve.rk4 import rk4 as rk4_numba
+    from winder.solve.rosenbrock import ros2 as ros2_numba
 
-    return dopri5_numba, rk4_numba
+    return dopri5_numba, rk4_numba, ros2_numba
 
 
 def _ptr(a: np.ndarray, dtype: Any, name: str, writable: bool = False) -> Any:
@@ -118,6 +124,28 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
         _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
         _ptr(stats, np.int64, "stats", True), stats.shape[0], ctypes.byref(tr),
         ctypes.byref(hr), ctypes.byref(kr))
+    return _result(status, tr, hr, kr)
+
+
+def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
+         p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
+         max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
+         stats: np.ndarray) -> tuple[int, float, float, int]:
+    """:func:`winder.solve.rosenbrock.ros2` in C: the same arguments and results
+    (``stats`` needs all 5 counters: ``stats[4]`` counts Jacobians)."""
+    lib = library()
+    n = _check(fns, table, y, m, t_out, Y_out, stats)
+    if stats.shape[0] < 5:
+        raise ValueError("stats must hold 5 counters")
+    tr, hr, kr = _f64(), _f64(), _i64()
+    status = lib.winder_ros2(
+        _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+        float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+        _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol), float(atol),
+        float(h), float(max_step), _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
+        _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
+        _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
+        ctypes.byref(kr))
     return _result(status, tr, hr, kr)
 
 

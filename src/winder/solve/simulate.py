@@ -21,7 +21,6 @@ from winder.scene.schema import BACKENDS, MAX_SAMPLES, METHODS
 from winder.solve import integrators as integ
 from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances
 from winder.solve.cint import kernels
-from winder.solve.rosenbrock import ros2
 from winder.solve.stepwise import run_stepwise
 from winder.solve.system import MachineSystem
 
@@ -113,7 +112,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
     fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
-    dopri5, rk4 = kernels()  # numba, or C where WINDER_INTEGRATORS=c (issue #23)
+    dopri5, rk4, ros2 = kernels()  # numba, or C where WINDER_INTEGRATORS=c (#23)
     for tb in breaks:
         while t < tb:
             budget = min(integ.CHUNK, guards.limit - int(stats[0]))
