@@ -56,6 +56,15 @@ test: $(STAMP) pin-casadi chromium
 test-slow: $(STAMP) chromium
 	$(PY) -m pytest -q -m slow
 
+# The C integrators (src/winder/solve/c/) built with AddressSanitizer and UBSan: their
+# comparison with the numba kernels, and the solver tests run on them (issue #23, WIP:
+# the generated model is not sanitized yet, and CI does not run this target yet).
+.PHONY: test-asan
+test-asan: $(STAMP) pin-casadi
+	WINDER_SANITIZE=1 WINDER_INTEGRATORS=c ASAN_OPTIONS=detect_leaks=0 \
+	  LD_PRELOAD="$$($${CC:-cc} -print-file-name=libasan.so)" \
+	  $(PY) -m pytest -q -p no:cacheprovider tests/solve
+
 # The fixed physics mutants (tests/mutants/catalogue.toml): every one must be killed.
 .PHONY: mutants
 mutants: $(STAMP)

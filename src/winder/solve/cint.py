@@ -44,8 +44,17 @@ _ip = ctypes.POINTER(ctypes.c_int64)
 _i64, _f64 = ctypes.c_int64, ctypes.c_double
 
 
+#: ``WINDER_SANITIZE=1``: build with AddressSanitizer and UBSan (the start of
+#: ``make test-asan``; run Python with ``LD_PRELOAD=$(cc -print-file-name=libasan.so)``
+#: and ``ASAN_OPTIONS=detect_leaks=0``).
+SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
+                   "-fno-omit-frame-pointer", "-g")
+
+
 def _build(directory: Path | None = None) -> Path:
     flags = (*CFLAGS, *EXTRA_CFLAGS)
+    if os.environ.get("WINDER_SANITIZE", "") not in ("", "0"):
+        flags = (*flags, *SANITIZE_CFLAGS)
     h = hashlib.sha256(" ".join(flags).encode())
     for f in sorted(_DIR.glob("*.[ch]")):  # every source and header: the key
         h.update(f.name.encode() + b"\0" + f.read_bytes())
