@@ -59,10 +59,12 @@ test-slow: $(STAMP) chromium
 # The C integrators (src/winder/solve/c/) built with AddressSanitizer and UBSan: their
 # comparison with the numba kernels, and the solver tests run on them (issue #23, WIP:
 # the generated model is not sanitized yet, and CI does not run this target yet).
+# libstdc++ is preloaded too: without it ASan's __cxa_throw interceptor aborts in
+# matplotlib's ft2font.
 .PHONY: test-asan
 test-asan: $(STAMP) pin-casadi
 	WINDER_SANITIZE=1 WINDER_INTEGRATORS=c ASAN_OPTIONS=detect_leaks=0 \
-	  LD_PRELOAD="$$($${CC:-cc} -print-file-name=libasan.so)" \
+	  LD_PRELOAD="$$($${CC:-cc} -print-file-name=libasan.so) $$($${CC:-cc} -print-file-name=libstdc++.so.6)" \
 	  $(PY) -m pytest -q -p no:cacheprovider tests/solve
 
 # The fixed physics mutants (tests/mutants/catalogue.toml): every one must be killed.

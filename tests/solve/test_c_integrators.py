@@ -12,6 +12,7 @@ deleted."""
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
 import pytest
@@ -64,6 +65,7 @@ def _compare(system: MachineSystem, y0: np.ndarray, t1: float, rtol: float, atol
              chunk: int, n_out: int = 101, method: str = "DOPRI5") -> list:
     reference, kernel = ADAPTIVE[method]
     a, ya, Ya = _run(reference, system, y0, t1, rtol, atol, chunk, n_out)
+    kernel = partial(kernel, n_switches=system.generated.n_switches)
     b, yb, Yb = _run(kernel, system, y0, t1, rtol, atol, chunk, n_out)
     assert len(a) == len(b)
     for i, (ra, rb) in enumerate(zip(a, b, strict=True)):
@@ -170,7 +172,8 @@ def _run_rk4(kernel, system: MachineSystem, y0: np.ndarray, t1: float, step: flo
 def _compare_rk4(system: MachineSystem, y0: np.ndarray, t1: float, step: float,
                  window: float, n_out: int = 101) -> list:
     a, ya, Ya = _run_rk4(rk4_numba, system, y0, t1, step, window, n_out)
-    b, yb, Yb = _run_rk4(cint.rk4, system, y0, t1, step, window, n_out)
+    kernel = partial(cint.rk4, n_switches=system.generated.n_switches)
+    b, yb, Yb = _run_rk4(kernel, system, y0, t1, step, window, n_out)
     assert len(a) == len(b)
     for i, (ra, rb) in enumerate(zip(a, b, strict=True)):
         assert ra[0] == rb[0] and ra[3] == rb[3], (i, ra[:4], rb[:4])

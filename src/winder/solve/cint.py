@@ -18,6 +18,7 @@ import hashlib
 import os
 import subprocess
 import tempfile
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -83,25 +84,27 @@ def library() -> Any:
         handle = ctypes.CDLL(str(_build()))
         fn = handle.winder_dopri5
         fn.restype = ctypes.c_int
-        fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
+        fn.argtypes = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
                        _f64, _dp, _i64, _dp, _i64, _i64, _ip, _i64, _dp, _dp, _ip]
         fn = handle.winder_ros2
         fn.restype = ctypes.c_int
-        fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
+        fn.argtypes = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
                        _f64, _dp, _i64, _dp, _i64, _i64, _ip, _dp, _dp, _ip]
         fn = handle.winder_rk4
         fn.restype = ctypes.c_int
-        fn.argtypes = [_ip, _ip, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _dp, _i64,
+        fn.argtypes = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _dp, _i64,
                        _dp, _i64, _ip, _dp, _dp, _ip]
         _LIB = handle
     return _LIB
 
 
-def kernels() -> tuple[Any, Any, Any]:
-    """``(dopri5, rk4, ros2)``: the C kernels where ``$WINDER_INTEGRATORS`` is ``c``, else the
-    numba ones (the default until the numba code is deleted)."""
+def kernels(n_switches: int = 0) -> tuple[Any, Any, Any]:
+    """``(dopri5, rk4, ros2)``: the C kernels (for a machine whose ``sw`` writes
+    ``n_switches`` values) where ``$WINDER_INTEGRATORS`` is ``c``, else the numba ones
+    (the default until the numba code is deleted)."""
     if os.environ.get(ENV, "numba") == "c":
-        return dopri5, rk4, ros2
+        return (partial(dopri5, n_switches=n_switches), partial(rk4, n_switches=n_switches),
+                partial(ros2, n_switches=n_switches))
     from winder.solve.dopri5 import dopri5 as dopri5_numba
     from winder.solve.rk4 import rk4 as rk4_numba
     from winder.solve.rosenbrock import ros2 as ros2_numba
@@ -119,14 +122,18 @@ def _ptr(a: np.ndarray, dtype: Any, name: str, writable: bool = False) -> Any:
 def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
            p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
            max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
-           stats: np.ndarray) -> tuple[int, float, float, int]:
+           stats: np.ndarray, n_switches: int = 0) -> tuple[int, float, float, int]:
     """:func:`winder.solve.dopri5.dopri5` in C: the same arguments and results
-    (``(status, t, h, k)``; ``y``, ``m``, ``Y_out`` and ``stats`` updated in place)."""
+    (``(status, t, h, k)``; ``y``, ``m``, ``Y_out`` and ``stats`` updated in place).
+    ``n_switches``: how many values the generated ``sw`` writes
+    (``Generated.n_switches``); the switch buffers hold at least those the ``table``
+    refers to (all the numba kernels allocate)."""
     lib = library()
     n = _check(fns, table, y, m, t_out, Y_out, stats)
     tr, hr, kr = _f64(), _f64(), _i64()
     status = lib.winder_dopri5(
         _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+        int(n_switches),
         float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
         _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol), float(atol),
         float(h), float(max_step), _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
@@ -139,9 +146,10 @@ def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarr
 def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
          p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
          max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
-         stats: np.ndarray) -> tuple[int, float, float, int]:
+         stats: np.ndarray, n_switches: int = 0) -> tuple[int, float, float, int]:
     """:func:`winder.solve.rosenbrock.ros2` in C: the same arguments and results
-    (``stats`` needs all 5 counters: ``stats[4]`` counts Jacobians)."""
+    (``stats`` needs all 5 counters: ``stats[4]`` counts Jacobians; ``n_switches`` as
+    :func:`dopri5`)."""
     lib = library()
     n = _check(fns, table, y, m, t_out, Y_out, stats)
     if stats.shape[0] < 5:
@@ -149,6 +157,7 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
     tr, hr, kr = _f64(), _f64(), _i64()
     status = lib.winder_ros2(
         _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+        int(n_switches),
         float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
         _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol), float(atol),
         float(h), float(max_step), _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
@@ -160,13 +169,15 @@ def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray
 
 def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
         p: np.ndarray, m: np.ndarray, h: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
-        stats: np.ndarray) -> tuple[int, float, float, int]:
-    """:func:`winder.solve.rk4.rk4` in C: the same arguments and results."""
+        stats: np.ndarray, n_switches: int = 0) -> tuple[int, float, float, int]:
+    """:func:`winder.solve.rk4.rk4` in C: the same arguments and results (``n_switches``
+    as :func:`dopri5`)."""
     lib = library()
     n = _check(fns, table, y, m, t_out, Y_out, stats)
     tr, hr, kr = _f64(), _f64(), _i64()
     status = lib.winder_rk4(
         _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+        int(n_switches),
         float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
         _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(h),
         _ptr(t_out, np.float64, "t_out"), t_out.shape[0],

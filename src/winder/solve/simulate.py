@@ -112,7 +112,8 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
     fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
-    dopri5, rk4, ros2 = kernels()  # numba, or C where WINDER_INTEGRATORS=c (#23)
+    # numba, or C where WINDER_INTEGRATORS=c (issue #23)
+    dopri5, rk4, ros2 = kernels(system.generated.n_switches)
     for tb in breaks:
         while t < tb:
             budget = min(integ.CHUNK, guards.limit - int(stats[0]))

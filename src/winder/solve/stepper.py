@@ -148,7 +148,8 @@ class Stepper:
         sy = self.system
         nfev0, steps0, stiff0 = (int(x) for x in self._stats[[0, 1, 4]])
         wall0 = time.perf_counter()
-        dopri5 = kernels()[0]  # numba, or C where WINDER_INTEGRATORS=c (issue #23)
+        # numba, or C where WINDER_INTEGRATORS=c (issue #23)
+        dopri5 = kernels(sy.generated.n_switches)[0]
         for tb in stops:
             while self.t < tb:
                 spent = int(self._stats[0]) - nfev0

@@ -45,14 +45,15 @@
 /* Integrate y from t0 to t1 (solve/dopri5.py: the same arguments, statuses and
  * results). Returns the status; *t_out_, *h_out, *k_out: the time reached, the next
  * step, the samples written. */
-int winder_dopri5(const int64_t* fns, const int64_t* table, int64_t nslots, double t0,
-                  double t1, double* y, int64_t n, const double* p, double* m, double rtol,
-                  double atol, double h, double max_step, const double* t_out,
-                  int64_t n_out, double* Y_out, int64_t k, int64_t budget, int64_t* stats,
-                  int64_t nstats, double* t_res, double* h_res, int64_t* k_res) {
+int winder_dopri5(const int64_t* fns, const int64_t* table, int64_t nslots,
+                  int64_t n_switches, double t0, double t1, double* y, int64_t n,
+                  const double* p, double* m, double rtol, double atol, double h,
+                  double max_step, const double* t_out, int64_t n_out, double* Y_out,
+                  int64_t k, int64_t budget, int64_t* stats, int64_t nstats,
+                  double* t_res, double* h_res, int64_t* k_res) {
     Ctx ctx, *cx = &ctx;
     double* v[13];
-    if (!ctx_init(cx, fns, table, nslots, n, p, m, v, 13))
+    if (!ctx_init(cx, fns, table, nslots, n_switches, n, p, m, v, 13))
         return NO_MEMORY;
     double *k1 = v[0], *k2 = v[1], *k3 = v[2], *k4 = v[3], *k5 = v[4], *k6 = v[5],
            *k7 = v[6], *y1 = v[7], *rc = v[8];

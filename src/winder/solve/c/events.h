@@ -398,10 +398,15 @@ static inline int64_t sample_and_switch(Ctx* cx, const double* rc, double t, dou
     return slot;
 }
 
-/* Work buffers: g, g0 (switch size), yt, ye (n), rl (5 n). */
+/* Work buffers: g, g0 (switches), yt, ye (n), rl (5 n), then n_extra vectors of n. */
 static inline int ctx_init(Ctx* cx, const int64_t* fns, const int64_t* table, int64_t nslots,
-                    int64_t n, const double* p, double* m, double** extra, int64_t n_extra) {
+                    int64_t n_switches, int64_t n, const double* p, double* m, double** extra,
+                    int64_t n_extra) {
+    /* the switch buffers: every switch the generated sw writes (n_switches), and at least
+     * those the table refers to (the numba kernels size them from the table alone) */
     int64_t ns = switch_size(table, nslots);
+    if (n_switches > ns)
+        ns = n_switches;
     for (int j = 0; j < 4; j++)
         cx->fns[j] = (wfn)(intptr_t)fns[j];
     cx->table = table; cx->nslots = nslots; cx->n = n; cx->p = p; cx->m = m;

@@ -17,13 +17,14 @@ static void hermite(int64_t n, const double* y0, const double* f0, const double*
 /* RK4 with steps of at most h evenly dividing [t0, t1] (solve/rk4.py: the same
  * arguments, statuses and results). Returns the status; *t_res, *h_res, *k_res: the
  * time reached, the step taken, the samples written. */
-int winder_rk4(const int64_t* fns, const int64_t* table, int64_t nslots, double t0,
-               double t1, double* y, int64_t n, const double* p, double* m, double h,
-               const double* t_out, int64_t n_out, double* Y_out, int64_t k, int64_t* stats,
-               double* t_res, double* h_res, int64_t* k_res) {
+int winder_rk4(const int64_t* fns, const int64_t* table, int64_t nslots,
+               int64_t n_switches, double t0, double t1, double* y, int64_t n,
+               const double* p, double* m, double h, const double* t_out, int64_t n_out,
+               double* Y_out, int64_t k, int64_t* stats, double* t_res, double* h_res,
+               int64_t* k_res) {
     Ctx ctx, *cx = &ctx;
     double* v[10];
-    if (!ctx_init(cx, fns, table, nslots, n, p, m, v, 10))
+    if (!ctx_init(cx, fns, table, nslots, n_switches, n, p, m, v, 10))
         return NO_MEMORY;
     double *k1 = v[0], *k2 = v[1], *k3 = v[2], *k4 = v[3], *y1 = v[4], *rc = v[5];
     double* yt = cx->yt;

@@ -62,18 +62,19 @@ static void lu_solve(int64_t n, const double* LU, const int64_t* piv, double* b)
 
 /* Integrate y from t0 to t1 (solve/rosenbrock.py: arguments and results as
  * winder_dopri5; stats[4] counts Jacobians). */
-int winder_ros2(const int64_t* fns, const int64_t* table, int64_t nslots, double t0,
-                double t1, double* y, int64_t n, const double* p, double* m, double rtol,
-                double atol, double h, double max_step, const double* t_out, int64_t n_out,
-                double* Y_out, int64_t k, int64_t budget, int64_t* stats, double* t_res,
-                double* h_res, int64_t* k_res) {
+int winder_ros2(const int64_t* fns, const int64_t* table, int64_t nslots,
+                int64_t n_switches, double t0, double t1, double* y, int64_t n,
+                const double* p, double* m, double rtol, double atol, double h,
+                double max_step, const double* t_out, int64_t n_out, double* Y_out,
+                int64_t k, int64_t budget, int64_t* stats, double* t_res, double* h_res,
+                int64_t* k_res) {
     const double D = 1.0 / (2.0 + sqrt(2.0));
     const double E32 = 6.0 + sqrt(2.0);
     Ctx ctx, *cx = &ctx;
     int64_t n_extra = 14 + 2 * n;
     double** v = malloc(sizeof(double*) * (size_t)n_extra);
     int64_t* piv = malloc(sizeof(int64_t) * (size_t)n);
-    if (!v || !piv || !ctx_init(cx, fns, table, nslots, n, p, m, v, n_extra)) {
+    if (!v || !piv || !ctx_init(cx, fns, table, nslots, n_switches, n, p, m, v, n_extra)) {
         free(v);
         free(piv);
         return NO_MEMORY;
