@@ -1,8 +1,8 @@
 """The integrators in C (``solve/c/``: ``events.h`` the shared mode table, event location
-and guard; ``dopri5.c``, ``rk4.c``, ``ros2.c``), next to the generated functions: the contract of
-the numba kernels (:func:`winder.solve.dopri5.dopri5`, :func:`winder.solve.rk4.rk4`,
-:func:`winder.solve.rosenbrock.ros2`): the
-same arguments, statuses, counters and results, bit for bit (issue #23, step 1).
+and guard; ``dopri5.c``, ``rk4.c``, ``ros2.c``), next to the generated functions, with the
+contract of the numba kernels (:func:`winder.solve.dopri5.dopri5`,
+:func:`winder.solve.rk4.rk4`, :func:`winder.solve.rosenbrock.ros2`): the same arguments,
+statuses, counters and results, bit for bit (issue #23, item 1; ``docs/c-integrators.md``).
 
 For now a separate small shared library, compiled with the flags of the generated code
 (:data:`winder.model.codegen.CFLAGS`, plus ``-ffp-contract=off`` so that no fused
@@ -45,9 +45,8 @@ _ip = ctypes.POINTER(ctypes.c_int64)
 _i64, _f64 = ctypes.c_int64, ctypes.c_double
 
 
-#: ``WINDER_SANITIZE=1``: build with AddressSanitizer and UBSan (the start of
-#: ``make test-asan``; run Python with ``LD_PRELOAD=$(cc -print-file-name=libasan.so)``
-#: and ``ASAN_OPTIONS=detect_leaks=0``).
+#: ``WINDER_SANITIZE=1``: build with AddressSanitizer and UBSan (``make test-asan``: Python
+#: runs with libasan and libstdc++ preloaded and ``ASAN_OPTIONS=detect_leaks=0``).
 SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
                    "-fno-omit-frame-pointer", "-g")
 
