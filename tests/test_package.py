@@ -30,6 +30,54 @@ def test_import_winder_loads_no_heavy_dependency() -> None:
     assert out.strip() == "[]"
 
 
+#: What checking a scene must not import: the solver stack, the plots, the sweeps and
+#: NumPy itself (the scene's checks are plain arithmetic).
+_SOLVER_STACK = {"numpy", "numba", "llvmlite", "scipy", "casadi", "pinocchio", "coal",
+                 "matplotlib", "dask", "pandas", "pyarrow", "tqdm", "meshcat", "fmpy"}
+
+_CHECK = """
+import json, sys
+import winder.cli, winder
+for path in sys.argv[1:]:
+    winder.load_scene(path)
+print(json.dumps(sorted({m.split('.')[0] for m in sys.modules})))
+"""
+
+
+def test_checking_a_scene_imports_no_solver_stack(models_dir: Path) -> None:
+    """``import winder.cli`` and :func:`winder.load_scene` of every shipped scene import
+    none of the solver stack (start-up: a command that stops on its scene stops fast)."""
+    scenes = sorted(str(p) for p in models_dir.glob("*.toml"))
+    assert len(scenes) >= 5
+    out = subprocess.run([sys.executable, "-c", _CHECK, *scenes], capture_output=True,
+                         text=True, check=True).stdout
+    assert set(json.loads(out)) & _SOLVER_STACK == set()
+
+
+_BAD_RUN = """
+import json, sys
+import winder.cli
+status = winder.cli.main(["run", sys.argv[1], "--out", sys.argv[2]])
+print(json.dumps([status, sorted({m.split('.')[0] for m in sys.modules})]))
+"""
+
+
+def test_run_on_a_bad_scene_exits_2_before_the_solver_is_imported(tmp_path: Path,
+                                                                   models_dir: Path) -> None:
+    """``winder run`` on a scene that fails its checks exits 2 having imported none of
+    the solver stack."""
+    text = (models_dir / "paper_winding.toml").read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("[paper]", "[paper]\nno_such_key = 1", 1))
+    assert bad.read_text() != text
+    proc = subprocess.run([sys.executable, "-c", _BAD_RUN, str(bad), str(tmp_path / "r.npz")],
+                          capture_output=True, text=True, check=True)
+    status, modules = json.loads(proc.stdout)
+    assert status == 2 and "no_such_key" in proc.stderr
+    assert set(modules) & _SOLVER_STACK == set()
+    assert not (tmp_path / "r.npz").exists()
+
+
 _RUN = """
 import json, sys, warnings
 warnings.simplefilter("always")

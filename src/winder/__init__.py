@@ -16,7 +16,8 @@ from winder._errors import (
 )
 
 # The rest is imported on first use (PEP 562): a command pays only for what it runs
-# (``winder run`` never imports the FMU, the linearisation or scipy's optimisers).
+# (``winder run`` never imports the FMU, the linearisation or the sweeps; checking a scene
+# imports neither NumPy nor the solver).
 _LAZY = {
     **dict.fromkeys(("build_fmu",), ".fmu.build"),
     **dict.fromkeys(("jacobian",), ".analysis.linearise"),

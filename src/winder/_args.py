@@ -6,10 +6,9 @@ from __future__ import annotations
 
 import math
 import numbers
+import sys
 from collections.abc import Callable
 from typing import Any
-
-import numpy as np
 
 from winder._errors import ArgumentError, ArgumentTypeError
 
@@ -52,7 +51,10 @@ def range_text(lo: float | None, lo_open: bool = False, hi: float | None = None,
 def _as_float(value: Any) -> float | None:
     """``value`` as a float (an integer beyond the float range as ``±inf``), or None when it
     is not a real number (``bool`` and ``numpy.bool_`` are not numbers here)."""
-    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+    np = sys.modules.get("numpy")  # not imported yet: no numpy.bool_ to meet (no NumPy
+    # just to check a scene)
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or (
+            np is not None and isinstance(value, np.bool_)):
         return None
     try:
         return float(value)

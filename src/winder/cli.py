@@ -120,12 +120,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
         check_output_file(twin, "--out (its .npz twin)", suffixes=(".npz",))
     plots = check_output_dir(args.plots, "--plots") if args.plots is not None else None
 
-    from winder._errors import BudgetExceeded
     from winder.scene.load import load_scene
+
+    scene = load_scene(args.scene)  # a bad scene stops here, before the solver is imported
+    from winder._errors import BudgetExceeded
     from winder.solve.equilibrium import EquilibriumError
     from winder.solve.simulate import simulate
 
-    scene = load_scene(args.scene)
     progress = sys.stderr.isatty() if args.progress is None else args.progress
     try:
         result = simulate(scene, t_end=args.t_end, method=args.method, rtol=args.rtol,
@@ -178,12 +179,13 @@ def _load_for_view(path: str, check_span: Callable[[float], None]):
     from winder.io.files import _check_text
     from winder.io.result import load_result
     from winder.scene.load import load_scene, scene_from_dict
-    from winder.solve.simulate import simulate
 
     p = _check_text("source", path)
     if p.suffix.lower() == ".toml":
         scene = load_scene(p)
         check_span(scene.scene.duration)
+        from winder.solve.simulate import simulate
+
         print(f"simulating {p} for the view ...", file=sys.stderr)
         return scene, simulate(scene, progress=sys.stderr.isatty())
     if p.suffix.lower() not in (".npz", ".csv"):
@@ -307,11 +309,12 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     plot = check_output_file(args.plot, "--plot", suffixes=(".png",)) \
         if args.plot is not None else None
 
-    from winder.analysis.modes import mode_map
-    from winder.io.files import atomic_write, csv_writer
     from winder.scene.load import load_scene
 
     scene = load_scene(args.scene)
+    from winder.analysis.modes import mode_map
+    from winder.io.files import atomic_write, csv_writer
+
     mm = mode_map(scene, web_speed=args.web_speed, n=args.points, radius_min=args.radius_min,
                   radius_max=args.radius_max, _names=("--radius-min", "--radius-max"))
     print(f"{scene.name}: modes at {len(mm.radius)} radii, {mm.radius[0]:.3f}-"
@@ -382,8 +385,6 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     stderr and recorded in the table), 2 when every run failed (listed; the table is kept,
     no map is drawn), 1 when runs are missing (workers died), 128 + N on signal N (130
     Ctrl-C; finished runs are kept: re-run to resume)."""
-    from winder.analysis.sweep import sweep
-    from winder.analysis.sweep_grid import parse_vary
     from winder.io.files import check_output_dir, check_output_file
     from winder.scene.load import load_scene
 
@@ -391,11 +392,15 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.plot not in (None, True):
         check_output_file(args.plot, "--plot", suffixes=(".png",))
     scene = load_scene(args.scene)
+    from winder.analysis.sweep_grid import parse_vary
+
     vary = parse_vary(args.vary)
     if args.plot:
         from winder.plots.sweep import map_layout
 
         map_layout(vary)  # a map that cannot be drawn stops the sweep before it runs
+    from winder.analysis.sweep import sweep  # Dask, pandas, pyarrow
+
     try:
         table = sweep(scene, vary, args.out, scheduler=args.scheduler, workers=args.workers,
                       t_end=args.t_end, rtol=args.rtol, output_step=args.output_step,

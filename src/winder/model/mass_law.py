@@ -13,27 +13,19 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pinocchio as pin
 
 from winder._args import number
 from winder._errors import ArgumentError, ModelError
-from winder.model.com_offset import max_com_offset
+from winder.model.paper_roll import max_com_offset, paper_roll_mass
+
+if TYPE_CHECKING:  # Pinocchio on first use: the scene's checks read this module without it
+    import pinocchio as pin
 
 __all__ = ["MassLaw", "MassProperties", "FunctionMassLaw", "PaperRollLaw", "paper_roll_mass",
            "skew", "max_com_offset"]
-
-
-def paper_roll_mass(r: Any, core_radius: Any, core_mass: Any, core_inertia: Any,
-                    k: Any) -> tuple[Any, Any, Any, Any]:
-    """``(m, J, dm/dr, dJ/dr)`` of a paper roll of radius ``r`` [m] (winder-model §2):
-    ``k = π ρ L`` [kg/m³·m]; ``J`` about the roll axis [kg·m²]. Plain arithmetic: floats
-    or CasADi symbols (the generated code of every machine uses it)."""
-    rc2, r2 = core_radius * core_radius, r * r
-    return (core_mass + k * (r2 - rc2), core_inertia + 0.5 * k * (r2 * r2 - rc2 * rc2),
-            2.0 * k * r, 2.0 * k * r2 * r)
 
 
 def skew(x: np.ndarray) -> np.ndarray:
@@ -64,6 +56,8 @@ class MassProperties:
 
     def spatial(self) -> pin.Inertia:
         """``Y(s)`` as a :class:`pinocchio.Inertia`."""
+        import pinocchio as pin
+
         return pin.Inertia(self.mass, np.asarray(self.com, float),
                            np.asarray(self.inertia, float))
 

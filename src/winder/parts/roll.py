@@ -11,9 +11,8 @@ from typing import TYPE_CHECKING, Any
 
 from winder._args import show
 from winder._schema import Channel, Key, Table
-from winder.model.com_offset import max_com_offset
 from winder.model.locked_modes import AT_CORE, CORE_AUTO, ModeKind
-from winder.model.mass_law import paper_roll_mass
+from winder.model.paper_roll import max_com_offset, paper_roll_mass
 from winder.parts._base import BodyElement, Drawing, SubTable, TableReader
 from winder.parts._keys import CENTRE, NAME
 

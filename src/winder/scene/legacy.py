@@ -20,6 +20,7 @@ from winder._errors import SceneError
 from winder._schema import Channel, Key, Table
 from winder.forces.web_momentum import WebMomentum
 from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, WEB_SPEED
+from winder.model.paper_roll import paper_roll_mass
 from winder.parts import (
     ContactLaw,
     DrumPart,
@@ -336,12 +337,12 @@ def check_rest_on_nip(source: str, effects: Effects, gravity: float, roll: Roll,
     start inside the drum."""
     if not effects.contact or roll.initial_height is not None:
         return
-    from winder.forces.contact import rest_penetration  # (imports the Pinocchio model)
-    from winder.model.mass_law import PaperRollLaw
+    from winder.forces.contact import rest_penetration
 
     r = roll.initial_radius
-    weight = PaperRollLaw(roll.core_radius, roll.core_mass, roll.core_inertia, roll.width,
-                          paper.density).mass(r) * (gravity if effects.gravity else 0.0)
+    mass = paper_roll_mass(r, roll.core_radius, roll.core_mass, roll.core_inertia,
+                           math.pi * paper.density * roll.width)[0]
+    weight = mass * (gravity if effects.gravity else 0.0)
     r_dot = paper.caliper / (2 * math.pi) * roll.initial_speed
     c = contact
     delta = rest_penetration(c.law, lambda k: getattr(c, k), weight, r_dot)

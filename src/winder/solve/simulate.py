@@ -21,7 +21,6 @@ from winder.scene.schema import BACKENDS, MAX_SAMPLES, METHODS
 from winder.solve import integrators as integ
 from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances
 from winder.solve.cint import kernels
-from winder.solve.stepwise import run_stepwise
 from winder.solve.system import MachineSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
@@ -259,7 +258,9 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
                 filled = _run_compiled(meth, system, y, t_out, Ys, breaks, rtol, atol,
                                        max_step, guards, stats, at)
                 system.nfev, n_events = int(stats[0]), int(stats[3])
-            else:
+            else:  # scipy's integrators only for the runs that use them
+                from winder.solve.stepwise import run_stepwise
+
                 filled, n_events = run_stepwise(system, meth, y0, t_s, t_out, Ys, breaks,
                                                 rtol, atol, max_step, events, jacobian, guards)
         except _Stop as stop:
