@@ -50,7 +50,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 CATALOGUE = Path(__file__).with_name("catalogue.toml")
 #: Sources the generated code is keyed by (a mutant there must not see the clean cache).
-GENERATED = ("src/winder/model/", "src/winder/forces/", "src/winder/model/mass_law.py")
+GENERATED = ("src/winder/model/", "src/winder/parts/", "src/winder/forces/")
 KINDS = {"drop": lambda x: "0.0", "double": lambda x: f"2.0 * ({x})",
          "flip": lambda x: f"-({x})"}
 TIMEOUT = 300.0  # [s] per mutant
