@@ -1,14 +1,21 @@
-"""The integrators in C (``solve/c/``: ``events.h`` the shared mode table, event location
-and guard; ``dopri5.c``, ``rk4.c``, ``ros2.c``), next to the generated functions, with the
-contract of the numba kernels (:func:`winder.solve.dopri5.dopri5`,
-:func:`winder.solve.rk4.rk4`, :func:`winder.solve.rosenbrock.ros2`): the same arguments,
-statuses, counters and results, bit for bit (issue #23, item 1; ``docs/c-integrators.md``).
+"""The integrators in C, linked into every machine's library (issue #23).
 
-For now a separate small shared library, compiled with the flags of the generated code
-(:data:`winder.model.codegen.CFLAGS`, plus ``-ffp-contract=off`` so that no fused
-multiply–add changes a rounding), cached under :func:`~winder.model.codegen.cache_dir`
-keyed by its source and the flags, loaded with ctypes; it takes the generated functions'
-addresses (``MachineSystem.fns``). The one library per machine comes later.
+``solve/c/`` holds them: ``events.h`` (the shared mode table, event location and guard),
+``dopri5.c``, ``rk4.c``, ``ros2.c`` and ``machine.c`` (the modes and channels of a
+trajectory). :func:`link` compiles them once into objects (cached under
+:func:`~winder.model.codegen.cache_dir`, keyed by every source and header and the flags:
+the generated code's plus ``-ffp-contract=off -std=c99``, so no fused multiply–add
+changes a rounding), and :func:`winder.model.codegen.generate` links them with each
+machine's generated object into one shared library. :class:`Kernels` calls that library
+through ctypes, in chunks (the callers check their budgets, signals and progress between
+calls). ``docs/c-integrators.md`` gives the kernels' contract.
+
+Adding an integrator:
+
+1. write it in ``solve/c/NAME.c`` with the contract of ``winder_dopri5`` (``events.h``
+   holds the modes, events and guard);
+2. add the file to :data:`SOURCES` and its prototype to :meth:`Kernels.__init__`;
+3. call it from :mod:`winder.solve.simulate` and test it against a closed form.
 """
 
 from __future__ import annotations
@@ -16,99 +23,51 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
-import subprocess
 import tempfile
-from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from winder.model.codegen import CFLAGS, CompileError, _compiler, cache_dir
+from winder.model.codegen import Generated, Link, cache_dir, compile_flags, run_compiler
 
-__all__ = ["dopri5", "rk4", "ros2", "library", "kernels", "SOURCES", "EXTRA_CFLAGS", "ENV"]
-
-#: ``WINDER_INTEGRATORS=c`` runs simulate and the Stepper on these kernels (opt-in while
-#: they are compared with the numba ones; the default stays numba).
-ENV = "WINDER_INTEGRATORS"
+__all__ = ["Kernels", "link", "SOURCES", "EXTRA_CFLAGS"]
 
 _DIR = Path(__file__).resolve().parent / "c"
-#: The translation units of the library (each includes ``events.h``).
-SOURCES = (_DIR / "dopri5.c", _DIR / "rk4.c", _DIR / "ros2.c")
-#: Flags beyond the generated code's: no contraction into FMA (bit-equality with numba).
+#: The translation units (each includes ``events.h``).
+SOURCES = ("dopri5.c", "rk4.c", "ros2.c", "machine.c")
+#: Flags beyond the generated code's: no contraction into FMA.
 EXTRA_CFLAGS = ("-ffp-contract=off", "-std=c99")
-
-_LIB: Any = None
 
 _dp = ctypes.POINTER(ctypes.c_double)
 _ip = ctypes.POINTER(ctypes.c_int64)
 _i64, _f64 = ctypes.c_int64, ctypes.c_double
+_LINKS: dict[tuple[str, ...], Link] = {}
 
 
-#: ``WINDER_SANITIZE=1``: build with AddressSanitizer and UBSan (``make test-asan``: Python
-#: runs with libasan and libstdc++ preloaded and ``ASAN_OPTIONS=detect_leaks=0``).
-SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
-                   "-fno-omit-frame-pointer", "-g")
-
-
-def _build(directory: Path | None = None) -> Path:
-    flags = (*CFLAGS, *EXTRA_CFLAGS)
-    if os.environ.get("WINDER_SANITIZE", "") not in ("", "0"):
-        flags = (*flags, *SANITIZE_CFLAGS)
+def link() -> Link:
+    """The integrators' objects (compiled once, cached) for
+    :func:`~winder.model.codegen.generate`."""
+    flags = (*compile_flags(), *EXTRA_CFLAGS)
+    if flags in _LINKS:
+        return _LINKS[flags]
     h = hashlib.sha256(" ".join(flags).encode())
     for f in sorted(_DIR.glob("*.[ch]")):  # every source and header: the key
         h.update(f.name.encode() + b"\0" + f.read_bytes())
-    key = h.hexdigest()[:20]
-    root = Path(directory) if directory is not None else cache_dir() / "integrators"
-    lib = root / f"integrators-{key}.so"
-    if lib.exists():
-        return lib
-    cc = _compiler()
-    root.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
-        tmp_lib = Path(tmp) / lib.name
-        proc = subprocess.run([cc, *flags, *map(str, SOURCES), "-o", str(tmp_lib), "-lm"],
-                              capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise CompileError(f"compiling the C integrators failed ({cc}):\n"
-                               + proc.stderr[-2000:])
-        os.replace(tmp_lib, lib)
-    return lib
-
-
-def library() -> Any:
-    """The loaded C integrators (built and cached on first use)."""
-    global _LIB
-    if _LIB is None:
-        handle = ctypes.CDLL(str(_build()))
-        fn = handle.winder_dopri5
-        fn.restype = ctypes.c_int
-        fn.argtypes = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
-                       _f64, _dp, _i64, _dp, _i64, _i64, _ip, _i64, _dp, _dp, _ip]
-        fn = handle.winder_ros2
-        fn.restype = ctypes.c_int
-        fn.argtypes = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
-                       _f64, _dp, _i64, _dp, _i64, _i64, _ip, _dp, _dp, _ip]
-        fn = handle.winder_rk4
-        fn.restype = ctypes.c_int
-        fn.argtypes = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _dp, _i64,
-                       _dp, _i64, _ip, _dp, _dp, _ip]
-        _LIB = handle
-    return _LIB
-
-
-def kernels(n_switches: int = 0) -> tuple[Any, Any, Any]:
-    """``(dopri5, rk4, ros2)``: the C kernels (for a machine whose ``sw`` writes
-    ``n_switches`` values) where ``$WINDER_INTEGRATORS`` is ``c``, else the numba ones
-    (the default until the numba code is deleted)."""
-    if os.environ.get(ENV, "numba") == "c":
-        return (partial(dopri5, n_switches=n_switches), partial(rk4, n_switches=n_switches),
-                partial(ros2, n_switches=n_switches))
-    from winder.solve.dopri5 import dopri5 as dopri5_numba
-    from winder.solve.rk4 import rk4 as rk4_numba
-    from winder.solve.rosenbrock import ros2 as ros2_numba
-
-    return dopri5_numba, rk4_numba, ros2_numba
+    key = h.hexdigest()[:16]
+    root = cache_dir() / "integrators" / key
+    objects = tuple(root / f"{Path(s).stem}.o" for s in SOURCES)
+    if not all(o.exists() for o in objects):
+        root.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=root.parent, prefix=".build-") as tmp:
+            for src, obj in zip(SOURCES, objects, strict=True):
+                run_compiler([*flags, "-c", str(_DIR / src), "-o", str(Path(tmp) / obj.name)],
+                             f"the C integrators ({src})")
+            root.mkdir(exist_ok=True)
+            for obj in objects:
+                os.replace(Path(tmp) / obj.name, obj)  # atomic per file; a race writes equal
+    _LINKS[flags] = result = Link(objects, key)
+    return result
 
 
 def _ptr(a: np.ndarray, dtype: Any, name: str, writable: bool = False) -> Any:
@@ -118,72 +77,128 @@ def _ptr(a: np.ndarray, dtype: Any, name: str, writable: bool = False) -> Any:
     return a.ctypes.data_as(_ip if dtype == np.int64 else _dp)
 
 
-def dopri5(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
-           p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
-           max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
-           stats: np.ndarray, n_switches: int = 0) -> tuple[int, float, float, int]:
-    """:func:`winder.solve.dopri5.dopri5` in C: the same arguments and results
-    (``(status, t, h, k)``; ``y``, ``m``, ``Y_out`` and ``stats`` updated in place).
-    ``n_switches``: how many values the generated ``sw`` writes
-    (``Generated.n_switches``); the switch buffers hold at least those the ``table``
-    refers to (all the numba kernels allocate)."""
-    lib = library()
-    n = _check(fns, table, y, m, t_out, Y_out, stats)
-    tr, hr, kr = _f64(), _f64(), _i64()
-    status = lib.winder_dopri5(
-        _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
-        int(n_switches),
-        float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
-        _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol), float(atol),
-        float(h), float(max_step), _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
-        _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
-        _ptr(stats, np.int64, "stats", True), stats.shape[0], ctypes.byref(tr),
-        ctypes.byref(hr), ctypes.byref(kr))
-    return _result(status, tr, hr, kr)
+class Kernels:
+    """The integrators of one machine's library (``MachineSystem.kernels``).
 
+    Each kernel takes the arrays of the contract (``docs/c-integrators.md``): ``fns``
+    (the generated functions' addresses), the mode ``table``, the state ``y`` and modes
+    ``m`` (updated in place), the parameters ``p``, the output times ``t_out`` and
+    samples ``Y_out`` (n, n_out), and ``stats`` (int64 counters), and returns
+    ``(status, t, h, k)``.
+    """
 
-def ros2(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
-         p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
-         max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
-         stats: np.ndarray, n_switches: int = 0) -> tuple[int, float, float, int]:
-    """:func:`winder.solve.rosenbrock.ros2` in C: the same arguments and results
-    (``stats`` needs all 5 counters: ``stats[4]`` counts Jacobians; ``n_switches`` as
-    :func:`dopri5`)."""
-    lib = library()
-    n = _check(fns, table, y, m, t_out, Y_out, stats)
-    if stats.shape[0] < 5:
-        raise ValueError("stats must hold 5 counters")
-    tr, hr, kr = _f64(), _f64(), _i64()
-    status = lib.winder_ros2(
-        _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
-        int(n_switches),
-        float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
-        _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol), float(atol),
-        float(h), float(max_step), _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
-        _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
-        _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
-        ctypes.byref(kr))
-    return _result(status, tr, hr, kr)
+    def __init__(self, generated: Generated) -> None:
+        lib = generated._lib
+        if not hasattr(lib, "winder_dopri5"):
+            raise TypeError("generated: a machine library linked with the integrators "
+                            "(generate(machine, link=cint.link())) is needed")
+        self.n_switches = generated.n_switches
+        self.n_channels = generated.n_channels
+        adaptive = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
+                    _f64, _dp, _i64, _dp, _i64, _i64, _ip]
+        self._dopri5 = self._fn(lib.winder_dopri5, [*adaptive, _i64, _dp, _dp, _ip])
+        self._ros2 = self._fn(lib.winder_ros2, [*adaptive, _dp, _dp, _ip])
+        self._rk4 = self._fn(lib.winder_rk4, [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp,
+                                              _dp, _f64, _dp, _i64, _dp, _i64, _ip, _dp, _dp,
+                                              _ip])
+        self._modes = self._fn(lib.winder_modes, [_ip, _ip, _i64, _i64, _f64, _dp, _i64, _dp,
+                                                  _dp, _i64])
+        self._channels = self._fn(lib.winder_channels, [_ip, _ip, _i64, _i64, _dp, _i64, _dp,
+                                                        _i64, _dp, _dp, _dp, _i64])
+        self._lib = lib  # keep the library loaded
 
+    @staticmethod
+    def _fn(fn: Any, argtypes: list[Any]) -> Any:
+        fn.restype = ctypes.c_int
+        fn.argtypes = argtypes
+        return fn
 
-def rk4(fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
-        p: np.ndarray, m: np.ndarray, h: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
-        stats: np.ndarray, n_switches: int = 0) -> tuple[int, float, float, int]:
-    """:func:`winder.solve.rk4.rk4` in C: the same arguments and results (``n_switches``
-    as :func:`dopri5`)."""
-    lib = library()
-    n = _check(fns, table, y, m, t_out, Y_out, stats)
-    tr, hr, kr = _f64(), _f64(), _i64()
-    status = lib.winder_rk4(
-        _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
-        int(n_switches),
-        float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
-        _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(h),
-        _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
-        _ptr(Y_out, np.float64, "Y_out", True), int(k),
-        _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
-        ctypes.byref(kr))
-    return _result(status, tr, hr, kr)
+    def dopri5(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float,
+               y: np.ndarray, p: np.ndarray, m: np.ndarray, rtol: float, atol: float,
+               h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
+               budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
+        """DOPRI5 from ``t0`` towards ``t1`` [s] until done, an event that ends the run,
+        or ``budget`` evaluations (``PAUSED``); ``h <= 0``: it picks the first step."""
+        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        tr, hr, kr = _f64(), _f64(), _i64()
+        status = self._dopri5(
+            _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+            self.n_switches, float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+            _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol),
+            float(atol), float(h), float(max_step), _ptr(t_out, np.float64, "t_out"),
+            t_out.shape[0], _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
+            _ptr(stats, np.int64, "stats", True), stats.shape[0], ctypes.byref(tr),
+            ctypes.byref(hr), ctypes.byref(kr))
+        return _result(status, tr, hr, kr)
+
+    def ros2(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
+             p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
+             max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
+             stats: np.ndarray) -> tuple[int, float, float, int]:
+        """The Rosenbrock ROS2 on the exact Jacobian, as :meth:`dopri5` (``stats`` needs
+        5 counters: ``stats[4]`` counts Jacobians)."""
+        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        if stats.shape[0] < 5:
+            raise ValueError("stats must hold 5 counters")
+        tr, hr, kr = _f64(), _f64(), _i64()
+        status = self._ros2(
+            _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+            self.n_switches, float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+            _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol),
+            float(atol), float(h), float(max_step), _ptr(t_out, np.float64, "t_out"),
+            t_out.shape[0], _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
+            _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
+            ctypes.byref(kr))
+        return _result(status, tr, hr, kr)
+
+    def rk4(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
+            p: np.ndarray, m: np.ndarray, h: float, t_out: np.ndarray, Y_out: np.ndarray,
+            k: int, stats: np.ndarray) -> tuple[int, float, float, int]:
+        """Fixed-step RK4 with steps of at most ``h`` [s] evenly dividing
+        ``[t0, t1]``."""
+        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        tr, hr, kr = _f64(), _f64(), _i64()
+        status = self._rk4(
+            _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+            self.n_switches, float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+            _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(h),
+            _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
+            _ptr(Y_out, np.float64, "Y_out", True), int(k),
+            _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
+            ctypes.byref(kr))
+        return _result(status, tr, hr, kr)
+
+    def modes(self, fns: np.ndarray, table: np.ndarray, t: float, y: np.ndarray,
+              p: np.ndarray, m: np.ndarray, *, contact_auto: bool) -> None:
+        """The modes a step starting at ``(t, y)`` runs in, into ``m``:
+        a nip touching where its switching function is > 0 (``AUTO`` where
+        ``contact_auto``), a roll at its core where ``r <= r_c`` and it does not turn
+        forwards."""
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        status = self._modes(_ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"),
+                             table.shape[0], self.n_switches, float(t),
+                             _ptr(y, np.float64, "y"), y.shape[0],
+                             _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True),
+                             int(bool(contact_auto)))
+        _result(status, _f64(), _f64(), _i64())
+
+    def channels(self, fns: np.ndarray, table: np.ndarray, t: np.ndarray, Y: np.ndarray,
+                 p: np.ndarray) -> np.ndarray:
+        """The channels (n_channels, len(t)) of the samples ``Y`` (n, len(t)), each in
+        the modes of its state with the nips' clamped law."""
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        Y = np.ascontiguousarray(Y, dtype=np.float64)
+        if Y.ndim != 2 or Y.shape[1] != t.shape[0]:
+            raise ValueError(f"Y must be (n, {t.shape[0]}), got {Y.shape}")
+        out = np.empty((self.n_channels, t.shape[0]))
+        m = np.empty(table.shape[0])
+        status = self._channels(_ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"),
+                                table.shape[0], self.n_switches, _ptr(t, np.float64, "t"),
+                                t.shape[0], _ptr(Y, np.float64, "Y"), Y.shape[0],
+                                _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True),
+                                _ptr(out, np.float64, "out", True), self.n_channels)
+        _result(status, _f64(), _f64(), _i64())
+        return out
 
 
 def _check(fns: np.ndarray, table: np.ndarray, y: np.ndarray, m: np.ndarray,

@@ -11,6 +11,7 @@ numbers (the cross-check, and the fallback where no C compiler exists, with a wa
 
 from __future__ import annotations
 
+import ctypes
 import math
 import warnings
 from typing import Any
@@ -25,31 +26,13 @@ from winder.model.locked_modes import AT_CORE, AUTO, CORE_AUTO, WINDING, ModeKin
 from winder.model.machine import Machine
 from winder.scene import naming_of
 from winder.solve import integrators as integ
-from winder.solve._jit import njit
+from winder.solve.cint import Kernels, link
 from winder.solve.equilibrium import Equilibrium, static_state
 
 __all__ = ["MachineSystem", "NoCompilerWarning"]
 
 class NoCompilerWarning(UserWarning):
     """The generated path is unavailable (no C compiler): the numeric Pinocchio path runs."""
-
-
-@njit
-def _channels_into(fns: np.ndarray, table: np.ndarray, t: np.ndarray, Y: np.ndarray,
-                   p: np.ndarray, out: np.ndarray) -> None:
-    n = Y.shape[0]
-    y = np.empty(n)
-    m = np.empty(table.shape[0])
-    tb = np.empty(1)
-    g = integ.switch_buffer(table)
-    col = np.empty(out.shape[0])
-    for i in range(t.shape[0]):
-        for j in range(n):
-            y[j] = Y[j, i]
-        integ.modes_of(fns, table, tb, t[i], y, p, m, g, True)
-        integ.evaluate(fns, integ.F_OUT, tb, t[i], y, p, m, col)
-        for j in range(out.shape[0]):
-            out[j, i] = col[j]
 
 
 class MachineSystem:
@@ -71,7 +54,7 @@ class MachineSystem:
         self.generated: Generated | None = None
         if backend == "compiled":
             try:
-                self.generated = generate(m)
+                self.generated = generate(m, link=link())
             except CompilerMissing as exc:
                 warnings.warn(f"{exc}: the generated code cannot be built; running the "
                               "numeric Pinocchio path (much slower)", NoCompilerWarning,
@@ -79,6 +62,11 @@ class MachineSystem:
                 self.backend = "pinocchio"
         self._numeric = NumericBackend(m.model) if self.generated is None else None
         self.fns = self.generated.addresses if self.generated is not None else None
+        #: the C integrators of the machine's library (None on the numeric path)
+        self.kernels = Kernels(self.generated) if self.generated is not None else None
+        self._flat = {} if self.generated is None else {
+            which: ctypes.CFUNCTYPE(ctypes.c_int, *[ctypes.c_void_p] * 5)(int(address))
+            for which, address in enumerate(self.generated.addresses)}
         rows = [mode.table_row(m) for mode in m.modes]
         self.table = np.array(rows, dtype=np.int64).reshape(len(rows), 5)
         self.modes = np.array([mode.kind.automatic for mode in m.modes], dtype=float)
@@ -159,11 +147,13 @@ class MachineSystem:
                                      self.modes if modes is None else modes, outputs=outputs)
 
     def _call(self, which: int, t: float, y: np.ndarray, size: int) -> np.ndarray:
-        """One generated function at ``(t, y)`` through the compiled caller (about 1 µs
-        from Python)."""
+        """One generated function at ``(t, y)``, called through ctypes (a few µs from
+        Python)."""
         out = np.empty(size)
-        integ.evaluate(self.fns, which, self._tb, float(t),
-                       np.ascontiguousarray(y, dtype=np.float64), self.params, self.modes, out)
+        self._tb[0] = t
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        self._flat[which](self._tb.ctypes.data, y.ctypes.data, self.params.ctypes.data,
+                          self.modes.ctypes.data, out.ctypes.data)
         return out
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -274,9 +264,8 @@ class MachineSystem:
         t = np.ascontiguousarray(t, dtype=float)
         Y = np.ascontiguousarray(Y, dtype=float)
         names = self.machine.channel_names
-        if self.generated is not None:
-            out = np.empty((len(names), len(t)))
-            _channels_into(self.fns, self.table, t, Y, self.params, out)
+        if self.kernels is not None:
+            out = self.kernels.channels(self.fns, self.table, t, Y, self.params)
         else:
             out = np.empty((len(names), len(t)))
             modes = self.modes.copy()
