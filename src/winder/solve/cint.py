@@ -105,6 +105,9 @@ class Kernels:
                                                   _dp, _i64])
         self._channels = self._fn(lib.winder_channels, [_ip, _ip, _i64, _i64, _dp, _i64, _dp,
                                                         _i64, _dp, _dp, _dp, _i64])
+        self._repeat = lib.winder_repeat
+        self._repeat.restype = ctypes.c_double
+        self._repeat.argtypes = [_ip, _i64, _i64, _f64, _dp, _dp, _dp, _dp]
         self._lib = lib  # keep the library loaded
 
     @staticmethod
@@ -181,6 +184,19 @@ class Kernels:
                              _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True),
                              int(bool(contact_auto)))
         _result(status, _f64(), _f64(), _i64())
+
+    def repeat(self, fns: np.ndarray, which: int, count: int, t: float, y: np.ndarray,
+               p: np.ndarray, m: np.ndarray, out: np.ndarray) -> float:
+        """``count`` evaluations of the generated function ``fns[which]`` (``F_RHS``, ...)
+        at one point, from C as the integrators call it (the benchmarks' cost per
+        evaluation); ``out`` holds the last result. Returns the sum of ``out[0]``."""
+        if not 0 <= which < 4:
+            raise ValueError(f"which must be 0–3 (rhs, jac, out, sw), got {which}")
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        return float(self._repeat(_ptr(fns, np.int64, "fns"), int(which), int(count),
+                                  float(t), _ptr(y, np.float64, "y"),
+                                  _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m"),
+                                  _ptr(out, np.float64, "out", True)))
 
     def channels(self, fns: np.ndarray, table: np.ndarray, t: np.ndarray, Y: np.ndarray,
                  p: np.ndarray) -> np.ndarray:

@@ -27,7 +27,7 @@ from winder.model.machine import Machine
 from winder.scene import naming_of
 from winder.solve import integrators as integ
 from winder.solve.cint import Kernels, link
-from winder.solve.equilibrium import Equilibrium, static_state
+from winder.solve.equilibrium import Equilibrium, cached_static_state
 
 __all__ = ["MachineSystem", "NoCompilerWarning"]
 
@@ -87,9 +87,10 @@ class MachineSystem:
 
     @property
     def equilibrium(self) -> Equilibrium:
-        """The static balance of the initial state (machines.md §7)."""
+        """The static balance of the initial state (machines.md §7; kept on disk for the
+        same scene and parameters: :func:`~winder.solve.equilibrium.cached_static_state`)."""
         if self._eq is None:
-            self._eq = static_state(self.machine, self.params)
+            self._eq = cached_static_state(self.machine, self.params)
         return self._eq
 
     def initial_state(self) -> np.ndarray:

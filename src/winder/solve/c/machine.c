@@ -46,3 +46,18 @@ int winder_channels(const int64_t* fns, const int64_t* table, int64_t nslots,
     free(cx->g);
     return DONE;
 }
+
+/* count evaluations of the generated function fns[which] at one point, called as the
+ * integrators call it (the benchmarks' cost per evaluation); returns the sum of out[0]
+ * so that no call can be optimised away. */
+double winder_repeat(const int64_t* fns, int64_t which, int64_t count, double t,
+                     const double* y, const double* p, const double* m, double* out) {
+    wfn f = (wfn)(intptr_t)fns[which];
+    double tb[1] = {t};
+    double acc = 0.0;
+    for (int64_t i = 0; i < count; i++) {
+        f(tb, y, p, m, out);
+        acc += out[0];
+    }
+    return acc;
+}
