@@ -9,8 +9,8 @@ both see the same load:
   the repeats, after a warm-up run;
 - **two-drum cycle, in process**: the same for ``models/two_drum_winder.toml``;
 - **overhead per evaluation above the generated rhs**: ``wall / (nfev · t_rhs) − 1``,
-  ``t_rhs`` the generated rhs at the scene's initial state, timed in a compiled loop
-  (best of many; the C loop of the machine's library here, the numba loop in a baseline
+  ``t_rhs`` the generated rhs's mean cost over 100 states of the run, each timed in a
+  compiled loop (the C loop of the machine's library here, the numba loop in a baseline
   that has numba);
 - **``winder run`` paper cycle, whole process**: ``winder run models/paper_winding.toml
   --out r.npz`` from start to exit, median of the repeats;
@@ -48,9 +48,10 @@ SCENES = {"paper": "models/paper_winding.toml", "two_drum": "models/two_drum_win
 #: Run by each side's interpreter in its own checkout: a cycle's integration time,
 #: evaluations and the generated rhs's cost per evaluation in a compiled loop.
 _CYCLE = r"""
-import json, sys, time
+import json, math, sys, time
 import numpy as np
 import winder
+from winder.solve import integrators as integ
 from winder.solve.system import MachineSystem
 scene = winder.load_scene(sys.argv[1])
 repeats = int(sys.argv[2])
@@ -61,31 +62,59 @@ for _ in range(repeats):
     walls.append(res.meta["wall_time"])
     nfev = res.meta["rhs_evaluations"]
 system = MachineSystem(scene)
-y = system.initial_state()
-p, m = system.params, system.modes.copy()
-out = np.empty(system.n_states)
-count = 20000
-if getattr(system, "kernels", None) is not None:
-    loop = lambda: system.kernels.repeat(system.fns, 0, count, 0.0, y, p, m, out)
+fns, table, p = system.fns, system.table, system.params
+lib = getattr(system, "kernels", None)
+if lib is not None:
+    dopri5 = lib.dopri5
+    def modes(t, y, m):
+        lib.modes(fns, table, t, y, p, m, contact_auto=False)
+    def loop(which, t, y, m, out, count):
+        return lib.repeat(fns, which, count, t, y, p, m, out)
 else:  # a baseline with the numba kernels
     from numba import njit
-    from winder.solve import integrators as integ
-
+    from winder.solve.dopri5 import dopri5
+    g = integ.switch_buffer(table)
+    def modes(t, y, m):
+        integ.modes_of(fns, table, np.empty(1), t, y, p, m, g, False)
     @njit
-    def _loop(fns, t, y, p, m, out, n):
+    def _loop(fns, which, t, y, p, m, out, n):
         tb = np.empty(1)
         acc = 0.0
         for _ in range(n):
-            integ.evaluate(fns, 0, tb, t, y, p, m, out)
+            integ.evaluate(fns, which, tb, t, y, p, m, out)
             acc += out[0]
         return acc
-
-    loop = lambda: _loop(system.fns, 0.0, y, p, m, out, count)
-loop()
-best = min((lambda t0: (loop(), time.perf_counter() - t0)[1])(time.perf_counter())
-           for _ in range(200))
+    def loop(which, t, y, m, out, count):
+        return _loop(fns, which, t, y, p, m, out, count)
+# the states of the run (100 samples): the rhs's cost along the trajectory
+t_end = float(res.t[-1])
+t_out = np.linspace(0.0, t_end, 100)
+y = system.initial_state()
+Y = np.full((len(y), len(t_out)), np.nan)
+stats = np.zeros(5, dtype=np.int64)
+m = system.modes.copy()
+t, h, k = 0.0, 0.0, 0
+while t < t_end:
+    status, t, h, k = dopri5(fns, table, t, t_end, y, p, m, scene.solver.rtol,
+                             scene.solver.atol, h, math.inf, t_out, Y, k, 10**9, stats)
+    if status not in (integ.DONE, integ.PAUSED):
+        break
+out = np.empty(system.n_states)
+count, per_state = 20000, []
+for i in range(k):
+    yi = np.ascontiguousarray(Y[:, i])
+    mi = system.modes.copy()
+    modes(float(t_out[i]), yi, mi)
+    loop(0, float(t_out[i]), yi, mi, out, 10)
+    best = math.inf
+    for _ in range(5):
+        t0 = time.perf_counter()
+        loop(0, float(t_out[i]), yi, mi, out, count)
+        best = min(best, time.perf_counter() - t0)
+    per_state.append(best / count * 1e6)
 print(json.dumps({"wall": min(walls), "walls": walls, "nfev": nfev,
-                  "rhs_us": best / count * 1e6}))
+                  "rhs_us": float(np.mean(per_state)), "rhs_us_min": float(np.min(per_state)),
+                  "rhs_us_max": float(np.max(per_state)), "states": len(per_state)}))
 """
 
 _IMPORT = "import winder.cli, winder; winder.load_scene({scene!r})"
@@ -167,7 +196,8 @@ def measure(sides: list[Side], repeats: int, process_repeats: int) -> dict[str, 
 
 
 def overhead(row: dict[str, Any]) -> float:
-    """Time per evaluation above the generated rhs, as a fraction of the rhs."""
+    """Time per evaluation above the generated rhs (its mean cost over 100 states of the
+    run), as a fraction of the rhs."""
     return row["wall"] / (row["nfev"] * row["rhs_us"] * 1e-6) - 1.0
 
 
@@ -179,8 +209,8 @@ def table(out: dict[str, Any], labels: list[str]) -> list[str]:
 
     def row(name: str, fa: str, fb: str | None, ratio: float | None) -> None:
         cells = [fa] + ([fb] if fb is not None else [])
-        lines.append(f"| {name} | " + " | ".join(cells)
-                     + (f" | {ratio:.2f}× |" if ratio is not None else " |"))
+        end = f" | {ratio:.2f}× |" if ratio is not None else (" | – |" if b else " |")
+        lines.append(f"| {name} | " + " | ".join(cells) + end)
 
     for key, name in (("paper", "paper cycle, in process"),
                       ("two_drum", "two-drum cycle, in process")):
@@ -190,6 +220,10 @@ def table(out: dict[str, Any], labels: list[str]) -> list[str]:
                       ("two_drum", "overhead per evaluation above the rhs, two-drum")):
         row(name, f"{100 * overhead(a[key]):.0f} %",
             f"{100 * overhead(b[key]):.0f} %" if b else None, None)
+    for key, name in (("paper", "generated rhs per evaluation, paper"),
+                      ("two_drum", "generated rhs per evaluation, two-drum")):
+        row(name, f"{a[key]['rhs_us']:.3f} µs", f"{b[key]['rhs_us']:.3f} µs" if b else None,
+            None)
     row("`winder run` paper cycle, whole process", f"{a['winder_run']:.2f} s",
         f"{b['winder_run']:.2f} s" if b else None,
         b["winder_run"] / a["winder_run"] if b else None)
@@ -231,8 +265,10 @@ def main() -> None:
              "(`result.meta[\"wall_time\"]`), best of the runs; whole processes: median. "
              f"Load average {la[0]:.1f} before and {lb[0]:.1f} after on this "
              f"{os.cpu_count()}-core machine.", "", *table(out, labels), "",
-             "Ratio: baseline time over this tree's (> 1: this tree is faster). Overhead: "
-             "time per evaluation above the generated rhs (timed in a compiled loop), as "
+             "Ratio: baseline time over this tree's (> 1: this tree is faster). Generated rhs "
+             "per evaluation: its cost in a compiled loop (the machine's C loop here, a numba "
+             "loop in the baseline), the mean over 100 states of the run (each the best of 5 "
+             "loops of 20 000 calls). Overhead: the cycle's time per evaluation above that, as "
              "a fraction of it.", "",
              f"Compile times in an empty cache (this tree): the integrators' objects "
              f"{c['integrators']:.2f} s once per installation; per machine, generating, "
