@@ -76,6 +76,7 @@ mutants: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/rhs_speed.py
+	$(PY) benchmarks/compiled_machine.py $(if $(BASELINE),--baseline $(BASELINE))
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_realtime.py
 	$(PY) benchmarks/cli_speed.py
