@@ -56,6 +56,19 @@ test: $(STAMP) pin-casadi chromium
 test-slow: $(STAMP) chromium
 	$(PY) -m pytest -q -m slow
 
+# Every machine's library (its generated code and the C integrators of src/winder/solve/c/)
+# built with AddressSanitizer and UBSan (WINDER_SANITIZE=1: -O1, its own cache key), and
+# the kernel tests run through it: every shipped scene, the located events, the guard, the
+# core and the exhausted parent. libstdc++ is preloaded too: without it ASan's __cxa_throw
+# interceptor aborts in matplotlib's ft2font. A report aborts the run (exit status != 0).
+.PHONY: test-asan
+test-asan: $(STAMP) pin-casadi
+	WINDER_SANITIZE=1 ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  LD_PRELOAD="$$($${CC:-cc} -print-file-name=libasan.so) $$($${CC:-cc} -print-file-name=libstdc++.so.6)" \
+	  $(PY) -m pytest -q -p no:cacheprovider tests/solve/test_c_integrators.py \
+	    tests/solve/test_core_events.py tests/solve/test_guard.py tests/solve/test_cint.py
+
 # The fixed physics mutants (tests/mutants/catalogue.toml): every one must be killed.
 .PHONY: mutants
 mutants: $(STAMP)
@@ -63,6 +76,7 @@ mutants: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/rhs_speed.py
+	$(PY) benchmarks/compiled_machine.py $(if $(BASELINE),--baseline $(BASELINE))
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_realtime.py
 	$(PY) benchmarks/cli_speed.py

@@ -11,7 +11,7 @@
   exact Jacobian: ROS2, Radau, BDF, LSODA; each attempt capped at ``max_wall``.
 
 Integration wall time is ``result.meta["wall_time"]`` (the integrator alone, after a warm-up
-run that compiles the model and the numba kernels); best of N where a run is short.
+run that compiles and links the machine's library); best of N where a run is short.
 
 Run:  python benchmarks/cycle_speed.py [paper] [two_drum] [stiff] [--quick]
 """
@@ -66,7 +66,7 @@ def run(scene: winder.Scene, method: str, *, repeats: int, max_wall: float,
 
 
 def warm(scene: winder.Scene) -> None:
-    """Compile the model and the numba kernels of every method before timing."""
+    """Compile and link the machine's library, and run every method once, before timing."""
     for m in ("DOPRI5", "ROS2"):
         winder.simulate(scene, t_end=0.05, method=m, output_step=0.01)
 
@@ -121,8 +121,8 @@ def write_docs(data: dict[str, Any]) -> None:
              "Regenerate with `python benchmarks/cycle_speed.py` (each section can be run "
              "alone: `paper`, `two_drum`, `stiff`). rtol 1e-6, atol 1e-8 (the scenes' "
              "`[solver]`), output grids of the scenes. *wall*: `result.meta[\"wall_time\"]`, the "
-             "integration alone, after a warm-up that compiled the model and the numba "
-             "kernels; *total*: the `simulate()` call with the static balance and the output "
+             "integration alone, after a warm-up that compiled the machine's library"
+             "; *total*: the `simulate()` call with the static balance and the output "
              "channels; *CPU*: the process time of that call (what the process itself got "
              "of a core: on a loaded machine closer to a quiet machine's wall time than the "
              "wall time is). Shared 2-core machine: the load average at the start of each "

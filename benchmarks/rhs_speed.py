@@ -1,8 +1,8 @@
 """µs per evaluation of a machine's dynamics (writes docs/rhs_speed.md and .json).
 
 For each scene: the generated right-hand side and exact Jacobian called the way the
-compiled integrators call them (from numba through the function address,
-:func:`winder.solve.integrators.evaluate`), the generated right-hand side called from
+compiled integrators call them (from C through the function address, in the machine's
+library: ``MachineSystem.kernels.repeat``), the generated right-hand side called from
 Python (``MachineSystem.rhs``, ctypes) and the numeric Pinocchio path
 (``MachineSystem(scene, backend="pinocchio").rhs``: ``pin.aba`` on numbers with the same
 force elements). Scenes: the single-drum paper scene, the two-drum winder, and machines of
@@ -25,7 +25,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numba import njit
 
 import winder
 from winder.io.files import atomic_write
@@ -39,17 +38,6 @@ ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
 DOCS = ROOT / "docs"
 GROWN = ((1, 0), (2, 0), (3, 0), (4, 0), (1, 1), (1, 2), (1, 3))
-
-
-@njit
-def _loop(fns: np.ndarray, which: int, t: float, y: np.ndarray, p: np.ndarray,
-          m: np.ndarray, out: np.ndarray, n: int) -> float:
-    tb = np.empty(1)
-    acc = 0.0
-    for _ in range(n):
-        integ.evaluate(fns, which, tb, t, y, p, m, out)
-        acc += out[0]
-    return acc
 
 
 def best_us(f: Callable[[], Any], n: int, repeats: int) -> float:
@@ -73,17 +61,21 @@ def state_of(system: MachineSystem) -> np.ndarray:
 
 def measure(scene: winder.Scene, label: str, *, n_loop: int, n_py: int, repeats: int,
             pinocchio: bool = True) -> dict[str, Any]:
-    """(The numba loops run ``4 × repeats`` times: short loops, many repeats, so that the
-    best catches a moment with a whole core on a loaded machine.)"""
-    """µs per evaluation for one scene (compiled: inside numba, from Python; Pinocchio)."""
+    """µs per evaluation for one scene (compiled: from C, from Python; Pinocchio). The C
+    loops run ``4 × repeats`` times: short loops, many repeats, so that the best catches
+    a moment with a whole core on a loaded machine."""
     system = MachineSystem(scene)
     y, t = state_of(system), 5.0
     p, m = system.params, system.modes.copy()
-    g = np.empty(max(1, int(system.table[:, 1:3].max()) + 1 if system.table.shape[0] else 1))
-    integ.modes_of(system.fns, system.table, np.empty(1), t, y, p, m, g, False)
+    lib = system.kernels
+    lib.modes(system.fns, system.table, t, y, p, m, contact_auto=False)
     n = system.n_states
     out_r, out_j = np.empty(n), np.empty(n * n)
-    _loop(system.fns, integ.F_RHS, t, y, p, m, out_r, 10)  # compile the loop
+
+    def _loop(fns: np.ndarray, which: int, t: float, y: np.ndarray, p: np.ndarray,
+              m: np.ndarray, out: np.ndarray, count: int) -> float:
+        return lib.repeat(fns, which, count, t, y, p, m, out)
+
     row: dict[str, Any] = {
         "scene": label, "states": n, "bodies": len(system.machine.bodies),
         "nips": len(scene.nips), "route": system.generated.route,
@@ -153,7 +145,7 @@ def main(quick: bool = False, write: bool = True) -> dict[str, Any]:
            "load_before": load, "load_after": os.getloadavg(),
            "n_loop": n_loop, "repeats": repeats}
     for r in rows:
-        print(f"{r['scene']}: rhs {r['rhs_us']:.3f} µs (in numba), jac {r['jac_us']:.3f} µs, "
+        print(f"{r['scene']}: rhs {r['rhs_us']:.3f} µs (from C), jac {r['jac_us']:.3f} µs, "
               f"from Python {r['rhs_python_us']:.2f} µs, Pinocchio {r['pinocchio_us']:.1f} µs")
     if write:
         write_docs(out)
@@ -168,14 +160,14 @@ def plot(out: dict[str, Any], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for key, label, mark in (("rhs_us", "rhs (numba)", "o"), ("jac_us", "jac (numba)", "s")):
+    for key, label, mark in (("rhs_us", "rhs (from C)", "o"), ("jac_us", "jac (from C)", "s")):
         for rows, face, what in ((out["grown"], None, "grown"), (out["rows"], "none", "models")):
             x = [r["states"] for r in rows]
             a1.plot(x, [r[key] for r in rows], mark, mfc=face,
                     label=f"{label}, {what}", color="C0" if key == "rhs_us" else "C1")
     a1.set_xlabel("states")
     a1.set_ylabel("µs per call")
-    a1.set_title("generated code, called from numba")
+    a1.set_title("generated code, called from C")
     a1.legend(fontsize=8)
     a1.grid(alpha=0.3)
     for rows, face, what in ((out["grown"], None, "grown"), (out["rows"], "none", "models")):
@@ -199,19 +191,19 @@ def write_docs(out: dict[str, Any]) -> None:
     la, lb = out["load_before"], out["load_after"]
     lines = ["# Evaluation cost of the generated dynamics", "",
              "Regenerate with `python benchmarks/rhs_speed.py`. µs per call, best of "
-             f"{4 * out['repeats']} repeats of {out['n_loop']:,} calls (in numba; "
+             f"{4 * out['repeats']} repeats of {out['n_loop']:,} calls (from C; "
              f"{out['repeats']} repeats from Python) on a shared "
              f"2-core machine; load average {la[0]:.1f} before and {lb[0]:.1f} after "
              "(best-of-N filters most of the load, the absolute numbers still carry it).", "",
-             "- *rhs / jac in numba*: the generated C called through its address from a numba "
+             "- *rhs / jac from C*: the generated C called through its address from a C "
              "loop, as the compiled integrators (DOPRI5, RK4, ROS2) call it "
-             "(`winder.solve.integrators.evaluate`); the Jacobian is the exact dense n×n one.",
+             "(`MachineSystem.kernels.repeat`); the Jacobian is the exact dense n×n one.",
              "- *rhs from Python*: `MachineSystem.rhs` (ctypes, argument conversion), as scipy's "
              "methods call it.",
              "- *Pinocchio*: `MachineSystem(scene, backend=\"pinocchio\").rhs` — `pin.aba` on "
              "numbers with the same force elements (the reference path); its agreement with "
              "the generated code is the last column (relative, largest component).", "",
-             "| scene | states | bodies | nips | route | rhs in numba [µs] | jac in numba [µs] | "
+             "| scene | states | bodies | nips | route | rhs from C [µs] | jac from C [µs] | "
              "rhs from Python [µs] | Pinocchio rhs [µs] | Pinocchio vs generated |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in out["rows"] + out["grown"]:
@@ -226,7 +218,7 @@ def write_docs(out: dict[str, Any]) -> None:
               "| quantity | c0 [µs] | per body [µs] | per nip [µs] | largest residual [µs] | "
               "slope per unit [µs] | slope per rider [µs] |",
               "|---|---|---|---|---|---|---|"]
-    for k, label in (("rhs_us", "rhs in numba"), ("jac_us", "jac in numba"),
+    for k, label in (("rhs_us", "rhs from C"), ("jac_us", "jac from C"),
                      ("pinocchio_us", "Pinocchio rhs")):
         f = out["fits"][k]
         lines.append(f"| {label} | {f['c0']:.3f} | {f['per_body']:.3f} | {f['per_nip']:.3f} | "

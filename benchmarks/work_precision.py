@@ -208,7 +208,7 @@ def study(problems: list[Problem], *, max_wall: float, quick: bool, repeats: int
         prob.note += f"; reference: {ref_note}"
         print(f"{prob.name}: reference in {time.perf_counter() - t0:.1f} s ({ref_note})",
               file=log, flush=True)
-        for m in (*COMPILED, "RK4"):  # compile (numba) outside the timed runs and budgets
+        for m in (*COMPILED, "RK4"):  # build the library outside the timed runs and budgets
             prob.run(m, 1e-3, max_step=1e-3 if m == "RK4" else None,
                      t_end=prob.t_start + 10 * prob.output_step)
         runs: list[tuple[str, str, float | None, float | None]] = []

@@ -446,7 +446,6 @@ def test_imbalanced_roll_against_lagrange() -> None:
 def _integrate(system: Any, y0: np.ndarray, t_out: np.ndarray, rtol: float,
                atol: float) -> np.ndarray:
     from winder.solve import integrators as integ
-    from winder.solve.dopri5 import dopri5
 
     y = np.array(y0, dtype=float)
     Y = np.empty((len(y), len(t_out)))
@@ -454,9 +453,10 @@ def _integrate(system: Any, y0: np.ndarray, t_out: np.ndarray, rtol: float,
     t, h, k = float(t_out[0]), 0.0, 0
     modes = system.modes.copy()
     while t < t_out[-1]:
-        status, t, h, k = dopri5(system.fns, system.table, t, float(t_out[-1]), y,
-                                       system.params, modes, rtol, atol, h, math.inf, t_out,
-                                       Y, k, 10 ** 8, stats)
+        status, t, h, k = system.kernels.dopri5(system.fns, system.table, t,
+                                                float(t_out[-1]), y, system.params, modes,
+                                                rtol, atol, h, math.inf, t_out, Y, k, 10 ** 8,
+                                                stats)
         assert status in (integ.DONE, integ.PAUSED), status
     return Y
 

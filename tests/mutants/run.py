@@ -14,13 +14,13 @@ Anything but ``killed`` fails the run. Before the mutants, every test the mutant
 must pass on the unmutated copy (this also fills each worker's caches).
 
 Caches: the generated C of a machine is cached under ``$WINDER_CACHE_DIR``, keyed by a hash
-of the source of ``winder/model``, ``winder/forces`` and ``winder/model/mass_law.py``; numba
-caches its kernels under ``$NUMBA_CACHE_DIR``, keyed by each module's path and time stamp.
-Every mutant gets its own fresh directory for both (deleted afterwards), so no mutant runs
-code generated or compiled from another source: a mutant of those sources starts with an
-empty generated cache, a mutant of a module with numba kernels an empty numba cache; the
-others start from a copy of the worker's unmutated caches (which cannot depend on the
-edit). The Pinocchio/CasADi generator of ``model/pin_casadi.py`` (built once
+of the source of ``winder/model``, ``winder/parts`` and ``winder/forces``; the C
+integrators' objects (``solve/c/``) and each machine's library are keyed by the hash of
+their own sources, so a mutant of the integrators builds its own. Every mutant gets its
+own fresh cache directory (deleted afterwards), so no mutant runs code generated or
+compiled from another source: a mutant of the generated sources starts with an empty
+cache; the others start from a copy of the worker's unmutated cache.
+The Pinocchio/CasADi generator of ``model/pin_casadi.py`` (built once
 under the virtual environment, ``winder-pin-casadi``) is shared: it is Pinocchio's
 algorithms, not winder's physics (``model/_pin_casadi.cpp`` is not mutated: a changed
 source rebuilds it, ~160 s of g++ per mutant).
@@ -77,12 +77,6 @@ class Mutant:
     def generated(self) -> bool:
         """An edit of the sources the generated code is keyed by."""
         return any(f.startswith(GENERATED) for f, _, _ in self.edits)
-
-    @property
-    def jitted(self) -> bool:
-        """An edit of a module with numba kernels (numba checks the stamp of a kernel's own
-        module only: kernels of other modules that inlined a mutated one would be stale)."""
-        return any("@njit" in (ROOT / f).read_text(encoding="utf-8") for f, _, _ in self.edits)
 
 
 def _term_edits(spec: list[dict], kind: str) -> list[tuple[str, str, str]]:
@@ -143,7 +137,8 @@ def check_applies(m: Mutant) -> bool:
 
 
 class Worker:
-    """A private copy of ``src/`` and caches (numba, generated C) of its unmutated code."""
+    """A private copy of ``src/`` and the cache (generated C, integrators, libraries) of its
+    unmutated code."""
 
     def __init__(self, base: Path, index: int) -> None:
         self.dir = base / f"w{index}"
@@ -157,9 +152,9 @@ class Worker:
             shutil.copy2(ROOT / f, self.dir / f)
 
     def run(self, tests: list[str], cache: Path) -> tuple[int, str, float]:
-        """pytest on ``tests`` with the caches under ``cache`` (``numba``, ``winder``)."""
+        """pytest on ``tests`` with the cache under ``cache`` (``winder``)."""
         env = dict(os.environ, PYTHONPATH=str(self.src), WINDER_MUTANT_SRC=str(self.src),
-                   NUMBA_CACHE_DIR=str(cache / "numba"), WINDER_CACHE_DIR=str(cache / "winder"),
+                   WINDER_CACHE_DIR=str(cache / "winder"),
                    PYTHONDONTWRITEBYTECODE="1")
         cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-rfE", "--no-header",
                "-p", "no:cacheprovider", *tests]
@@ -188,8 +183,7 @@ class Worker:
                 path.write_text(text.replace(find, replace, 1), encoding="utf-8")
             # its own caches: empty, or a copy of the unmutated ones where they cannot
             # depend on the edit
-            subs = [sub for sub, fresh in (("numba", m.jitted), ("winder", m.generated))
-                    if not fresh]
+            subs = [] if m.generated else ["winder"]
             for sub in subs:
                 if (self.clean_cache / sub).is_dir():
                     shutil.copytree(self.clean_cache / sub, cache / sub, symlinks=True)

@@ -11,8 +11,6 @@ import pytest
 import winder
 from winder.model.locked_modes import AT_CORE, WINDING
 from winder.solve import integrators as integ
-from winder.solve.dopri5 import dopri5
-from winder.solve.rk4 import rk4
 from winder.solve.system import MachineSystem
 
 
@@ -49,12 +47,12 @@ def test_integrators_land_on_the_core(paper_scene, method) -> None:
     stats = np.zeros(5, dtype=np.int64)
     t_out, Y_out = np.empty(0), np.empty((len(y), 0))
     if method == "dopri5":
-        status, t, _, _ = dopri5(system.fns, system.table, 0.0, t_mid, y,
-                                       system.params, m, 1e-10, 1e-12, 0.0, np.inf, t_out,
-                                       Y_out, 0, 10**8, stats)
+        status, t, _, _ = system.kernels.dopri5(system.fns, system.table, 0.0, t_mid, y,
+                                                system.params, m, 1e-10, 1e-12, 0.0, np.inf,
+                                                t_out, Y_out, 0, 10**8, stats)
     else:
-        status, t, _, _ = rk4(system.fns, system.table, 0.0, t_mid, y, system.params,
-                                    m, 1e-4, t_out, Y_out, 0, stats)
+        status, t, _, _ = system.kernels.rk4(system.fns, system.table, 0.0, t_mid, y,
+                                             system.params, m, 1e-4, t_out, Y_out, 0, stats)
     assert status == integ.DONE and t == t_mid
     assert stats[3] >= 1  # the core event happened
     assert m[_core_slot(system)] == AT_CORE
@@ -67,12 +65,11 @@ def test_start_mode_at_the_core(paper_scene) -> None:
     system = MachineSystem(paper_scene)
     rc = paper_scene.roll.core_radius
     slot = _core_slot(system)
-    g = np.empty(len(system.machine.switch_names))
-    tb = np.empty(1)
     for r, speed, mode in ((rc, -5.0, AT_CORE), (rc, 5.0, WINDING), (rc + 1e-3, -5.0, WINDING)):
         y = system.initial_state()
         y[system.index("roll.radius")] = r
         y[system.index("roll.theta_dot")] = -speed  # the roll's sense is −1
         m = system.modes.copy()
-        integ.modes_of(system.fns, system.table, tb, 0.0, y, system.params, m, g, False)
+        system.kernels.modes(system.fns, system.table, 0.0, y, system.params, m,
+                             contact_auto=False)
         assert m[slot] == mode, (r, speed)

@@ -21,7 +21,6 @@ from cli_corpus import PAPER
 import winder
 from winder.cli import main
 from winder.solve import integrators as integ
-from winder.solve.dopri5 import dopri5
 from winder.solve.system import MachineSystem
 
 DRUM_RADIUS = 0.5  # [m], models/paper_winding.toml
@@ -131,9 +130,9 @@ def test_dopri5_with_no_error_control_stops_at_the_drum(centred) -> None:
     t_out = np.linspace(0.0, 0.5, 51)
     Y = np.full((len(y), len(t_out)), np.nan)
     stats = np.zeros(5, dtype=np.int64)
-    status, t, _, k = dopri5(system.fns, system.table, 0.0, 0.5, y, system.params,
-                                   system.modes.copy(), 1e-6, 1e300, 0.0, math.inf, t_out,
-                                   Y, 0, 10**7, stats)
+    status, t, _, k = system.kernels.dopri5(system.fns, system.table, 0.0, 0.5, y,
+                                            system.params, system.modes.copy(), 1e-6, 1e300,
+                                            0.0, math.inf, t_out, Y, 0, 10**7, stats)
     assert status == integ.PENETRATED
     state = dict(zip(system.state_names, y, strict=True))
     assert 0.0 <= _on_the_bound(state) < 1e-9, state

@@ -1,7 +1,7 @@
 """FMI 2.0 co-simulation export (pythonfmu): the winder as an FMU for controller work.
 
 The FMU runs *inside the host's Python*: pythonfmu's binary loads the Python interpreter
-of the importing process and imports :mod:`winder` (with Pinocchio and numba) from it.
+of the importing process and imports :mod:`winder` (with Pinocchio) from it.
 A host that loads the FMU must therefore be a Python process (FMPy, or any tool that
 embeds that Python) whose environment has winder installed; the scene travels inside the
 FMU (``resources/scene.toml``).

@@ -5,10 +5,16 @@ The machine's dynamics (:meth:`~winder.model.machine.Machine.evaluate`) runs onc
 symbols; four functions of ``(t, x, p, m)`` (time, state, parameters, locked modes) are
 generated as C, wrapped with flat entry points ``int NAME(const double* t, const double*
 x, const double* p, const double* m, double* out)`` and compiled with the system C
-compiler. The cache key is everything that changes the generated code: the machine's
-structure (:meth:`~winder.model.machine.Machine.structure_key`), the source of the physics
-(:mod:`winder.model`, :mod:`winder.parts`, :mod:`winder.forces`), the CasADi version and
-the compiler flags.
+compiler into an object file. The cache key is everything that changes the generated
+code: the machine's structure (:meth:`~winder.model.machine.Machine.structure_key`), the
+source of the physics (:mod:`winder.model`, :mod:`winder.parts`, :mod:`winder.forces`),
+the CasADi version and the compiler flags.
+
+The machine's library links that object with the objects the caller brings (the
+integrators of :mod:`winder.solve.cint`: ``generate(machine, link=...)``), cached under a
+key of both; changing an integrator relinks (about 0.05 s) and recompiles nothing
+generated. ``WINDER_SANITIZE=1`` builds everything with AddressSanitizer and UBSan
+(:data:`SANITIZE_CFLAGS`, a separate cache key).
 Writes are atomic (a temporary file, then ``os.replace``), so processes building the same
 model at once all succeed. Parameter values are run-time inputs: changing one compiles
 nothing.
@@ -33,13 +39,22 @@ from winder._errors import WinderError
 from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
-           "stats"]
+           "stats", "Link", "compile_flags", "link_flags", "run_compiler",
+           "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash"]
 
 #: The generated functions, in the order of :attr:`Generated.addresses`.
 FUNCTIONS = ("rhs", "jac", "out", "sw")
-CFLAGS = ("-O3", "-shared", "-fPIC")
-#: Counters of this process: models compiled, and loaded from the cache.
-stats = {"compiled": 0, "cached": 0}
+#: ``-fno-semantic-interposition``: the generated helpers (``sq``, ``fmax``, ...) are inlined
+#: into the functions that call them rather than called through the PLT (the rhs 1.7×
+#: faster; the same operations, so the same results).
+CFLAGS = ("-O3", "-shared", "-fPIC", "-fno-semantic-interposition")
+#: ``WINDER_SANITIZE=1`` (``make test-asan``): AddressSanitizer and UBSan on every object
+#: and the link (Python then needs libasan preloaded; see the Makefile).
+SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
+                   "-fno-omit-frame-pointer", "-g")
+#: Counters of this process: models compiled, libraries linked (the generated object
+#: cached), and libraries loaded from the cache.
+stats = {"compiled": 0, "linked": 0, "cached": 0}
 
 
 class CompilerMissing(WinderError, RuntimeError):
@@ -59,6 +74,44 @@ def cache_dir() -> Path:
     return Path(base) / "winder"
 
 
+def sanitized() -> bool:
+    """Whether ``$WINDER_SANITIZE`` asks for sanitized builds."""
+    return os.environ.get("WINDER_SANITIZE", "") not in ("", "0")
+
+
+def compile_flags() -> tuple[str, ...]:
+    """The flags an object is compiled with (``-c``; :data:`CFLAGS` without ``-shared``;
+    where :func:`sanitized`, ``-O1`` and :data:`SANITIZE_CFLAGS`: without fast-math or FMA
+    contraction the optimisation level changes no result)."""
+    flags = tuple(f for f in CFLAGS if f != "-shared")
+    if sanitized():  # -O1: a sanitized build compiles several times faster than -O3
+        return (*("-O1" if f == "-O3" else f for f in flags), *SANITIZE_CFLAGS)
+    return flags
+
+
+def link_flags() -> tuple[str, ...]:
+    """The flags the machine's shared library is linked with."""
+    return (*CFLAGS, *SANITIZE_CFLAGS) if sanitized() else CFLAGS
+
+
+def run_compiler(args: list[str], what: str) -> None:
+    """Run the C compiler with ``args``; :class:`CompileError` with its output if it
+    fails."""
+    cc = _compiler()
+    proc = subprocess.run([cc, *args], capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise CompileError(f"compiling {what} failed ({cc}):\n" + proc.stderr[-2000:])
+
+
+def source_hash() -> str:
+    """A hash of the physics' source (:mod:`winder.model`, :mod:`winder.parts`,
+    :mod:`winder.forces`; computed once per process)."""
+    global _SOURCE
+    if _SOURCE is None:
+        _SOURCE = _source_hash()
+    return _SOURCE
+
+
 def _source_hash() -> str:
     h = hashlib.sha256()
     root = Path(__file__).resolve().parent.parent
@@ -72,6 +125,18 @@ def _source_hash() -> str:
 
 
 _SOURCE: str | None = None
+
+
+def _casadi_version() -> str:
+    """CasADi's version, from its package metadata (no import)."""
+    import importlib.metadata
+
+    try:
+        return importlib.metadata.version("casadi")
+    except importlib.metadata.PackageNotFoundError:  # a build without metadata: import it
+        import casadi as ca
+
+        return str(ca.__version__)
 
 
 def _compiler() -> str:
@@ -148,8 +213,11 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Pat
     cg = ca.CodeGenerator(name, {"with_header": False})
     for f in funcs.values():
         cg.add(f)
-    cg.generate(str(directory) + os.sep)
+    # dump() rather than generate(): the same code, written here, without loading CasADi's
+    # file-system plugin (dlopen with RTLD_DEEPBIND, which AddressSanitizer refuses)
     path = directory / name
+    path.write_text(f"/* {symbol}: generated by CasADi {ca.__version__} for winder */\n"
+                    + cg.dump())
     wrap = ["", "/* flat, reentrant entry points */"]
     for k, f in funcs.items():
         wrap.append(
@@ -164,40 +232,51 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Pat
     return path
 
 
+@dataclass(frozen=True)
+class Link:
+    """Objects linked into every machine's library, and a key of their sources and
+    flags (it names the library beside the generated code's key)."""
+
+    objects: tuple[Path, ...]
+    key: str
+
+
 def generate(machine: Machine, *, directory: Path | None = None,
-             route: str | None = None) -> Generated:
+             route: str | None = None, link: Link | None = None) -> Generated:
     """The compiled functions of ``machine``: from the cache, or generated and compiled
     (and cached). ``route``: how Pinocchio's algorithms reach the symbols (one of
     :data:`~winder.model.backends.ROUTES`; default ``cpp`` where its generator is built).
-    Raises :class:`CompilerMissing` without a C compiler."""
-    import casadi as ca
-
+    ``link``: objects linked into the machine's library with the generated code (the
+    integrators). Raises :class:`CompilerMissing` without a C compiler. A cached machine
+    loads without importing CasADi (its version comes from the package metadata)."""
     from winder.model.backends import default_route
 
-    global _SOURCE
-    if _SOURCE is None:
-        _SOURCE = _source_hash()
     route = default_route() if route is None else route
-    key = hashlib.sha256("|".join((machine.structure_key(), _SOURCE, ca.__version__, route,
-                                   " ".join(CFLAGS))).encode()).hexdigest()[:20]
+    cflags = compile_flags()
+    key = hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(), route,
+                                   " ".join(cflags))).encode()).hexdigest()[:20]
     symbol = f"w{key}"
     root = Path(directory) if directory is not None else cache_dir() / "generated"
-    lib = root / f"{symbol}.so"
+    obj = root / f"{symbol}.o"
+    lib = root / (f"{symbol}-{link.key}.so" if link is not None else f"{symbol}.so")
     t0 = time.perf_counter()
     from_cache = lib.exists()
     if not from_cache:
-        cc = _compiler()
         root.mkdir(parents=True, exist_ok=True)
+        compiled = not obj.exists()
         with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
-            src = _c_source(machine, symbol, Path(tmp), route)
-            tmp_lib = Path(tmp) / f"{symbol}.so"
-            proc = subprocess.run([cc, *CFLAGS, str(src), "-o", str(tmp_lib), "-lm"],
-                                  capture_output=True, text=True)
-            if proc.returncode != 0:
-                raise CompileError(f"compiling the generated model failed ({cc}):\n"
-                                   + proc.stderr[-2000:])
+            if compiled:
+                src = _c_source(machine, symbol, Path(tmp), route)
+                tmp_obj = Path(tmp) / obj.name
+                run_compiler([*cflags, "-c", str(src), "-o", str(tmp_obj)],
+                             "the generated model")
+                os.replace(tmp_obj, obj)
+            tmp_lib = Path(tmp) / lib.name
+            extra = [str(o) for o in link.objects] if link is not None else []
+            run_compiler([*link_flags(), str(obj), *extra, "-o", str(tmp_lib), "-lm"],
+                         "the machine's library")
             os.replace(tmp_lib, lib)
-        stats["compiled"] += 1
+        stats["compiled" if compiled else "linked"] += 1
     else:
         stats["cached"] += 1
     handle = ctypes.CDLL(str(lib))

@@ -17,9 +17,11 @@ them. The largest force residual is reported with the result; above
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -31,8 +33,8 @@ from winder.model.machine import Machine, Nip
 from winder.parts import BodyElement as Body
 from winder.scene.naming import naming_of
 
-__all__ = ["static_state", "resting_state", "Resting", "Equilibrium", "EquilibriumError",
-           "RESIDUAL_LIMIT", "balance_keys", "body_key", "nip_key"]
+__all__ = ["static_state", "cached_static_state", "resting_state", "Resting", "Equilibrium",
+           "EquilibriumError", "RESIDUAL_LIMIT", "balance_keys", "body_key", "nip_key"]
 
 #: Largest accepted residual of the static balance, relative to the largest force in it.
 RESIDUAL_LIMIT = 1e-6
@@ -324,3 +326,64 @@ def static_state(machine: Machine, p: np.ndarray | None = None) -> Equilibrium:
             f"{res[worst]:.3g} N (largest force {scale:.3g} N, limit {RESIDUAL_LIMIT:g} of "
             f"it); the balance is decided by {', '.join(keys)} and the loads on it")
     return Equilibrium(x, float(np.max(np.abs(res))), scale)
+
+
+# ---- the balance cache --------------------------------------------------------------------
+def _balance_key(machine: Machine, p: np.ndarray) -> str:
+    """Everything the balance depends on: the scene, the parameters, the initial state,
+    the source of the physics and of this module, and the numeric libraries' versions."""
+    import importlib.metadata
+    import json
+
+    from winder.model.codegen import source_hash
+
+    h = hashlib.sha256(machine.structure_key().encode())
+    h.update(json.dumps(machine.scene.to_dict(), sort_keys=True, default=repr).encode())
+    h.update(np.ascontiguousarray(p, dtype=float).tobytes())
+    h.update(np.asarray(machine.state_initial, dtype=float).tobytes())
+    h.update(source_hash().encode() + Path(__file__).read_bytes())
+    for dist in ("numpy", "scipy", "pin"):
+        try:
+            h.update(f"{dist}{importlib.metadata.version(dist)}".encode())
+        except importlib.metadata.PackageNotFoundError:
+            h.update(f"{dist}-none".encode())
+    return h.hexdigest()[:24]
+
+
+def cached_static_state(machine: Machine, p: np.ndarray | None = None) -> Equilibrium:
+    """:func:`static_state`, kept on disk (``cache_dir()/balance``) under a key of
+    everything it depends on (:func:`_balance_key`): a second run of the same scene and
+    parameters reads the state (exactly: floats as hex) and imports no solver. Only
+    balances that were found are kept; a refused one is refused again every time. A
+    machine whose scene cannot be written out (``to_dict``: the tests' stand-ins) is
+    solved every time."""
+    import json
+    import os
+    import tempfile
+
+    from winder.model.codegen import cache_dir
+
+    p = machine.parameters() if p is None else p
+    if not hasattr(machine.scene, "to_dict"):
+        return static_state(machine, p)
+    path = cache_dir() / "balance" / f"{_balance_key(machine, p)}.json"
+    try:
+        data = json.loads(path.read_text())
+        state = np.array([float.fromhex(v) for v in data["state"]])
+        if state.shape == (machine.n_states,):
+            return Equilibrium(state, float.fromhex(data["residual"]),
+                               float.fromhex(data["scale"]))
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    eq = static_state(machine, p)
+    text = json.dumps({"state": [float(v).hex() for v in eq.state],
+                       "residual": float(eq.residual).hex(), "scale": float(eq.scale).hex()})
+    try:  # atomic; a cache that cannot be written is skipped
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".balance-", suffix=".json")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except OSError:
+        pass
+    return eq

@@ -20,9 +20,6 @@ from winder.scene.load import Scene, load_scene
 from winder.scene.schema import BACKENDS, MAX_SAMPLES, METHODS
 from winder.solve import integrators as integ
 from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances
-from winder.solve.dopri5 import dopri5
-from winder.solve.rk4 import rk4
-from winder.solve.rosenbrock import ros2
 from winder.solve.system import MachineSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
@@ -113,6 +110,8 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     t, h, k = float(t_out[0]), 0.0, 0
     hmax = math.inf if max_step is None else float(max_step)
     fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
+    lib = system.kernels  # the C integrators of the machine's library
+    dopri5, rk4, ros2 = lib.dopri5, lib.rk4, lib.ros2
     for tb in breaks:
         while t < tb:
             budget = min(integ.CHUNK, guards.limit - int(stats[0]))

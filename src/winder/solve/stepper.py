@@ -16,7 +16,6 @@ from winder.scene import naming_of
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
 from winder.solve.budgets import budget_error, check_budgets, check_tolerances
-from winder.solve.dopri5 import dopri5
 from winder.solve.simulate import _as_scene
 from winder.solve.system import MachineSystem
 
@@ -148,6 +147,7 @@ class Stepper:
         sy = self.system
         nfev0, steps0, stiff0 = (int(x) for x in self._stats[[0, 1, 4]])
         wall0 = time.perf_counter()
+        dopri5 = sy.kernels.dopri5  # the C DOPRI5 of the machine's library
         for tb in stops:
             while self.t < tb:
                 spent = int(self._stats[0]) - nfev0

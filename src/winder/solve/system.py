@@ -11,6 +11,7 @@ numbers (the cross-check, and the fallback where no C compiler exists, with a wa
 
 from __future__ import annotations
 
+import ctypes
 import math
 import warnings
 from typing import Any
@@ -25,31 +26,13 @@ from winder.model.locked_modes import AT_CORE, AUTO, CORE_AUTO, WINDING, ModeKin
 from winder.model.machine import Machine
 from winder.scene import naming_of
 from winder.solve import integrators as integ
-from winder.solve._jit import njit
-from winder.solve.equilibrium import Equilibrium, static_state
+from winder.solve.cint import Kernels, link
+from winder.solve.equilibrium import Equilibrium, cached_static_state
 
 __all__ = ["MachineSystem", "NoCompilerWarning"]
 
 class NoCompilerWarning(UserWarning):
     """The generated path is unavailable (no C compiler): the numeric Pinocchio path runs."""
-
-
-@njit
-def _channels_into(fns: np.ndarray, table: np.ndarray, t: np.ndarray, Y: np.ndarray,
-                   p: np.ndarray, out: np.ndarray) -> None:
-    n = Y.shape[0]
-    y = np.empty(n)
-    m = np.empty(table.shape[0])
-    tb = np.empty(1)
-    g = integ.switch_buffer(table)
-    col = np.empty(out.shape[0])
-    for i in range(t.shape[0]):
-        for j in range(n):
-            y[j] = Y[j, i]
-        integ.modes_of(fns, table, tb, t[i], y, p, m, g, True)
-        integ.evaluate(fns, integ.F_OUT, tb, t[i], y, p, m, col)
-        for j in range(out.shape[0]):
-            out[j, i] = col[j]
 
 
 class MachineSystem:
@@ -71,7 +54,7 @@ class MachineSystem:
         self.generated: Generated | None = None
         if backend == "compiled":
             try:
-                self.generated = generate(m)
+                self.generated = generate(m, link=link())
             except CompilerMissing as exc:
                 warnings.warn(f"{exc}: the generated code cannot be built; running the "
                               "numeric Pinocchio path (much slower)", NoCompilerWarning,
@@ -79,6 +62,11 @@ class MachineSystem:
                 self.backend = "pinocchio"
         self._numeric = NumericBackend(m.model) if self.generated is None else None
         self.fns = self.generated.addresses if self.generated is not None else None
+        #: the C integrators of the machine's library (None on the numeric path)
+        self.kernels = Kernels(self.generated) if self.generated is not None else None
+        self._flat = {} if self.generated is None else {
+            which: ctypes.CFUNCTYPE(ctypes.c_int, *[ctypes.c_void_p] * 5)(int(address))
+            for which, address in enumerate(self.generated.addresses)}
         rows = [mode.table_row(m) for mode in m.modes]
         self.table = np.array(rows, dtype=np.int64).reshape(len(rows), 5)
         self.modes = np.array([mode.kind.automatic for mode in m.modes], dtype=float)
@@ -88,6 +76,8 @@ class MachineSystem:
         self.breakpoints = sorted({t for b in m.bodies for t in b.breakpoints()})
         self.nfev = 0
         self._tb = np.empty(1)
+        self._bufs: dict[int, tuple[np.ndarray, int]] = {}
+        self._held: tuple[np.ndarray, np.ndarray] | None = None
         self._eq: Equilibrium | None = None
         #: ``(t, state, message)`` where an unwinding roll ran out of web, else None
         self.end: tuple[float, np.ndarray, str] | None = None
@@ -99,9 +89,10 @@ class MachineSystem:
 
     @property
     def equilibrium(self) -> Equilibrium:
-        """The static balance of the initial state (machines.md §7)."""
+        """The static balance of the initial state (machines.md §7; kept on disk for the
+        same scene and parameters: :func:`~winder.solve.equilibrium.cached_static_state`)."""
         if self._eq is None:
-            self._eq = static_state(self.machine, self.params)
+            self._eq = cached_static_state(self.machine, self.params)
         return self._eq
 
     def initial_state(self) -> np.ndarray:
@@ -159,12 +150,24 @@ class MachineSystem:
                                      self.modes if modes is None else modes, outputs=outputs)
 
     def _call(self, which: int, t: float, y: np.ndarray, size: int) -> np.ndarray:
-        """One generated function at ``(t, y)`` through the compiled caller (about 1 µs
-        from Python)."""
-        out = np.empty(size)
-        integ.evaluate(self.fns, which, self._tb, float(t),
-                       np.ascontiguousarray(y, dtype=np.float64), self.params, self.modes, out)
-        return out
+        """One generated function at ``(t, y)``, called through ctypes with the addresses
+        of persistent buffers (about 3 µs from Python: ``ndarray.ctypes`` costs more than
+        the call, so ``y`` is copied into a buffer whose address is kept)."""
+        held = self._held
+        if held is None or held[0] is not self.params or held[1] is not self.modes:
+            self._bufs.clear()  # first call, or params/modes replaced: new addresses
+            self._held = (self.params, self.modes)
+            self._ybuf = np.empty(self.n_states)
+            self._addrs = [a.ctypes.data for a in (self._tb, self._ybuf, self.params,
+                                                    self.modes)]
+        buf = self._bufs.get(which)
+        if buf is None:
+            out = np.empty(size)
+            buf = self._bufs[which] = (out, out.ctypes.data)
+        self._tb[0] = t
+        self._ybuf[:] = y
+        self._flat[which](*self._addrs, buf[1])
+        return buf[0].copy()
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """``dy/dt`` (clamped nip laws; core modes as locked)."""
@@ -274,9 +277,8 @@ class MachineSystem:
         t = np.ascontiguousarray(t, dtype=float)
         Y = np.ascontiguousarray(Y, dtype=float)
         names = self.machine.channel_names
-        if self.generated is not None:
-            out = np.empty((len(names), len(t)))
-            _channels_into(self.fns, self.table, t, Y, self.params, out)
+        if self.kernels is not None:
+            out = self.kernels.channels(self.fns, self.table, t, Y, self.params)
         else:
             out = np.empty((len(names), len(t)))
             modes = self.modes.copy()

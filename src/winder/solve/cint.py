@@ -1,0 +1,237 @@
+"""The integrators in C, linked into every machine's library (issue #23).
+
+``solve/c/`` holds them: ``events.h`` (the shared mode table, event location and guard),
+``dopri5.c``, ``rk4.c``, ``ros2.c`` and ``machine.c`` (the modes and channels of a
+trajectory). :func:`link` compiles them once into objects (cached under
+:func:`~winder.model.codegen.cache_dir`, keyed by every source and header and the flags:
+the generated code's plus ``-ffp-contract=off -std=c99``, so no fused multiply–add
+changes a rounding), and :func:`winder.model.codegen.generate` links them with each
+machine's generated object into one shared library. :class:`Kernels` calls that library
+through ctypes, in chunks (the callers check their budgets, signals and progress between
+calls). ``docs/c-integrators.md`` gives the kernels' contract.
+
+Adding an integrator:
+
+1. write it in ``solve/c/NAME.c`` with the contract of ``winder_dopri5`` (``events.h``
+   holds the modes, events and guard);
+2. add the file to :data:`SOURCES` and its prototype to :meth:`Kernels.__init__`;
+3. call it from :mod:`winder.solve.simulate` and test it against a closed form.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from winder.model.codegen import Generated, Link, cache_dir, compile_flags, run_compiler
+
+__all__ = ["Kernels", "link", "SOURCES", "EXTRA_CFLAGS"]
+
+_DIR = Path(__file__).resolve().parent / "c"
+#: The translation units (each includes ``events.h``).
+SOURCES = ("dopri5.c", "rk4.c", "ros2.c", "machine.c")
+#: Flags beyond the generated code's: no contraction into FMA.
+EXTRA_CFLAGS = ("-ffp-contract=off", "-std=c99")
+
+_dp = ctypes.POINTER(ctypes.c_double)
+_ip = ctypes.POINTER(ctypes.c_int64)
+_i64, _f64 = ctypes.c_int64, ctypes.c_double
+_LINKS: dict[tuple[str, ...], Link] = {}
+
+
+def link() -> Link:
+    """The integrators' objects (compiled once, cached) for
+    :func:`~winder.model.codegen.generate`."""
+    flags = (*compile_flags(), *EXTRA_CFLAGS)
+    if flags in _LINKS:
+        return _LINKS[flags]
+    h = hashlib.sha256(" ".join(flags).encode())
+    for f in sorted(_DIR.glob("*.[ch]")):  # every source and header: the key
+        h.update(f.name.encode() + b"\0" + f.read_bytes())
+    key = h.hexdigest()[:16]
+    root = cache_dir() / "integrators" / key
+    objects = tuple(root / f"{Path(s).stem}.o" for s in SOURCES)
+    if not all(o.exists() for o in objects):
+        root.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=root.parent, prefix=".build-") as tmp:
+            for src, obj in zip(SOURCES, objects, strict=True):
+                run_compiler([*flags, "-c", str(_DIR / src), "-o", str(Path(tmp) / obj.name)],
+                             f"the C integrators ({src})")
+            root.mkdir(exist_ok=True)
+            for obj in objects:
+                os.replace(Path(tmp) / obj.name, obj)  # atomic per file; a race writes equal
+    _LINKS[flags] = result = Link(objects, key)
+    return result
+
+
+def _ptr(a: np.ndarray, dtype: Any, name: str, writable: bool = False) -> Any:
+    if a.dtype != dtype or not a.flags.c_contiguous or (writable and not a.flags.writeable):
+        raise TypeError(f"{name}: a C-contiguous{' writable' if writable else ''} {dtype} "
+                        f"array is needed, got {a.dtype} {a.shape}")
+    return a.ctypes.data_as(_ip if dtype == np.int64 else _dp)
+
+
+class Kernels:
+    """The integrators of one machine's library (``MachineSystem.kernels``).
+
+    Each kernel takes the arrays of the contract (``docs/c-integrators.md``): ``fns``
+    (the generated functions' addresses), the mode ``table``, the state ``y`` and modes
+    ``m`` (updated in place), the parameters ``p``, the output times ``t_out`` and
+    samples ``Y_out`` (n, n_out), and ``stats`` (int64 counters), and returns
+    ``(status, t, h, k)``.
+    """
+
+    def __init__(self, generated: Generated) -> None:
+        lib = generated._lib
+        if not hasattr(lib, "winder_dopri5"):
+            raise TypeError("generated: a machine library linked with the integrators "
+                            "(generate(machine, link=cint.link())) is needed")
+        self.n_switches = generated.n_switches
+        self.n_channels = generated.n_channels
+        adaptive = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
+                    _f64, _dp, _i64, _dp, _i64, _i64, _ip]
+        self._dopri5 = self._fn(lib.winder_dopri5, [*adaptive, _i64, _dp, _dp, _ip])
+        self._ros2 = self._fn(lib.winder_ros2, [*adaptive, _dp, _dp, _ip])
+        self._rk4 = self._fn(lib.winder_rk4, [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp,
+                                              _dp, _f64, _dp, _i64, _dp, _i64, _ip, _dp, _dp,
+                                              _ip])
+        self._modes = self._fn(lib.winder_modes, [_ip, _ip, _i64, _i64, _f64, _dp, _i64, _dp,
+                                                  _dp, _i64])
+        self._channels = self._fn(lib.winder_channels, [_ip, _ip, _i64, _i64, _dp, _i64, _dp,
+                                                        _i64, _dp, _dp, _dp, _i64])
+        self._repeat = lib.winder_repeat
+        self._repeat.restype = ctypes.c_double
+        self._repeat.argtypes = [_ip, _i64, _i64, _f64, _dp, _dp, _dp, _dp]
+        self._lib = lib  # keep the library loaded
+
+    @staticmethod
+    def _fn(fn: Any, argtypes: list[Any]) -> Any:
+        fn.restype = ctypes.c_int
+        fn.argtypes = argtypes
+        return fn
+
+    def dopri5(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float,
+               y: np.ndarray, p: np.ndarray, m: np.ndarray, rtol: float, atol: float,
+               h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
+               budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
+        """DOPRI5 from ``t0`` towards ``t1`` [s] until done, an event that ends the run,
+        or ``budget`` evaluations (``PAUSED``); ``h <= 0``: it picks the first step."""
+        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        tr, hr, kr = _f64(), _f64(), _i64()
+        status = self._dopri5(
+            _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+            self.n_switches, float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+            _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol),
+            float(atol), float(h), float(max_step), _ptr(t_out, np.float64, "t_out"),
+            t_out.shape[0], _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
+            _ptr(stats, np.int64, "stats", True), stats.shape[0], ctypes.byref(tr),
+            ctypes.byref(hr), ctypes.byref(kr))
+        return _result(status, tr, hr, kr)
+
+    def ros2(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
+             p: np.ndarray, m: np.ndarray, rtol: float, atol: float, h: float,
+             max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
+             stats: np.ndarray) -> tuple[int, float, float, int]:
+        """The Rosenbrock ROS2 on the exact Jacobian, as :meth:`dopri5` (``stats`` needs
+        5 counters: ``stats[4]`` counts Jacobians)."""
+        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        if stats.shape[0] < 5:
+            raise ValueError("stats must hold 5 counters")
+        tr, hr, kr = _f64(), _f64(), _i64()
+        status = self._ros2(
+            _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+            self.n_switches, float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+            _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol),
+            float(atol), float(h), float(max_step), _ptr(t_out, np.float64, "t_out"),
+            t_out.shape[0], _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
+            _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
+            ctypes.byref(kr))
+        return _result(status, tr, hr, kr)
+
+    def rk4(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,
+            p: np.ndarray, m: np.ndarray, h: float, t_out: np.ndarray, Y_out: np.ndarray,
+            k: int, stats: np.ndarray) -> tuple[int, float, float, int]:
+        """Fixed-step RK4 with steps of at most ``h`` [s] evenly dividing
+        ``[t0, t1]``."""
+        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        tr, hr, kr = _f64(), _f64(), _i64()
+        status = self._rk4(
+            _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+            self.n_switches, float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+            _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(h),
+            _ptr(t_out, np.float64, "t_out"), t_out.shape[0],
+            _ptr(Y_out, np.float64, "Y_out", True), int(k),
+            _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
+            ctypes.byref(kr))
+        return _result(status, tr, hr, kr)
+
+    def modes(self, fns: np.ndarray, table: np.ndarray, t: float, y: np.ndarray,
+              p: np.ndarray, m: np.ndarray, *, contact_auto: bool) -> None:
+        """The modes a step starting at ``(t, y)`` runs in, into ``m``:
+        a nip touching where its switching function is > 0 (``AUTO`` where
+        ``contact_auto``), a roll at its core where ``r <= r_c`` and it does not turn
+        forwards."""
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        status = self._modes(_ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"),
+                             table.shape[0], self.n_switches, float(t),
+                             _ptr(y, np.float64, "y"), y.shape[0],
+                             _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True),
+                             int(bool(contact_auto)))
+        _result(status, _f64(), _f64(), _i64())
+
+    def repeat(self, fns: np.ndarray, which: int, count: int, t: float, y: np.ndarray,
+               p: np.ndarray, m: np.ndarray, out: np.ndarray) -> float:
+        """``count`` evaluations of the generated function ``fns[which]`` (``F_RHS``, ...)
+        at one point, from C as the integrators call it (the benchmarks' cost per
+        evaluation); ``out`` holds the last result. Returns the sum of ``out[0]``."""
+        if not 0 <= which < 4:
+            raise ValueError(f"which must be 0–3 (rhs, jac, out, sw), got {which}")
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        return float(self._repeat(_ptr(fns, np.int64, "fns"), int(which), int(count),
+                                  float(t), _ptr(y, np.float64, "y"),
+                                  _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m"),
+                                  _ptr(out, np.float64, "out", True)))
+
+    def channels(self, fns: np.ndarray, table: np.ndarray, t: np.ndarray, Y: np.ndarray,
+                 p: np.ndarray) -> np.ndarray:
+        """The channels (n_channels, len(t)) of the samples ``Y`` (n, len(t)), each in
+        the modes of its state with the nips' clamped law."""
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        Y = np.ascontiguousarray(Y, dtype=np.float64)
+        if Y.ndim != 2 or Y.shape[1] != t.shape[0]:
+            raise ValueError(f"Y must be (n, {t.shape[0]}), got {Y.shape}")
+        out = np.empty((self.n_channels, t.shape[0]))
+        m = np.empty(table.shape[0])
+        status = self._channels(_ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"),
+                                table.shape[0], self.n_switches, _ptr(t, np.float64, "t"),
+                                t.shape[0], _ptr(Y, np.float64, "Y"), Y.shape[0],
+                                _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True),
+                                _ptr(out, np.float64, "out", True), self.n_channels)
+        _result(status, _f64(), _f64(), _i64())
+        return out
+
+
+def _check(fns: np.ndarray, table: np.ndarray, y: np.ndarray, m: np.ndarray,
+           t_out: np.ndarray, Y_out: np.ndarray, stats: np.ndarray) -> int:
+    n = y.shape[0]
+    if stats.shape[0] < 4:
+        raise ValueError("stats must hold at least 4 counters")
+    if Y_out.ndim != 2 or Y_out.shape[0] != n or Y_out.shape[1] != t_out.shape[0]:
+        raise ValueError(f"Y_out must be ({n}, {t_out.shape[0]}), got {Y_out.shape}")
+    if table.ndim != 2 or table.shape[1] != 5 or m.shape[0] != table.shape[0]:
+        raise ValueError("table must be (slots, 5) with one mode per slot")
+    if fns.shape[0] < 4:
+        raise ValueError("fns must hold the 4 generated functions' addresses")
+    return n
+
+
+def _result(status: int, tr: Any, hr: Any, kr: Any) -> tuple[int, float, float, int]:
+    if status == 6:
+        raise MemoryError("the C integrator could not allocate its work buffers")
+    return int(status), tr.value, hr.value, int(kr.value)
