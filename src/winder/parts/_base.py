@@ -230,6 +230,18 @@ class BodyElement(ABC):
         return cls.part_cls(**reader.keys(label, raw, cls.KEYS))
 
     @classmethod
+    def elements(cls, part: Any, placed: Mapping[str, BodyElement]) -> list[BodyElement]:
+        """The body elements of its part ``part`` (``placed``: those built before, by
+        name): default one, ``cls(part, placed)``; a flexible body its segments."""
+        return [cls(part, placed)]
+
+    @classmethod
+    def nip_refusal(cls, part: Any) -> str | None:
+        """Why no nip may touch ``part`` (the scene's error names the nip's key and this
+        text), or None (default: nips welcome)."""
+        return None
+
+    @classmethod
     def fixed_centre(cls, part: Any) -> bool:
         """Whether its centre is fixed (a nip needs one body free to move): default,
         where the part has no ``free`` axes."""

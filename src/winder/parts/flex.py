@@ -1,0 +1,79 @@
+"""A flexible body's ``flex`` sub-table (issue #25): the body becomes ``segments`` lumped
+segments along its axis, joined by a beam's bending stiffness (Timoshenko or
+Euler–Bernoulli, condensed onto the segment centres: :mod:`winder.model.beam`) and a
+torsion spring between neighbours, held at its two ends by bearings.
+
+``flex = { segments = N, EI = ..., kGA = ..., GJ = ... }`` on a ``[[drum]]`` (which then
+needs its ``length``); without it the body is rigid, exactly as before."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from winder._schema import Key, Table
+
+__all__ = ["FlexPart", "FLEX_KEYS", "parse_flex", "MAX_SEGMENTS"]
+
+#: The most segments a flexible body may have.
+MAX_SEGMENTS = 64
+
+#: The keys of a body's ``flex`` sub-table: one declaration each.
+FLEX_KEYS = Table((
+    Key(name="segments", required=True, unit="-", lo=2.0, hi=float(MAX_SEGMENTS),
+        valid=f"an integer, 2–{MAX_SEGMENTS}",
+        doc="number N of segments along the axis, each of length L/N, mass m/N and polar "
+            "inertia J/N; its channels are named NAME_s{i} (i = 0 at the drive end)"),
+    Key(name="EI", required=True, unit="N·m²", lo=0.0, lo_open=True, hi=1e13,
+        doc="bending stiffness E·I of the beam"),
+    Key(name="shear", kind="bool",
+        doc="true: Timoshenko beam (shear stiffness kGA); false: Euler–Bernoulli"),
+    Key(name="kGA", unit="N", lo=0.0, lo_open=True, hi=1e13,
+        default_text="required when shear = true",
+        doc="shear stiffness k·G·A of the beam (Timoshenko)"),
+    Key(name="GJ", required=True, unit="N·m²", lo=0.0, lo_open=True, hi=1e13,
+        doc="torsional stiffness G·J; neighbouring segments are joined by GJ/(L/N)"),
+    Key(name="bearing_stiffness", unit="N/m", lo=0.0, hi=1e15,
+        doc="stiffness of each of the two end bearings, per direction (x and z); a very "
+            "large value: simply supported; 0: free–free"),
+    Key(name="bearing_damping", unit="N·s/m", lo=0.0, hi=1e12,
+        doc="damping of each end bearing, per direction"),
+    Key(name="damping_ratio", unit="-", lo=0.0, hi=1.0,
+        doc="damping ratio ζ of the first bending mode (Rayleigh, stiffness-proportional "
+            "β = 2ζ/ω₁; torsion takes the same β)"),
+))
+
+
+@dataclass(frozen=True)
+class FlexPart:
+    """``flex = { ... }``: a body made of ``segments`` lumped segments; keys, units, bounds
+    and meanings: :data:`FLEX_KEYS`."""
+
+    segments: int
+    EI: float
+    GJ: float
+    shear: bool = True
+    kGA: float | None = None
+    bearing_stiffness: float = 1e9
+    bearing_damping: float = 0.0
+    damping_ratio: float = 0.01
+
+
+def parse_flex(reader: Any, label: str, raw: Any, length: float | None) -> FlexPart:
+    """The ``flex`` sub-table ``raw`` of ``[label]`` (``drum 'front'``): its keys, an
+    integer ``segments``, ``kGA`` where ``shear`` is on, and the body's ``length`` [m]
+    given."""
+    flabel = f"{label}.flex"
+    kw = reader.keys(flabel, raw, FLEX_KEYS)
+    n = kw["segments"]
+    if float(n) != int(n):
+        raise reader.fail(flabel, "segments", f"{n!r} is not an integer; valid: an integer, "
+                                              f"2–{MAX_SEGMENTS}")
+    kw["segments"] = int(n)
+    if kw.get("shear", True) and "kGA" not in kw:
+        raise reader.fail(flabel, "kGA", "missing required key (shear = true: a Timoshenko "
+                                         "beam); valid: kGA [N] > 0, or shear = false")
+    if length is None:
+        raise reader.fail(label, "length", "missing required key (a flexible body, flex = "
+                                           "{ ... }, needs its length along the axis [m])")
+    return FlexPart(**kw)
