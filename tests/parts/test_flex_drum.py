@@ -167,35 +167,6 @@ def test_bad_flex_values_name_the_file_and_key(change: Any, where: str, what: st
     assert where.split("] ")[1] in text and what in text, text
 
 
-def test_a_nip_on_a_flexible_drum_is_refused_naming_the_key() -> None:
-    extra = """
-[[roll]]
-name = "set"
-centre = [0.0, 0.6]
-core_radius = 0.05
-core_mass = 40.0
-core_inertia = 0.1
-width = 5.0
-density = 650.0
-caliper = 7e-5
-
-[[nip]]
-name = "n1"
-a = "front"
-b = "set"
-contact = { law = "linear", stiffness = 2.5e7, damping = 1.5e4 }
-friction = { mu = 0.35, slip_velocity = 0.05, relaxation_length = 0.01, min_speed = 0.1 }
-
-[web]
-entry_nip = "n1"
-"""
-    with pytest.raises(SceneError) as err:
-        winder.scene_from_dict(tomllib.loads(scene_text(4, extra=extra)), source="flex.toml")
-    text = str(err.value)
-    assert "flex.toml" in text and "nip 'n1'" in text and "] a: 'front'" in text, text
-    assert "flexible drum" in text
-
-
 # ---- oracles -------------------------------------------------------------------------------
 @pytest.mark.parametrize("shear", [False, True])
 @pytest.mark.parametrize("n", [4, 10])

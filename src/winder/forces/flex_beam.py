@@ -15,6 +15,13 @@ with the run-time parameters ``NAME.flex.K_i_j`` [N/m], ``NAME.flex.C_i_j`` [N·
 torsion torques go in as spatial forces (they are not part of a segment's ``NAME_s{i}_torque``
 channel, which keeps machines.md §9's meaning). Channel ``NAME_twist`` [rad]: the drive
 end's angle minus the far end's, operation sense.
+
+A scene nip ``NIP`` against a flexible body is sliced (:mod:`winder.model.slices`): its
+slices ``NIP_s{i}`` have the generic nip channels; this element writes the scene nip's own:
+``NIP_normal_force`` and ``NIP_friction_force`` the sums over its slices,
+``NIP_slip_velocity`` their mean, ``NIP_penetration`` their largest, and the line load
+``F_i / (L/N)`` [N/m] of its slices, ``NIP_line_load_min``, ``_max`` and ``_mean``. It runs
+after the contact and the slip relaxation (``uses`` their ``steady_friction``).
 """
 
 from __future__ import annotations
@@ -23,16 +30,27 @@ from typing import TYPE_CHECKING, Any
 
 from winder._schema import Channel
 from winder.forces._base import ForceElement
+from winder.model.channels import NIP_CHANNELS
 
 if TYPE_CHECKING:
     from winder.model.machine import Evaluation, Machine
 
-__all__ = ["FlexBeam", "TWIST"]
+__all__ = ["FlexBeam", "TWIST", "LINE_LOAD"]
 
 #: A flexible body's twist.
 TWIST = Channel(name="BODY_twist", unit="rad",
                 doc="flexible drum: twist, angle of segment 0 (drive end) minus that of the "
                     "last segment, operation sense")
+
+#: A sliced nip's line load along its width: least, largest and mean over its slices.
+LINE_LOAD = (
+    Channel(name="NIP_line_load_min", unit="N/m",
+            doc="nip against a flexible body: least line load of its slices, F_i/(L/N)"),
+    Channel(name="NIP_line_load_max", unit="N/m",
+            doc="nip against a flexible body: largest line load of its slices"),
+    Channel(name="NIP_line_load_mean", unit="N/m",
+            doc="nip against a flexible body: mean line load of its slices"),
+)
 
 
 class FlexBeam(ForceElement):
@@ -42,11 +60,14 @@ class FlexBeam(ForceElement):
     name = "flex_beam"
     doc = "bending and torsion between the segments of a flexible body"
     provides = frozenset({"spatial_force"})
-    CHANNELS = (TWIST,)
+    uses = frozenset({"steady_friction"})
+    CHANNELS = (TWIST, *LINE_LOAD)
 
     def __init__(self) -> None:
         #: the segment bodies of each flexible body, by its name, drive end first
         self.groups: dict[str, list[Any]] = {}
+        #: the slices of each sliced scene nip, by its name
+        self.sliced: dict[str, list[Any]] = {}
 
     def declare(self, machine: Machine) -> None:
         from winder.model.beam import beam_matrices  # NumPy: not for checking a scene
@@ -71,9 +92,39 @@ class FlexBeam(ForceElement):
             machine.parameter(f"{body}.flex.k_t", bm.k_t)
             machine.parameter(f"{body}.flex.c_t", bm.c_t)
             machine.channel(TWIST, body)
+        self.sliced = {}
+        for nip in machine.nips:
+            if nip.whole is not None:
+                self.sliced.setdefault(nip.whole, []).append(nip)
+        for whole in self.sliced:
+            for ch in (*NIP_CHANNELS, *LINE_LOAD):
+                machine.channel(ch, whole)
 
     def structure_tag(self, machine: Machine) -> str:
         return ",".join(f"{body}:{len(segs)}" for body, segs in self.groups.items())
+
+    def _nip_channels(self, ev: Evaluation) -> None:
+        """The sliced scene nips' own channels (see the module text)."""
+        mathns = ev.mathns
+        normal, friction, slip, penetration = NIP_CHANNELS
+        for whole, slices in self.sliced.items():
+            states = [ev.nips[s.name] for s in slices]
+            n, h = len(states), slices[0].slice_length
+            fn = [ns.normal_force for ns in states]
+            total, least, most, deepest = fn[0], fn[0], fn[0], states[0].delta
+            ft, vs = states[0].friction_force, states[0].v_s
+            for ns, f in zip(states[1:], fn[1:], strict=True):
+                total, ft, vs = total + f, ft + ns.friction_force, vs + ns.v_s
+                least, most = mathns.fmin(least, f), mathns.fmax(most, f)
+                deepest = mathns.fmax(deepest, ns.delta)
+            ev.output(normal, whole, total)
+            ev.output(friction, whole, ft)
+            ev.output(slip, whole, vs / n)
+            ev.output(penetration, whole, deepest)
+            lo, hi, mean = LINE_LOAD
+            ev.output(lo, whole, least / h)
+            ev.output(hi, whole, most / h)
+            ev.output(mean, whole, total / (n * h))
 
     def apply(self, ev: Evaluation) -> None:
         for body, segs in self.groups.items():
@@ -101,3 +152,4 @@ class FlexBeam(ForceElement):
                 ev.add_spatial_force(segs[i].name, [0.0, 0.0, 0.0, 0.0, tq, 0.0])
                 ev.add_spatial_force(segs[i + 1].name, [0.0, 0.0, 0.0, 0.0, -tq, 0.0])
             ev.output(TWIST, body, segs[0].sense * (states[0].theta - states[-1].theta))
+        self._nip_channels(ev)

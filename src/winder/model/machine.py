@@ -39,6 +39,7 @@ from winder._schema import Channel
 from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, WEB_SPEED
 from winder.model.element_order import order_elements
 from winder.model.locked_modes import FREE, ModeKind, ModeSlot
+from winder.model.slices import assemble_nips, entry_slice
 
 __all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState"]
 
@@ -47,13 +48,18 @@ _COORDS = ("x", "z")
 
 @dataclass
 class Nip:
-    """A nip between bodies ``a`` and ``b`` (machines.md §2)."""
+    """A nip between bodies ``a`` and ``b`` (machines.md §2); a slice of the scene's nip
+    ``whole`` (one of ``count``, ``slice_length`` [m] long) against a flexible body
+    (:mod:`winder.model.slices`)."""
 
     name: str
     a: Any
     b: Any
     part: Any
     index: int
+    whole: str | None = None
+    count: int = 1
+    slice_length: float | None = None
 
 
 @dataclass
@@ -102,8 +108,7 @@ class Machine:
             forces = own_forces if forces is None else forces
         self.bodies: list[Any] = list(bodies)
         self.body = {b.name: b for b in self.bodies}
-        self.nips = [Nip(n.name, self.body[n.a], self.body[n.b], n, i)
-                     for i, n in enumerate(scene.nips)]
+        self.nips = assemble_nips(scene.nips, self.body, self.bodies, Nip)
         self.nip = {n.name: n for n in self.nips}
         self._assemble_webs(scene)
         #: the bodies whose mass properties change in time (:attr:`BodyElement.variable_mass`)
@@ -140,7 +145,7 @@ class Machine:
             name = getattr(w, "name", None) or w.entry_nip
             span = getattr(w, "span", None)
             several, spanned = len(parts) > 1, spans > 1
-            self.webs.append(Web(name, w, self.nip[w.entry_nip], span,
+            self.webs.append(Web(name, w, entry_slice(self.nips, w.entry_nip), span,
                                  self.body[span.source] if span is not None else None,
                                  f"{name}." if several else "", f"{name}_" if several else "",
                                  f"{name}." if spanned else "", f"{name}_" if spanned else ""))

@@ -218,6 +218,8 @@ class BodyElement(ABC):
         self.winds = False
         #: its centre of mass offset [m] for the ``imbalance`` effect (None: no imbalance)
         self.com_offset: float | None = None
+        #: a segment of a flexible body: that body's name (its nips are sliced), else None
+        self.segment_of: str | None = None
         #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine
         self.joints: dict[str, int] = {}
 
@@ -234,12 +236,6 @@ class BodyElement(ABC):
         """The body elements of its part ``part`` (``placed``: those built before, by
         name): default one, ``cls(part, placed)``; a flexible body its segments."""
         return [cls(part, placed)]
-
-    @classmethod
-    def nip_refusal(cls, part: Any) -> str | None:
-        """Why no nip may touch ``part`` (the scene's error names the nip's key and this
-        text), or None (default: nips welcome)."""
-        return None
 
     @classmethod
     def fixed_centre(cls, part: Any) -> bool:

@@ -41,7 +41,8 @@ KEYS = Table((
         doc="length L of the drum along its axis"),
     Key(name="flex", kind="table",
         default_text="none: a rigid drum",
-        doc="a flexible drum, a sub-table: keys below (issue #25); no nip may touch it yet"),
+        doc="a flexible drum, a sub-table: keys below (issue #25); its nips are sliced, one "
+            "slice per segment"),
 ))
 
 #: The keys of a drum's ``drive``; ``kinds``: the keys each drive kind takes.
@@ -138,15 +139,6 @@ class DrumBody(RigidDisc):
         if getattr(part, "flex", None) is None:
             return [cls(part, placed)]
         return [DrumSegment(part, i, placed) for i in range(part.flex.segments)]
-
-    @classmethod
-    def nip_refusal(cls, part: Any) -> str | None:
-        """A flexible drum refuses nips (slicing them is issue #25's next phase)."""
-        if getattr(part, "flex", None) is None:
-            return None
-        return ("is a flexible drum (flex = { segments = ... }): nips against a flexible "
-                "body are not modelled yet (issue #25, phase 2); valid: a rigid drum (no "
-                "flex) or no nip on it")
 
     @classmethod
     def fixed_centre(cls, part: Any) -> bool:
@@ -252,6 +244,7 @@ class DrumSegment(DrumBody):
         #: the flexible body's data for the force element ``flex_beam``
         self.flex, self.length = flex, float(part.length)
         self.name = f"{part.name}_s{index}"
+        self.segment_of = part.name
         self.free = ("x", "z")
         self.prescribed = index == 0 and part.drive.kind == "speed_profile"
         self.torque_inputs = (f"{self.name}.torque",) \

@@ -73,10 +73,6 @@ def check_references(source: str, bodies: Bodies, nips: list[NipPart],
                 raise fail(source, label, key,
                            f"{show(ref)} {what}; a nip joins two bodies; valid names: "
                            f"{', '.join(body_names)}")
-            refusal = next((cls.nip_refusal(p) for cls, parts in types for p in parts
-                            if p.name == ref), None)
-            if refusal is not None:
-                raise fail(source, label, key, f"{show(ref)} {refusal}")
         if nip.a == nip.b:
             raise fail(source, label, "b",
                         f"{nip.b!r} is also a: a nip joins two different bodies; valid "
