@@ -151,3 +151,131 @@ def test_a_flexible_winder_runs_and_keeps_its_total() -> None:
     assert np.max(np.abs(res["nip_normal_force"] - total)) < 1e-9 * np.max(total)
     assert np.all(res["nip_line_load_min"] <= res["nip_line_load_max"])
     assert res["roll_speed"][-1] > 0.0
+
+
+def _stiffened(text: str, factor: float) -> str:
+    for key, value in (("EI", EI), ("kGA", KGA), ("GJ", GJ), ("bearing_stiffness", KB)):
+        text = text.replace(f"{key} = {value}", f"{key} = {value * factor}")
+    return text
+
+
+def test_stiff_limit_reproduces_the_rigid_machine() -> None:
+    """EI, kGA, GJ and the bearings × 1e6: the run (0.2 s of the start, rtol 1e-9) is the
+    rigid drum's within 1e-6 (relative to each channel's largest value) on the roll's
+    radius, speed and height, the drive segment's speed and the nip's total force
+    (measured ≤ 2e-9), and within 1e-5 on the far segment's speed (its torsion still rings
+    after the start: measured 1.2e-6)."""
+    text = scene_text(3)
+    rigid_text = text.split("length = ")[0] + "drive = " + text.split("drive = ")[1]
+    rigid_text = rigid_text.split("flex = ")[0] + "[[roll]]" + rigid_text.split("[[roll]]")[1]
+    rigid = winder.simulate(winder.scene_from_dict(tomllib.loads(rigid_text), source="r.toml"),
+                            t_end=0.2, rtol=1e-9)
+    flex = winder.simulate(winder.scene_from_dict(tomllib.loads(_stiffened(text, 1e6)),
+                                                  source="f.toml"), t_end=0.2, rtol=1e-9)
+
+    def err(a: str, b: str) -> float:
+        return float(np.max(np.abs(rigid[a] - flex[b])) / np.max(np.abs(rigid[a])))
+
+    for a, b in (("roll_radius", "roll_radius"), ("roll_speed", "roll_speed"),
+                 ("roll_z", "roll_z"), ("drum_speed", "drum_s0_speed"),
+                 ("nip_normal_force", "nip_normal_force")):
+        assert err(a, b) < 1e-6, (a, err(a, b))
+    assert err("drum_speed", "drum_s2_speed") < 1e-5
+
+
+VALLEY = """
+[scene]
+name = "valley"
+duration = 0.1
+output_step = 0.01
+
+[effects]
+imbalance = false
+
+[paper]
+density = 650.0
+caliper = 70e-6
+
+[[drum]]
+name = "front"
+radius = 0.5
+inertia = 600.0
+mass = 3000.0
+centre = [-0.525, 0.0]
+length = 5.0
+drive = { kind = "speed_profile", web_acceleration = 0.7, web_speed = 41.7 }
+flex = { segments = 5, EI = 1.4e9, kGA = 2.3e9, GJ = 1.1e9, bearing_stiffness = 1e10 }
+
+[[drum]]
+name = "rear"
+radius = 0.5
+inertia = 600.0
+mass = 3000.0
+centre = [0.525, 0.0]
+length = 5.0
+drive = { kind = "speed_profile", web_acceleration = 0.7, web_speed = 41.7 }
+flex = { segments = 5, EI = 1.4e9, kGA = 2.3e9, GJ = 1.1e9, bearing_stiffness = 1e10 }
+
+[[roll]]
+name = "set"
+centre = [0.0, 0.4]
+free = ["x", "z"]
+core_radius = 0.05
+core_mass = 40.0
+core_inertia = 0.1
+width = 5.0
+initial_radius = 0.3
+
+[[nip]]
+name = "front_nip"
+a = "front"
+b = "set"
+contact = { law = "linear", stiffness = 2.5e7, damping = 1.5e4 }
+friction = { mu = 0.35, slip_velocity = 0.05, relaxation_length = 0.01, min_speed = 0.1 }
+
+[[nip]]
+name = "rear_nip"
+a = "rear"
+b = "set"
+contact = { law = "linear", stiffness = 2.5e7, damping = 1.5e4 }
+friction = { mu = 0.35, slip_velocity = 0.05, relaxation_length = 0.01, min_speed = 0.1 }
+
+[web]
+entry_nip = "rear_nip"
+"""
+
+
+def test_symmetric_two_drum_valley_at_rest() -> None:
+    """A set in the valley of two equal flexible drums, at rest: the static balance solves
+    every segment and the set; each nip's slices are symmetric about mid-width, the two
+    nips mirror each other, and the slices' forces carry the set's weight (1e-9)."""
+    sc = winder.scene_from_dict(tomllib.loads(VALLEY), source="valley.toml")
+    sys = MachineSystem(sc, backend="pinocchio")
+    y = sys.initial_state()
+    ev = sys.evaluate_numeric(0.0, y)
+    front = np.array([ev.channels[f"front_nip_s{i}_normal_force"] for i in range(5)])
+    rear = np.array([ev.channels[f"rear_nip_s{i}_normal_force"] for i in range(5)])
+    assert np.max(np.abs(front - front[::-1])) < 1e-9 * front.max()
+    assert np.max(np.abs(front - rear)) < 1e-9 * front.max()
+    assert abs(y[sys.index("set.x")]) < 1e-12
+    lift = sum(float(ns.normal_force * ns.nz) for ns in ev.nips.values())
+    mass = 40.0 + 650.0 * np.pi * 5.0 * (0.3 ** 2 - 0.05 ** 2)
+    assert lift == pytest.approx(mass * 9.81, rel=1e-9)
+    assert front[2] < front[0]  # the drums sag most at mid-width
+
+
+def test_generated_code_matches_the_numeric_path() -> None:
+    """The generated right-hand side and Pinocchio's numeric one agree at a state away
+    from rest (deflected, twisted, moving segments; the roll turning and winding)."""
+    sc = scene(3)
+    gen, num = MachineSystem(sc), MachineSystem(sc, backend="pinocchio")
+    assert gen.generated is not None
+    y = gen.initial_state()
+    rng = np.random.default_rng(25)
+    for name in gen.state_names:
+        i = gen.index(name)
+        if name.startswith("drum_s"):
+            y[i] += (1e-5 if name.endswith((".x", ".z")) else 1e-2) * rng.standard_normal()
+    y[gen.index("roll.theta_dot")] = 20.0
+    a, b = gen.rhs(0.5, y), num.rhs(0.5, y)
+    assert np.max(np.abs(a - b) / (np.abs(b) + 1e-6)) < 1e-9
