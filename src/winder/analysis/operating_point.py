@@ -120,9 +120,11 @@ def _check_scene(scene: Scene, where: str) -> None:
 
 
 def _entry_drive(scene: Scene) -> BodyElement:
-    """The body element the web wraps before its entry nip (side ``a``: the drum)."""
+    """The body element the web wraps before its entry nip (side ``a``: the drum; a
+    flexible drum's drive segment)."""
     nip = next(n for n in scene.nips if n.name == scene.web.entry_nip)
-    return next(b for b in body_elements(scene) if b.name == nip.a)
+    return next(b for b in body_elements(scene) if b.name == nip.a or
+                (b.segment_of == nip.a and b.drive_web_speed() is not None))
 
 
 def _web_speed(where: str, scene: Scene, web_speed: float | None, lo_open: bool) -> float:
