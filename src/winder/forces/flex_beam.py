@@ -7,11 +7,14 @@ machine without flexible bodies never builds it. Per flexible body ``NAME`` with
 ``NAME_s0 … NAME_s{N−1}`` (deflections ``u_i = c_i − c`` from its ``centre`` [m], rates
 ``u̇_i`` [m/s]; angles ``θ_i`` [rad] and rates ``θ̇_i`` [rad/s] about ``+y``):
 
-    f_x,i = −Σ_j K_ij u_x,j − Σ_j C_ij u̇_x,j     (and the same in z)        [N]
+    f_x,i = −Σ_j Kx_ij u_x,j − Σ_j Cx_ij u̇_x,j     (and in z with Kz, Cz)     [N]
     τ_i   = k_t (θ_{i+1} − θ_i) + c_t (θ̇_{i+1} − θ̇_i)  on i, its reaction on i + 1  [N·m]
 
-with the run-time parameters ``NAME.flex.K_i_j`` [N/m], ``NAME.flex.C_i_j`` [N·s/m]
-(``i ≤ j``, symmetric), ``NAME.flex.k_t`` [N·m/rad] and ``NAME.flex.c_t`` [N·m·s/rad]. The
+with the run-time parameters ``NAME.flex.Kx_i_j`` [N/m], ``NAME.flex.Cx_i_j`` [N·s/m]
+(``i ≤ j``, symmetric; ``Kz``, ``Cz`` likewise), ``NAME.flex.k_t`` [N·m/rad] and
+``NAME.flex.c_t`` [N·m·s/rad]. The bearings hold the axes a segment lists in
+``bearing_axes`` (a drum: ``x`` and ``z``; a rider: ``x``); along the others the beam is
+free–free (it rests on its nip). The
 torsion torques go in as spatial forces (they are not part of a segment's ``NAME_s{i}_torque``
 channel, which keeps machines.md §9's meaning). Channel ``NAME_twist`` [rad]: the drive
 end's angle minus the far end's, operation sense.
@@ -39,8 +42,8 @@ __all__ = ["FlexBeam", "TWIST", "LINE_LOAD"]
 
 #: A flexible body's twist.
 TWIST = Channel(name="BODY_twist", unit="rad",
-                doc="flexible drum: twist, angle of segment 0 (drive end) minus that of the "
-                    "last segment, operation sense")
+                doc="flexible drum or rider: twist, angle of segment 0 (drive end) minus that "
+                    "of the last segment, operation sense")
 
 #: A sliced nip's line load along its width: least, largest and mean over its slices.
 LINE_LOAD = (
@@ -75,21 +78,24 @@ class FlexBeam(ForceElement):
         self.groups = {}
         for b in machine.bodies:
             if self.name in b.drives:
-                self.groups.setdefault(b.drum, []).append(b)
+                self.groups.setdefault(b.segment_of, []).append(b)
         for body, segs in self.groups.items():
             segs.sort(key=lambda s: s.index)
             first = segs[0]
             flex, part, n = first.flex, first.part, len(segs)
-            bm = beam_matrices(n, first.length, part.mass, flex.EI,
-                               flex.kGA if flex.shear else None, flex.bearing_stiffness,
-                               flex.bearing_damping, flex.damping_ratio, flex.GJ)
-            for i in range(n):
-                for j in range(i, n):
-                    machine.parameter(f"{body}.flex.K_{i}_{j}", bm.K[i, j])
-            for i in range(n):
-                for j in range(i, n):
-                    machine.parameter(f"{body}.flex.C_{i}_{j}", bm.C[i, j])
-            machine.parameter(f"{body}.flex.k_t", bm.k_t)
+            for axis in ("x", "z"):
+                held = axis in first.bearing_axes
+                bm = beam_matrices(n, first.length, part.mass, flex.EI,
+                                   flex.kGA if flex.shear else None,
+                                   flex.bearing_stiffness if held else 0.0,
+                                   flex.bearing_damping if held else 0.0,
+                                   flex.damping_ratio, flex.GJ)
+                for kind, matrix in (("K", bm.K), ("C", bm.C)):
+                    for i in range(n):
+                        for j in range(i, n):
+                            machine.parameter(f"{body}.flex.{kind}{axis}_{i}_{j}",
+                                              matrix[i, j])
+            machine.parameter(f"{body}.flex.k_t", bm.k_t)  # the same for x and z
             machine.parameter(f"{body}.flex.c_t", bm.c_t)
             machine.channel(TWIST, body)
         self.sliced = {}
@@ -141,9 +147,8 @@ class FlexBeam(ForceElement):
                 fx: Any = 0.0
                 fz: Any = 0.0
                 for j, bs in enumerate(states):
-                    k, c = entry("K", i, j), entry("C", i, j)
-                    fx = fx - k * ux[j] - c * bs.vx
-                    fz = fz - k * uz[j] - c * bs.vz
+                    fx = fx - entry("Kx", i, j) * ux[j] - entry("Cx", i, j) * bs.vx
+                    fz = fz - entry("Kz", i, j) * uz[j] - entry("Cz", i, j) * bs.vz
                 ev.add_force(seg.name, fx, fz)
             kt, ct = ev.p(f"{body}.flex.k_t"), ev.p(f"{body}.flex.c_t")
             for i in range(n - 1):

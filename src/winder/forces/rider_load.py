@@ -50,6 +50,8 @@ class RiderLoad(ForceElement):
                    for i in range(len(b.load))]
             roll = ev.bodies[b.rides]
             f = ev.p(f"{roll.body.name}.width") * line_load(ev.mathns, roll.r, pts) if pts else 0.0
+            if b.segment_of is not None:  # a flexible rider's segment: its share
+                f = f / b.segments
             ev.add_force(n, 0.0, -f)
             ev.set_channel(f"{n}_load", f)
 

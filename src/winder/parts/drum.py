@@ -236,6 +236,9 @@ class DrumSegment(DrumBody):
     torsion between the segments are the force element ``flex_beam``, which every segment
     calls for (:attr:`drives`)."""
 
+    #: the axes its bearings hold (the beam's supports)
+    bearing_axes = ("x", "z")
+
     def __init__(self, part: Any, index: int, placed: Any = None) -> None:
         super().__init__(part, placed)
         flex = part.flex

@@ -3,8 +3,9 @@ segments along its axis, joined by a beam's bending stiffness (Timoshenko or
 Euler–Bernoulli, condensed onto the segment centres: :mod:`winder.model.beam`) and a
 torsion spring between neighbours, held at its two ends by bearings.
 
-``flex = { segments = N, EI = ..., kGA = ..., GJ = ... }`` on a ``[[drum]]`` (which then
-needs its ``length``); without it the body is rigid, exactly as before."""
+``flex = { segments = N, EI = ..., kGA = ..., GJ = ... }`` on a ``[[drum]]`` or a
+``[[rider]]`` (which then needs its ``length``); without it the body is rigid, exactly as
+before."""
 
 from __future__ import annotations
 
@@ -34,8 +35,8 @@ FLEX_KEYS = Table((
     Key(name="GJ", required=True, unit="N·m²", lo=0.0, lo_open=True, hi=1e18,
         doc="torsional stiffness G·J; neighbouring segments are joined by GJ/(L/N)"),
     Key(name="bearing_stiffness", unit="N/m", lo=0.0, hi=1e18,
-        doc="stiffness of each of the two end bearings, per direction (x and z); a very "
-            "large value: simply supported; 0: free–free"),
+        doc="stiffness of each of the two end bearings, per direction (x and z; a rider's "
+            "arms: x only); a very large value: simply supported; 0: free–free"),
     Key(name="bearing_damping", unit="N·s/m", lo=0.0, hi=1e12,
         doc="damping of each end bearing, per direction"),
     Key(name="damping_ratio", unit="-", lo=0.0, hi=1.0,

@@ -170,8 +170,9 @@ def resting_state(machine: Machine, x: np.ndarray, p: np.ndarray, movable: set[s
         for n in machine.nips:
             if n.b.name not in supports or n not in supports[n.b.name]:
                 continue
+            share = n.count if n.b.segment_of is None else 1  # slices under a rigid b
             d = rest_penetration(n.part.contact.law, _law(machine, p, n),
-                                 load[n.name] / n.count, dd.get(n.name, 0.0))
+                                 load[n.name] / share, dd.get(n.name, 0.0))
             ra, rb = radius[n.a.name], radius[n.b.name]
             if not d < min(ra, rb):
                 raise EquilibriumError(_too_soft(machine, n, load[n.name], d, min(ra, rb)))
@@ -182,10 +183,12 @@ def resting_state(machine: Machine, x: np.ndarray, p: np.ndarray, movable: set[s
 
 
 def _whole(machine: Machine, nip: Nip) -> bool:
-    """Whether ``nip`` stands for its scene nip in the resting state: an unsliced nip, or
-    the middle slice of a sliced one (which carries the whole load there, its law
-    ``1/count`` of the nip's)."""
-    return nip.whole is None or nip is entry_slice(machine.nips, nip.whole)
+    """Whether ``nip`` is a support in the resting state: an unsliced nip, a slice under
+    a segment of a flexible ``b`` (each carries its own), or the middle slice of a sliced
+    nip under a rigid ``b`` (which carries the whole load there, its law ``1/count`` of
+    the nip's)."""
+    return nip.whole is None or nip.b.segment_of is not None or \
+        nip is entry_slice(machine.nips, nip.whole)
 
 
 def _too_soft(machine: Machine, n: Nip, load: float, d: float, r: float) -> str:
