@@ -27,7 +27,7 @@ from winder.scene.schema import PAPER_KEYS, TABLES, effect_settings
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "models"
 #: The parts' own declarations, by module.
-PART_TABLES = {drum: (drum.KEYS, drum.DRIVE_KEYS), flex: (flex.FLEX_KEYS,),
+PART_TABLES = {drum: (drum.KEYS, drum.DRIVE_KEYS), flex: (flex.FLEX_KEYS, flex.ROLL_FLEX_KEYS),
                roll: (roll.KEYS, roll.DRIVE_KEYS),
                rider: (rider.KEYS,), nip: (nip.KEYS, nip.CONTACT_KEYS, nip.FRICTION_KEYS),
                web: (web.KEYS, web.SPAN_KEYS)}

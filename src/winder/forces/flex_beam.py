@@ -29,6 +29,7 @@ after the contact and the slip relaxation (``uses`` their ``steady_friction``).
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 from winder._schema import Channel
@@ -83,6 +84,19 @@ class FlexBeam(ForceElement):
             segs.sort(key=lambda s: s.index)
             first = segs[0]
             flex, part, n = first.flex, first.part, len(segs)
+            if hasattr(flex, "core_EI"):  # a paper roll: EI(r), no bearings
+                unit = beam_matrices(n, first.length, float(n), 1.0, None, 0.0, 0.0, 0.0,
+                                     flex.GJ)
+                for i in range(n):
+                    for j in range(i, n):
+                        machine.parameter(f"{body}.flex.K1_{i}_{j}", unit.K[i, j])
+                machine.parameter(f"{body}.flex.mu1", unit.omega1 ** 2)
+                machine.parameter(f"{body}.flex.damping_ratio", flex.damping_ratio)
+                machine.parameter(f"{body}.flex.core_EI", flex.core_EI)
+                machine.parameter(f"{body}.flex.paper_E", flex.paper_E)
+                machine.parameter(f"{body}.flex.k_t", unit.k_t)
+                machine.channel(TWIST, body)
+                continue
             for axis in ("x", "z"):
                 held = axis in first.bearing_axes
                 bm = beam_matrices(n, first.length, part.mass, flex.EI,
@@ -108,6 +122,32 @@ class FlexBeam(ForceElement):
 
     def structure_tag(self, machine: Machine) -> str:
         return ",".join(f"{body}:{len(segs)}" for body, segs in self.groups.items())
+
+    @staticmethod
+    def _roll_bending(ev: Evaluation, body: str, segs: list[Any], states: list[Any],
+                      ux: list[Any], uz: list[Any]) -> tuple[Any, Any]:
+        """A paper roll's bending, ``EI(r) K₁ (u + β u̇)`` with ``EI(r) = core_EI +
+        paper_E·π (r⁴ − r_c⁴)/4`` [N·m²] and ``β = 2ζ/ω₁(r)``, ``ω₁² = EI μ₁ / (m/N)``
+        (``K₁``, ``μ₁``: the free–free chain of unit ``EI`` and unit segment mass); its
+        torsion spring and damper ``(k_t, β k_t)``."""
+        p = ev.p
+        r, rc = states[0].r, p(f"{body}.core_radius")
+        r2, rc2 = r * r, rc * rc
+        ei = p(f"{body}.flex.core_EI") + p(f"{body}.flex.paper_E") * math.pi \
+            * (r2 * r2 - rc2 * rc2) / 4.0
+        beta = 2.0 * p(f"{body}.flex.damping_ratio") \
+            / ev.mathns.sqrt(ei * p(f"{body}.flex.mu1") / states[0].mass)
+        free = segs[0].free
+        for i, seg in enumerate(segs):
+            fx: Any = 0.0
+            fz: Any = 0.0
+            for j, bs in enumerate(states):
+                k = ei * p(f"{body}.flex.K1_{min(i, j)}_{max(i, j)}")
+                fx = fx - k * (ux[j] + beta * bs.vx)
+                fz = fz - k * (uz[j] + beta * bs.vz)
+            ev.add_force(seg.name, fx if "x" in free else 0.0, fz if "z" in free else 0.0)
+        kt = p(f"{body}.flex.k_t")
+        return kt, beta * kt
 
     def _nip_channels(self, ev: Evaluation) -> None:
         """The sliced scene nips' own channels (see the module text)."""
@@ -143,14 +183,17 @@ class FlexBeam(ForceElement):
             def entry(kind: str, i: int, j: int, body: str = body) -> Any:
                 return ev.p(f"{body}.flex.{kind}_{min(i, j)}_{max(i, j)}")
 
-            for i, seg in enumerate(segs):
-                fx: Any = 0.0
-                fz: Any = 0.0
-                for j, bs in enumerate(states):
-                    fx = fx - entry("Kx", i, j) * ux[j] - entry("Cx", i, j) * bs.vx
-                    fz = fz - entry("Kz", i, j) * uz[j] - entry("Cz", i, j) * bs.vz
-                ev.add_force(seg.name, fx, fz)
-            kt, ct = ev.p(f"{body}.flex.k_t"), ev.p(f"{body}.flex.c_t")
+            if hasattr(segs[0].flex, "core_EI"):
+                kt, ct = self._roll_bending(ev, body, segs, states, ux, uz)
+            else:
+                for i, seg in enumerate(segs):
+                    fx: Any = 0.0
+                    fz: Any = 0.0
+                    for j, bs in enumerate(states):
+                        fx = fx - entry("Kx", i, j) * ux[j] - entry("Cx", i, j) * bs.vx
+                        fz = fz - entry("Kz", i, j) * uz[j] - entry("Cz", i, j) * bs.vz
+                    ev.add_force(seg.name, fx, fz)
+                kt, ct = ev.p(f"{body}.flex.k_t"), ev.p(f"{body}.flex.c_t")
             for i in range(n - 1):
                 a, b = states[i], states[i + 1]
                 tq = kt * (b.theta - a.theta) + ct * (b.omega - a.omega)

@@ -29,7 +29,7 @@ and switch at located events.
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -39,7 +39,7 @@ from winder._schema import Channel
 from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, WEB_SPEED
 from winder.model.element_order import order_elements
 from winder.model.locked_modes import FREE, ModeKind, ModeSlot
-from winder.model.slices import assemble_nips, entry_slice
+from winder.model.slices import assemble_nips, entry_slice, entry_slices
 
 __all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState"]
 
@@ -81,6 +81,12 @@ class Web:
     channel: str = ""
     span_key: str = ""
     span_channel: str = ""
+    #: the nips its forces act at: ``[entry]``, or every slice into a flexible roll
+    entries: list[Nip] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.entries:
+            self.entries = [self.entry]
 
 
 class Machine:
@@ -148,7 +154,8 @@ class Machine:
             self.webs.append(Web(name, w, entry_slice(self.nips, w.entry_nip), span,
                                  self.body[span.source] if span is not None else None,
                                  f"{name}." if several else "", f"{name}_" if several else "",
-                                 f"{name}." if spanned else "", f"{name}_" if spanned else ""))
+                                 f"{name}." if spanned else "", f"{name}_" if spanned else "",
+                                 entry_slices(self.nips, w.entry_nip)))
         first = self.webs[0] if self.webs else None
         self.web = first.part if first is not None else None
         self.entry = first.entry if first is not None else None

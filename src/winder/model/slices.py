@@ -6,8 +6,9 @@ body element with ``segment_of = NAME``) and a rigid body becomes ``N`` nips of 
 stiffness and damping scaled by the slice's share ``1/N`` of the length: the contact
 element reads :attr:`~winder.model.machine.Nip.count`) and its own friction state. Between
 two flexible bodies of the same ``N``, slice ``i`` joins their segments ``i``. A web that
-enters at a sliced nip enters at its middle slice (``i = N // 2``), which carries the web's
-forces on the rigid body and gives the entry drum's surface speed.
+enters at a sliced nip enters at its middle slice (``i = N // 2``), which gives the entry
+drum's surface speed and carries the web's forces on a rigid roll; into a flexible roll its
+forces are spread over every slice (each segment its own ``ṁ_i u`` and ``T/N``).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-__all__ = ["segments_of", "assemble_nips", "entry_slice"]
+__all__ = ["segments_of", "assemble_nips", "entry_slice", "entry_slices"]
 
 
 def segments_of(bodies: Sequence[Any]) -> dict[str, list[Any]]:
@@ -60,3 +61,12 @@ def entry_slice(nips: Sequence[Any], name: str) -> Any:
     the middle slice of a sliced one."""
     slices = [n for n in nips if n.name == name or n.whole == name]
     return slices[0] if len(slices) == 1 else slices[len(slices) // 2]
+
+
+def entry_slices(nips: Sequence[Any], name: str) -> list[Any]:
+    """The machine's nips a web's forces act at, for the scene's nip ``name``: every slice
+    where its roll (``b``) is flexible, else the one :func:`entry_slice`."""
+    slices = [n for n in nips if n.whole == name]
+    if slices and slices[0].b.segment_of is not None:
+        return slices
+    return [entry_slice(nips, name)]

@@ -14,7 +14,11 @@ from typing import Any
 
 from winder._schema import Key, Table
 
-__all__ = ["FlexPart", "FLEX_KEYS", "parse_flex", "MAX_SEGMENTS"]
+__all__ = ["FlexPart", "FLEX_KEYS", "parse_flex", "MAX_SEGMENTS", "RollFlexPart",
+           "ROLL_FLEX_KEYS", "parse_roll_flex", "ROLL_SUPPORTS"]
+
+#: How a flexible wound roll is carried: ``drums`` (by its nips, no bearings).
+ROLL_SUPPORTS = ("drums",)
 
 #: The most segments a flexible body may have.
 MAX_SEGMENTS = 64
@@ -78,3 +82,47 @@ def parse_flex(reader: Any, label: str, raw: Any, length: float | None) -> FlexP
         raise reader.fail(label, "length", "missing required key (a flexible body, flex = "
                                            "{ ... }, needs its length along the axis [m])")
     return FlexPart(**kw)
+
+
+#: The keys of a wound roll's ``flex`` sub-table (its length is its ``width``).
+ROLL_FLEX_KEYS = Table((
+    FLEX_KEYS["segments"],
+    Key(name="core_EI", required=True, unit="N·m²", lo=0.0, lo_open=True, hi=1e18,
+        doc="bending stiffness of the core; the roll's EI(r) = core_EI + paper_E·π(r⁴ − "
+            "r_c⁴)/4 (Euler–Bernoulli)"),
+    Key(name="paper_E", required=True, unit="Pa", lo=0.0, hi=1e18,
+        doc="Young's modulus of the wound paper in bending"),
+    Key(name="GJ", required=True, unit="N·m²", lo=0.0, lo_open=True, hi=1e18,
+        doc="torsional stiffness G·J; neighbouring segments are joined by GJ/(L/N)"),
+    Key(name="support", kind="str", choices=ROLL_SUPPORTS,
+        doc="drums: carried by its nips, no bearings (free–free); chucks: not yet "
+            "(issue #25)"),
+    FLEX_KEYS["damping_ratio"],
+))
+
+
+@dataclass(frozen=True)
+class RollFlexPart:
+    """``flex = { ... }`` of a wound roll: ``segments`` lumped segments of its width, each
+    with its share of ``m(r)``, ``J(r)``; keys, units, bounds and meanings:
+    :data:`ROLL_FLEX_KEYS`."""
+
+    segments: int
+    core_EI: float
+    paper_E: float
+    GJ: float
+    support: str = "drums"
+    damping_ratio: float = 0.01
+
+
+def parse_roll_flex(reader: Any, label: str, raw: Any) -> RollFlexPart:
+    """The ``flex`` sub-table ``raw`` of the wound roll ``[label]``: its keys and an
+    integer ``segments``."""
+    flabel = f"{label}.flex"
+    kw = reader.keys(flabel, raw, ROLL_FLEX_KEYS)
+    n = kw["segments"]
+    if float(n) != int(n):
+        raise reader.fail(flabel, "segments", f"{n!r} is not an integer; valid: an integer, "
+                                              f"2–{MAX_SEGMENTS}")
+    kw["segments"] = int(n)
+    return RollFlexPart(**kw)

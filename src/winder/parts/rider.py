@@ -108,7 +108,8 @@ class RiderBody(RigidDisc):
     def __init__(self, part: Any, placed: Any) -> None:
         super().__init__(part)
         self.sense = 1
-        ridden = placed[part.rides]
+        ridden = placed[part.rides] if part.rides in placed else \
+            next(b for b in placed.values() if b.segment_of == part.rides)  # flexible
         self.free = ("z",)
         self.centre = (float(part.x), ridden.centre[1] + ridden.initial_radius + part.radius)
         #: the name of the body it rests on
