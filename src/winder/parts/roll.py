@@ -413,6 +413,10 @@ class RollSegment(RollBody):
             ev.switches[f"{n}.forward"] = speed
             ev.set_rate(f"{n}.radius", bs.r_dot)
 
+    def radius_of(self, y: Any, machine: Machine) -> float:
+        """The roll's shared radius [m] in state ``y``."""
+        return float(y[machine.index(f"{self.roll}.radius")])
+
     def transverse_inertia(self, ev: Evaluation, mass: Any, inertia: Any) -> Any:
         """A cylinder of width ``L/N``."""
         h = ev.p(f"{self.roll}.width") / self.segments
