@@ -279,3 +279,14 @@ def test_generated_code_matches_the_numeric_path() -> None:
     y[gen.index("roll.theta_dot")] = 20.0
     a, b = gen.rhs(0.5, y), num.rhs(0.5, y)
     assert np.max(np.abs(a - b) / (np.abs(b) + 1e-6)) < 1e-9
+
+
+def test_the_flexible_two_drum_example_builds() -> None:
+    """examples/two_drum_winder_flexible.toml: every body in 8 segments, every nip sliced."""
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "two_drum_winder_flexible.toml"
+    m = Machine(winder.load_scene(path))
+    assert len(m.bodies) == 32 and len(m.nips) == 24
+    for nip in ("front_nip", "rear_nip", "rider_nip"):
+        assert m.channel_units[f"{nip}_line_load_max"] == "N/m"
