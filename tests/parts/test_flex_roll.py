@@ -103,6 +103,11 @@ def test_a_flexible_roll_is_n_segments_sharing_one_radius() -> None:
     assert [n.name for n in m.nips] == [f"nip_s{i}" for i in range(4)]
     assert [e.name for e in m.webs[0].entries] == [f"nip_s{i}" for i in range(4)]
     assert m.channel_units["roll_s2_radius"] == "m" and m.channel_units["roll_twist"] == "rad"
+    sys = MachineSystem(scene(4, speed=20.0), backend="pinocchio")
+    ev = sys.evaluate_numeric(0.0, np.array(sys.machine.state_initial))
+    assert ev.channels["roll_radius"] == ev.channels["roll_s3_radius"] == 0.3
+    assert ev.channels["roll_mass"] == pytest.approx(mass(0.3), rel=1e-14)
+    assert ev.channels["roll_speed"] == pytest.approx(20.0, rel=1e-14)
 
 
 def test_segments_of_both_flexible_bodies_of_a_nip_must_match() -> None:
