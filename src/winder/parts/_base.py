@@ -68,13 +68,15 @@ class Drawing:
     drum's). width: its own length along ``y`` [m] (None: the machine's, 1.05 × the widest
     body's width). width_of: the name of a body whose width it takes (a rider: the roll
     it rides). core_radius: a paper roll's core [m] (then a core, a paper cylinder scaled
-    by its radius state, and a centre-of-mass marker at com_offset [m])."""
+    by its radius state, and a centre-of-mass marker at com_offset [m]). y: its centre
+    along the axis [m] from the machine's mid-width (a segment of a flexible body)."""
 
     colour: str = "drum"
     width: float | None = None
     width_of: str | None = None
     core_radius: float | None = None
     com_offset: float = 0.0
+    y: float = 0.0
 
 
 class BodyElement(ABC):

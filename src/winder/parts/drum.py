@@ -255,7 +255,8 @@ class DrumSegment(DrumBody):
         self.drives = ("flex_beam",)
 
     def drawing(self) -> Drawing:
-        return Drawing(colour="drum", width=self.length / self.segments)
+        h = self.length / self.segments
+        return Drawing(colour="drum", width=h, y=(self.index + 0.5) * h - self.length / 2)
 
     def declare(self, machine: Machine) -> None:
         n, part, N = self.name, self.part, self.segments

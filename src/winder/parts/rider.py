@@ -142,7 +142,8 @@ class RiderSegment(RiderBody):
         self.drives = ("flex_beam",)
 
     def drawing(self) -> Drawing:
-        return Drawing(colour="rider", width=self.length / self.segments)
+        h = self.length / self.segments
+        return Drawing(colour="rider", width=h, y=(self.index + 0.5) * h - self.length / 2)
 
     def declare(self, machine: Any) -> None:
         n, part, N = self.name, self.part, self.segments

@@ -382,7 +382,8 @@ class RollSegment(RollBody):
         self.drives = ("flex_beam",)
 
     def drawing(self) -> Drawing:
-        return replace(super().drawing(), width=self.length / self.segments)
+        h = self.length / self.segments
+        return replace(super().drawing(), width=h, y=(self.index + 0.5) * h - self.length / 2)
 
     @property
     def roll_key(self) -> str:
