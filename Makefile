@@ -81,6 +81,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/fmu_realtime.py
 	$(PY) benchmarks/cli_speed.py
 	$(PY) benchmarks/sweep_scaling.py
+	$(PY) benchmarks/flex_speed.py
 
 # Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
 peers: $(STAMP)

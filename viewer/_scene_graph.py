@@ -27,8 +27,8 @@ from winder.viewer._motion import WEB_ARC_POINTS, Motion
 from winder.model.machine import Machine
 from winder.scene.load import Scene
 
-__all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN", "WEB_THICKNESS", "FOV", "Pose",
-           "apply_poses"]
+__all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN", "DEFLECTION_GAIN", "WEB_THICKNESS",
+           "FOV", "Pose", "apply_poses"]
 
 #: Colours (hex RGB) of the parts; the browser tests look for them.
 COLOURS = {"drum": 0x3A6EA5, "paper": 0xF2E6C9, "core": 0x8B5A2B, "mark": 0xC0392B,
@@ -36,6 +36,9 @@ COLOURS = {"drum": 0x3A6EA5, "paper": 0xF2E6C9, "core": 0x8B5A2B, "mark": 0xC039
            "web": 0xD4AC0D}
 #: The CoM offset (1 mm) is drawn this many times larger so that it can be seen.
 COM_MARKER_GAIN = 100.0
+#: The segments of a flexible body are drawn along its axis, their offsets from the
+#: segments' mean (its bending) this many times larger so that they can be seen.
+DEFLECTION_GAIN = 200.0
 #: Drawn thickness of the web strip [m] (its centre line is the web's path).
 WEB_THICKNESS = 0.02
 #: Vertical field of view of meshcat's camera [deg] and the aspect the framing assumes.
@@ -64,9 +67,10 @@ class WinderGraph:
         self.data = self.model.createData()
         #: How each body is drawn (:meth:`~winder.parts.BodyElement.drawing`), by name.
         self.drawings = {b.name: b.drawing() for b in self.machine.bodies}
-        #: Length of the drums [m]: the widest body's width (a paper roll's).
-        self.length = max((d.width for d in self.drawings.values() if d.width is not None),
-                          default=1.0)
+        #: Length of the drums [m]: the widest body's width (a paper roll's; the span of a
+        #: flexible body's segments along the axis).
+        self.length = max((2.0 * abs(d.y) + d.width for d in self.drawings.values()
+                           if d.width is not None), default=1.0)
         #: Bodies on stands (drums and unwinding rolls: fixed centres) or, without any,
         #: every body: the floor spans them and each stand gets a far side frame.
         self.fixed = [b for b in self.machine.bodies if not b.free]
@@ -74,13 +78,18 @@ class WinderGraph:
         #: Height of the floor [m]: 0.35 m below the lowest stand.
         self.floor_z = min(b.centre[1] - _radius0(b) for b in self.stands) - 0.35
         entry = self.machine.entry
-        self.web_width = 1.12 * (self._width(entry.b.name) if entry is not None
+        self.web_width = 1.12 * (self._web_width(entry.b) if entry is not None
                                  else self.length)
         #: Node of each web's strip (``web`` for the first) and its width [m]: 1.12 × the
         #: width of the roll it enters.
         self.web_nodes = [("web" if i == 0 else f"web-{w.name}",
-                           1.12 * self._width(w.entry.b.name))
+                           1.12 * self._web_width(w.entry.b))
                           for i, w in enumerate(self.machine.webs)]
+
+    def _web_width(self, body: object) -> float:
+        """The width [m] of the roll a web enters (a flexible roll: its whole width)."""
+        flexible = getattr(body, "segment_of", None) is not None
+        return float(body.length) if flexible else self._width(body.name)
 
     def _width(self, name: str) -> float:
         """The drawn length along ``y`` [m] of body ``name``: its own width, the width of
@@ -178,14 +187,28 @@ class WinderGraph:
         """World placements (4×4) of the bodies from ``frame`` = body name → centre ``x``,
         ``z`` [m] and model angle ``θ`` about ``+y`` [rad], by Pinocchio FK."""
         q = np.zeros(self.model.nq)
+        mean: dict[str, list[float]] = {}
+        for b in self.machine.bodies:  # flexible bodies: their segments' mean centre
+            if b.segment_of is not None:
+                x, z, _ = frame[b.name]
+                acc = mean.setdefault(b.segment_of, [0.0, 0.0, 0.0])
+                acc[0], acc[1], acc[2] = acc[0] + x, acc[1] + z, acc[2] + 1.0
         for b in self.machine.bodies:
             x, z, theta = frame[b.name]
+            if b.segment_of is not None:  # its bending, exaggerated
+                mx, mz, n = mean[b.segment_of]
+                x = mx / n + DEFLECTION_GAIN * (x - mx / n)
+                z = mz / n + DEFLECTION_GAIN * (z - mz / n)
             for coord, value in (("x", x), ("z", z), ("theta", theta)):
                 if coord in b.joints:
                     q[self.model.joints[b.joints[coord]].idx_q] = value
         pin.forwardKinematics(self.model, self.data, q)
-        return {b.name: self.data.oMi[b.joints["theta"]].homogeneous.copy()
-                for b in self.machine.bodies}
+        out = {}
+        for b in self.machine.bodies:
+            pose = self.data.oMi[b.joints["theta"]].homogeneous.copy()
+            pose[1, 3] += self.drawings[b.name].y  # a segment's place along the axis
+            out[b.name] = pose
+        return out
 
     def pose_commands(self, m: Motion, k: int) -> list[Pose]:
         """What to set to show sample ``k`` of ``m``: body placements, paper scales, the

@@ -119,10 +119,17 @@ def _check_scene(scene: Scene, where: str) -> None:
                                 "operating point and no slip mode; valid: mu > 0")
 
 
+def _radius_state(body: BodyElement) -> str:
+    """The radius state of a paper roll (a flexible roll's segments share their roll's)."""
+    return f"{getattr(body, 'roll_key', body.name)}.radius"
+
+
 def _entry_drive(scene: Scene) -> BodyElement:
-    """The body element the web wraps before its entry nip (side ``a``: the drum)."""
+    """The body element the web wraps before its entry nip (side ``a``: the drum; a
+    flexible drum's drive segment)."""
     nip = next(n for n in scene.nips if n.name == scene.web.entry_nip)
-    return next(b for b in body_elements(scene) if b.name == nip.a)
+    return next(b for b in body_elements(scene) if b.name == nip.a or
+                (b.segment_of == nip.a and b.drive_web_speed() is not None))
 
 
 def _web_speed(where: str, scene: Scene, web_speed: float | None, lo_open: bool) -> float:
@@ -157,7 +164,7 @@ class _Linearisation:
             b.hold_operating_speed(m, p, v)
         self.t = 0.0
         self.roll = m.entry.b
-        self.i_r = m.index(f"{self.roll.name}.radius")
+        self.i_r = m.index(_radius_state(self.roll))
         self.rc = self.roll.least_radius
         names = m.state_names
         self.positions = [m.index(f"{b.name}.{c}") for b in m.bodies for c in b.free]
@@ -165,14 +172,14 @@ class _Linearisation:
         self.velocities = [m.index(f"{n}_dot") for n in self.coords]
         self.speeds = [m.index(f"{b.name}.theta_dot") for b in m.bodies if not b.prescribed]
         slow = {m.index(f"{b.name}.theta") for b in m.bodies if not b.prescribed}
-        slow |= {m.index(f"{b.name}.radius") for b in m.bodies if b.radius_state}
+        slow |= {m.index(_radius_state(b)) for b in m.bodies if b.radius_state}
         taken = set(self.positions) | set(self.velocities) | set(self.speeds) | slow
         self.others = [i for i in range(len(names)) if i not in taken]  # friction, ...
         # unknowns of the balance and their equations (rates)
         self.unknowns = self.positions + self.speeds + self.others
         self.equations = self.velocities + self.speeds + self.others
         self.fast = self.positions + self.velocities + self.speeds + self.others
-        self.paper = {m.index(f"{b.name}.theta_dot"): m.index(f"{b.name}.radius")
+        self.paper = {m.index(f"{b.name}.theta_dot"): m.index(_radius_state(b))
                       for b in m.bodies if b.radius_state}
         self._speed_slots = np.arange(len(self.positions),
                                       len(self.positions) + len(self.speeds))

@@ -5,6 +5,7 @@ from typing import Any
 
 from winder.forces._base import ForceElement
 from winder.forces.contact import Contact
+from winder.forces.flex_beam import FlexBeam
 from winder.forces.gravity import Gravity
 from winder.forces.imbalance import Imbalance
 from winder.forces.rider_load import RiderLoad
@@ -23,8 +24,10 @@ FORCES: dict[str, type[ForceElement]] = {
                               Contact, SlipRelaxation, RiderLoad)
 }
 
-#: Force elements a part's drive calls for (not ``[effects]`` keys), by drive kind.
-DRIVES: dict[str, type[ForceElement]] = {"tension_control": TensionController}
+#: Force elements a part calls for (not ``[effects]`` keys; a body lists them in its
+#: ``drives``): its drive's (by drive kind), a flexible body's beam (``flex_beam``).
+DRIVES: dict[str, type[ForceElement]] = {"tension_control": TensionController,
+                                         "flex_beam": FlexBeam}
 
 #: The order in which the built-in effects' force elements run where their declarations
 #: (``provides``/``requires``/``uses``) leave it open: the order their forces are summed,

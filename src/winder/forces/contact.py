@@ -1,5 +1,8 @@
 """Nip contact (machines.md §2, winder-model §4): compliant normal force and slip friction.
 
+A nip against a flexible body is one machine nip per slice (:mod:`winder.model.slices`),
+its stiffness and damping scaled by ``1/count`` here.
+
 ``F_n`` acts on ``b`` along ``+n`` and on ``a`` along ``−n`` through the centres, never
 negative, zero for ``δ ≤ 0``: linear ``k δ + c δ̇`` or Hunt–Crossley
 ``k δ^p (1 + α δ̇)``. Friction ``F_ss = μ F_n tanh(v_s / v_ref)`` acts on ``b`` along
@@ -61,8 +64,9 @@ class Contact(ForceElement):
             c, f = nip.part.contact, nip.part.friction
             keys = ("stiffness", "damping") if c.law == "linear" else \
                 ("stiffness", "exponent", "hc_damping")
+            share = {"stiffness": 1.0 / nip.count, "damping": 1.0 / nip.count}  # a slice's
             for key in keys:
-                machine.parameter(f"{nip.name}.{key}", getattr(c, key))
+                machine.parameter(f"{nip.name}.{key}", getattr(c, key) * share.get(key, 1.0))
             machine.parameter(f"{nip.name}.mu", f.mu)
             machine.parameter(f"{nip.name}.slip_velocity", f.slip_velocity)
             machine.mode(f"{nip.name}.contact", tuple(

@@ -36,20 +36,29 @@ class RiderLoad(ForceElement):
                         "the riders' weight)"),)
 
     def declare(self, machine: Machine) -> None:
+        from winder.model.slices import segments_of
+
+        #: the body whose radius each rider's schedule reads: the roll, or a flexible
+        #: roll's segment 0 (they share one radius)
+        self.ridden: dict[str, str] = {}
+        groups = segments_of(machine.bodies)
         scale = machine.scene.effects.setting(self.name, "scale")
         for b in _riders(machine):
             for i, (r, q) in enumerate(b.load):
                 machine.parameter(f"{b.name}.load_radius_{i}", r)
                 machine.parameter(f"{b.name}.line_load_{i}", q * scale)
             machine.channel(self.CHANNELS[0], b.name)
+            self.ridden[b.name] = groups[b.rides][0].name if b.rides in groups else b.rides
 
     def apply(self, ev: Evaluation) -> None:
         for b in _riders(ev.machine):
             n = b.name
             pts = [(ev.p(f"{n}.load_radius_{i}"), ev.p(f"{n}.line_load_{i}"))
                    for i in range(len(b.load))]
-            roll = ev.bodies[b.rides]
-            f = ev.p(f"{roll.body.name}.width") * line_load(ev.mathns, roll.r, pts) if pts else 0.0
+            roll = ev.bodies[self.ridden[n]]
+            f = ev.p(f"{b.rides}.width") * line_load(ev.mathns, roll.r, pts) if pts else 0.0
+            if b.segment_of is not None:  # a flexible rider's segment: its share
+                f = f / b.segments
             ev.add_force(n, 0.0, -f)
             ev.set_channel(f"{n}_load", f)
 

@@ -6,7 +6,7 @@ unwinding roll keeps its speed."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from winder._schema import Channel
 from winder.forces._base import ForceElement
@@ -35,12 +35,14 @@ class WebMomentum(ForceElement):
     def apply(self, ev: Evaluation) -> None:
         m = ev.machine
         for w in m.webs:
-            entry = w.entry
-            ns, b = ev.nips[entry.name], ev.bodies[entry.b.name]
-            u = ns.u_a if m.scene.effects.contact else ns.u_b
-            f = b.mass_rate * u
-            ev.add_force(b.body.name, f * ns.tx, f * ns.tz, -b.r * ns.nx, -b.r * ns.nz)
-            ev.set_channel(f"{w.channel}web_force", f)
+            total: Any = 0.0
+            for entry in w.entries:  # one; a flexible roll: each slice, its own ṁ_i
+                ns, b = ev.nips[entry.name], ev.bodies[entry.b.name]
+                u = ns.u_a if m.scene.effects.contact else ns.u_b
+                f = b.mass_rate * u
+                ev.add_force(b.body.name, f * ns.tx, f * ns.tz, -b.r * ns.nx, -b.r * ns.nz)
+                total = f if len(w.entries) == 1 else total + f
+            ev.set_channel(f"{w.channel}web_force", total)
             if w.unwind is not None:
                 un = ev.bodies[w.unwind.name]
                 f = un.mass_rate * un.r * un.speed

@@ -81,4 +81,11 @@ class WebTension(ForceElement):
             T = ev.mathns.fmax(state, 0.0)
             tx, tz, ox, oz = exit_point(ev, w)
             ev.add_force(u.body.name, T * tx, T * tz, ox, oz)
-        ev.add_force(b.body.name, -T * ns.tx, -T * ns.tz, -b.r * ns.nx, -b.r * ns.nz)
+        if len(w.entries) == 1:
+            ev.add_force(b.body.name, -T * ns.tx, -T * ns.tz, -b.r * ns.nx, -b.r * ns.nz)
+            return
+        share = T / len(w.entries)  # a flexible roll: T/N on each slice
+        for entry in w.entries:
+            ns, b = ev.nips[entry.name], ev.bodies[entry.b.name]
+            ev.add_force(b.body.name, -share * ns.tx, -share * ns.tz, -b.r * ns.nx,
+                         -b.r * ns.nz)

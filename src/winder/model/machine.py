@@ -29,7 +29,7 @@ and switch at located events.
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -39,6 +39,7 @@ from winder._schema import Channel
 from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, WEB_SPEED
 from winder.model.element_order import order_elements
 from winder.model.locked_modes import FREE, ModeKind, ModeSlot
+from winder.model.slices import assemble_nips, entry_slice, entry_slices
 
 __all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState"]
 
@@ -47,13 +48,18 @@ _COORDS = ("x", "z")
 
 @dataclass
 class Nip:
-    """A nip between bodies ``a`` and ``b`` (machines.md §2)."""
+    """A nip between bodies ``a`` and ``b`` (machines.md §2); a slice of the scene's nip
+    ``whole`` (one of ``count``, ``slice_length`` [m] long) against a flexible body
+    (:mod:`winder.model.slices`)."""
 
     name: str
     a: Any
     b: Any
     part: Any
     index: int
+    whole: str | None = None
+    count: int = 1
+    slice_length: float | None = None
 
 
 @dataclass
@@ -75,6 +81,12 @@ class Web:
     channel: str = ""
     span_key: str = ""
     span_channel: str = ""
+    #: the nips its forces act at: ``[entry]``, or every slice into a flexible roll
+    entries: list[Nip] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.entries:
+            self.entries = [self.entry]
 
 
 class Machine:
@@ -102,8 +114,7 @@ class Machine:
             forces = own_forces if forces is None else forces
         self.bodies: list[Any] = list(bodies)
         self.body = {b.name: b for b in self.bodies}
-        self.nips = [Nip(n.name, self.body[n.a], self.body[n.b], n, i)
-                     for i, n in enumerate(scene.nips)]
+        self.nips = assemble_nips(scene.nips, self.body, self.bodies, Nip)
         self.nip = {n.name: n for n in self.nips}
         self._assemble_webs(scene)
         #: the bodies whose mass properties change in time (:attr:`BodyElement.variable_mass`)
@@ -140,10 +151,11 @@ class Machine:
             name = getattr(w, "name", None) or w.entry_nip
             span = getattr(w, "span", None)
             several, spanned = len(parts) > 1, spans > 1
-            self.webs.append(Web(name, w, self.nip[w.entry_nip], span,
+            self.webs.append(Web(name, w, entry_slice(self.nips, w.entry_nip), span,
                                  self.body[span.source] if span is not None else None,
                                  f"{name}." if several else "", f"{name}_" if several else "",
-                                 f"{name}." if spanned else "", f"{name}_" if spanned else ""))
+                                 f"{name}." if spanned else "", f"{name}_" if spanned else "",
+                                 entry_slices(self.nips, w.entry_nip)))
         first = self.webs[0] if self.webs else None
         self.web = first.part if first is not None else None
         self.entry = first.entry if first is not None else None

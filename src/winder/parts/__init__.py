@@ -55,5 +55,6 @@ def body_elements(scene: Any) -> list[BodyElement]:
     for attr, cls in PARTS.items():
         parts = bodies.get(attr) if attr in bodies else getattr(scene, attr, None)
         for part in parts or ():
-            placed[part.name] = cls(part, placed)
+            for element in cls.elements(part, placed):
+                placed[element.name] = element
     return list(placed.values())

@@ -68,13 +68,15 @@ class Drawing:
     drum's). width: its own length along ``y`` [m] (None: the machine's, 1.05 × the widest
     body's width). width_of: the name of a body whose width it takes (a rider: the roll
     it rides). core_radius: a paper roll's core [m] (then a core, a paper cylinder scaled
-    by its radius state, and a centre-of-mass marker at com_offset [m])."""
+    by its radius state, and a centre-of-mass marker at com_offset [m]). y: its centre
+    along the axis [m] from the machine's mid-width (a segment of a flexible body)."""
 
     colour: str = "drum"
     width: float | None = None
     width_of: str | None = None
     core_radius: float | None = None
     com_offset: float = 0.0
+    y: float = 0.0
 
 
 class BodyElement(ABC):
@@ -218,6 +220,8 @@ class BodyElement(ABC):
         self.winds = False
         #: its centre of mass offset [m] for the ``imbalance`` effect (None: no imbalance)
         self.com_offset: float | None = None
+        #: a segment of a flexible body: that body's name (its nips are sliced), else None
+        self.segment_of: str | None = None
         #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine
         self.joints: dict[str, int] = {}
 
@@ -228,6 +232,12 @@ class BodyElement(ABC):
         checked against :attr:`KEYS`, then :attr:`part_cls` of them (override for
         sub-tables, defaults from ``[paper]`` and checks across keys)."""
         return cls.part_cls(**reader.keys(label, raw, cls.KEYS))
+
+    @classmethod
+    def elements(cls, part: Any, placed: Mapping[str, BodyElement]) -> list[BodyElement]:
+        """The body elements of its part ``part`` (``placed``: those built before, by
+        name): default one, ``cls(part, placed)``; a flexible body its segments."""
+        return [cls(part, placed)]
 
     @classmethod
     def fixed_centre(cls, part: Any) -> bool:

@@ -1,5 +1,7 @@
 """Drums (machines spec §1, §6, §8 ``[[drum]]``): bodies with a fixed centre and a
-constant radius, driven by a speed profile or a torque."""
+constant radius, driven by a speed profile or a torque; rigid, or flexible (issue #25:
+``flex = { segments = N, ... }``, :mod:`winder.parts.flex`): then N segment bodies
+(:class:`DrumSegment`) joined by the force element ``flex_beam``."""
 
 from __future__ import annotations
 
@@ -9,12 +11,13 @@ from typing import TYPE_CHECKING, Any
 from winder._schema import Key, Table
 from winder.parts._base import Drawing, RigidDisc, SubTable, TableReader
 from winder.parts._keys import CENTRE, NAME
+from winder.parts.flex import FLEX_KEYS, FlexPart, parse_flex
 
 if TYPE_CHECKING:
     from winder.model.machine import BodyState, Evaluation, Machine
 
-__all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "DrumBody", "KEYS", "DRIVE_KEYS",
-           "DRIVE_KINDS"]
+__all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "DrumBody", "DrumSegment", "KEYS",
+           "DRIVE_KEYS", "DRIVE_KINDS"]
 
 #: Drive kinds of a drum.
 DRIVE_KINDS = ("speed_profile", "torque")
@@ -33,6 +36,13 @@ KEYS = Table((
         doc="operation direction: +1 turns the top surface towards +x"),
     Key(name="drive", kind="table", required=True,
         doc="the drive, a sub-table: keys below"),
+    Key(name="length", unit="m", lo=0.0, lo_open=True, hi=50.0,
+        default_text="required with flex; else unused",
+        doc="length L of the drum along its axis"),
+    Key(name="flex", kind="table",
+        default_text="none: a rigid drum",
+        doc="a flexible drum, a sub-table: keys below (issue #25); its nips are sliced, one "
+            "slice per segment"),
 ))
 
 #: The keys of a drum's ``drive``; ``kinds``: the keys each drive kind takes.
@@ -89,6 +99,8 @@ class DrumPart:
     centre: tuple[float, float]
     sense: int = 1
     drive: SpeedProfileDrive | TorqueDrive = SpeedProfileDrive()
+    length: float | None = None
+    flex: FlexPart | None = None
 
 
 class DrumBody(RigidDisc):
@@ -99,7 +111,8 @@ class DrumBody(RigidDisc):
     table = "drum"
     role = "drum"
     KEYS = KEYS
-    SUB_TABLES = {"drive": SubTable(DRIVE_KEYS, (SpeedProfileDrive, TorqueDrive))}
+    SUB_TABLES = {"drive": SubTable(DRIVE_KEYS, (SpeedProfileDrive, TorqueDrive)),
+                  "flex": SubTable(FLEX_KEYS, (FlexPart,))}
     part_cls = DrumPart
 
     @classmethod
@@ -116,7 +129,16 @@ class DrumBody(RigidDisc):
             drive: SpeedProfileDrive | TorqueDrive = SpeedProfileDrive(**d)
         else:
             drive = TorqueDrive(**d)
+        if "flex" in raw:
+            kw["flex"] = parse_flex(reader, label, raw["flex"], kw.get("length"))
         return DrumPart(**kw, drive=drive)
+
+    @classmethod
+    def elements(cls, part: Any, placed: Any) -> list[Any]:
+        """A rigid drum: itself; a flexible one: its segments (:class:`DrumSegment`)."""
+        if getattr(part, "flex", None) is None:
+            return [cls(part, placed)]
+        return [DrumSegment(part, i, placed) for i in range(part.flex.segments)]
 
     @classmethod
     def fixed_centre(cls, part: Any) -> bool:
@@ -133,6 +155,9 @@ class DrumBody(RigidDisc):
 
     def declare(self, machine: Machine) -> None:
         super().declare(machine)
+        self._declare_drive(machine)
+
+    def _declare_drive(self, machine: Machine) -> None:
         n, dr = self.name, self.part.drive
         if self.prescribed:
             aw, vw = dr.web_acceleration, dr.web_speed
@@ -200,3 +225,62 @@ class DrumBody(RigidDisc):
             tr = v / a
             return a * T * T / 2 if T <= tr else v * T - v * tr / 2
         return v * T
+
+
+class DrumSegment(DrumBody):
+    """Segment ``i`` of a flexible drum (issue #25): a body ``NAME_s{i}`` free along ``x``
+    and ``z`` (its deflection from the drum's ``centre``, the line of its bearings) that
+    turns about ``+y``, of mass ``m/N`` [kg], polar inertia ``J/N`` [kg·m²] and the drum's
+    radius [m]; segment 0 is the drive end and carries the drive (a speed profile
+    prescribes its rotation alone; a torque drive acts on it alone). The beam and the
+    torsion between the segments are the force element ``flex_beam``, which every segment
+    calls for (:attr:`drives`)."""
+
+    #: the axes its bearings hold (the beam's supports)
+    bearing_axes = ("x", "z")
+
+    def __init__(self, part: Any, index: int, placed: Any = None) -> None:
+        super().__init__(part, placed)
+        flex = part.flex
+        #: the drum's name, its segment index (0: drive end) and count
+        self.drum, self.index, self.segments = part.name, index, flex.segments
+        #: the flexible body's data for the force element ``flex_beam``
+        self.flex, self.length = flex, float(part.length)
+        self.name = f"{part.name}_s{index}"
+        self.segment_of = part.name
+        self.free = ("x", "z")
+        self.prescribed = index == 0 and part.drive.kind == "speed_profile"
+        self.torque_inputs = (f"{self.name}.torque",) \
+            if index == 0 and part.drive.kind == "torque" else ()
+        self.drives = ("flex_beam",)
+
+    def drawing(self) -> Drawing:
+        h = self.length / self.segments
+        return Drawing(colour="drum", width=h, y=(self.index + 0.5) * h - self.length / 2)
+
+    def declare(self, machine: Machine) -> None:
+        n, part, N = self.name, self.part, self.segments
+        machine.parameter(f"{n}.radius", part.radius)
+        machine.parameter(f"{n}.inertia", part.inertia / N)
+        machine.parameter(f"{n}.mass", part.mass / N)
+        if self.index == 0:
+            self._declare_drive(machine)
+
+    def drive_torque(self, ev: Evaluation) -> Any:
+        return ev.p(f"{self.name}.torque") if self.torque_inputs else None
+
+    def drive_web_speed(self) -> float | None:
+        """Its drive's ``web_speed`` [m/s] (segment 0 only)."""
+        return super().drive_web_speed() if self.index == 0 else None
+
+    def structure_tag(self) -> str:
+        return f"{super().structure_tag()}:{self.index}/{self.segments}"
+
+    def initial_rate(self, coord: str) -> float:
+        """Spec §7 for every segment: a torque drive's ``s · web_speed / R``, a speed
+        profile's ``Ω(0)`` [rad/s]; translational rates 0."""
+        dr = self.part.drive
+        if coord != "theta" or dr.kind == "torque":
+            return super().initial_rate(coord)
+        return self.sense * dr.ratio * (dr.web_speed if dr.web_acceleration == 0 else 0.0) \
+            / self.part.radius

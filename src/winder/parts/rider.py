@@ -1,5 +1,8 @@
 """Rider rolls (machines spec §4, §8 ``[[rider]]``): constant bodies free along ``z``
-resting on a paper roll under an applied line load."""
+resting on a paper roll under an applied line load; rigid, or flexible (issue #25: ``flex =
+{ segments = N, ... }``, :mod:`winder.parts.flex`): then N segment bodies
+(:class:`RiderSegment`), held in ``x`` at their ends by the rider's arms (bearings in
+``x``) and resting in ``z``, joined by the force element ``flex_beam``."""
 
 from __future__ import annotations
 
@@ -7,10 +10,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from winder._schema import Key, Table
-from winder.parts._base import Drawing, RigidDisc
+from winder.parts._base import Drawing, RigidDisc, SubTable, TableReader
 from winder.parts._keys import MAX_COORD, NAME
+from winder.parts.flex import FLEX_KEYS, FlexPart, parse_flex
 
-__all__ = ["RiderPart", "RiderBody", "KEYS"]
+__all__ = ["RiderPart", "RiderBody", "RiderSegment", "KEYS"]
 
 #: The keys of ``[[rider]]``.
 KEYS = Table((
@@ -33,6 +37,12 @@ KEYS = Table((
         items=(Key(name="radius", unit="m", lo=0.0, lo_open=True, hi=10.0,
                    doc="radius of the ridden roll"),
                Key(name="line_load", unit="N/m", lo=0.0, hi=1e7, doc="line load"))),
+    Key(name="length", unit="m", lo=0.0, lo_open=True, hi=50.0,
+        default_text="required with flex; else unused",
+        doc="length L of the rider along its axis"),
+    Key(name="flex", kind="table", default_text="none: a rigid rider",
+        doc="a flexible rider, a sub-table: the keys of [[drum]] flex (its bearings hold x "
+            "only: it rests in z); its nip is sliced, one slice per segment"),
 ))
 
 
@@ -49,6 +59,8 @@ class RiderPart:
     inertia: float
     x: float
     load: tuple[tuple[float, float], ...] = ()
+    length: float | None = None
+    flex: FlexPart | None = None
 
 
 # ---- behaviour (the part protocol, :class:`~winder.parts._base.BodyElement`) -------------
@@ -61,7 +73,23 @@ class RiderBody(RigidDisc):
     role = "rider"
     place_key = "x"
     KEYS = KEYS
+    SUB_TABLES = {"flex": SubTable(FLEX_KEYS, (FlexPart,))}
     part_cls = RiderPart
+
+    @classmethod
+    def parse(cls, reader: TableReader, label: str, raw: Any) -> RiderPart:
+        """Its keys and its ``flex`` sub-table."""
+        kw = reader.keys(label, raw, KEYS)
+        if "flex" in raw:
+            kw["flex"] = parse_flex(reader, label, raw["flex"], kw.get("length"))
+        return RiderPart(**kw)
+
+    @classmethod
+    def elements(cls, part: Any, placed: Any) -> list[Any]:
+        """A rigid rider: itself; a flexible one: its segments (:class:`RiderSegment`)."""
+        if getattr(part, "flex", None) is None:
+            return [cls(part, placed)]
+        return [RiderSegment(part, i, placed) for i in range(part.flex.segments)]
 
     @classmethod
     def fixed_centre(cls, part: Any) -> bool:
@@ -80,7 +108,8 @@ class RiderBody(RigidDisc):
     def __init__(self, part: Any, placed: Any) -> None:
         super().__init__(part)
         self.sense = 1
-        ridden = placed[part.rides]
+        ridden = placed[part.rides] if part.rides in placed else \
+            next(b for b in placed.values() if b.segment_of == part.rides)  # flexible
         self.free = ("z",)
         self.centre = (float(part.x), ridden.centre[1] + ridden.initial_radius + part.radius)
         #: the name of the body it rests on
@@ -90,3 +119,37 @@ class RiderBody(RigidDisc):
 
     def structure_tag(self) -> str:
         return f"{super().structure_tag()}:{len(self.load)}"
+
+
+class RiderSegment(RiderBody):
+    """Segment ``i`` of a flexible rider (issue #25): a body ``NAME_s{i}`` free along ``x``
+    (held at the rider's two ends by its arms, the bearings of ``flex``) and ``z`` (it
+    rests on the roll through its slice of the nip), of mass ``m/N`` [kg] and polar inertia
+    ``J/N`` [kg·m²]; its share ``1/N`` of the rider's load (``rider_load``). The beam and
+    the torsion are the force element ``flex_beam``."""
+
+    #: the axes its bearings hold (the beam's supports): the arms hold ``x`` only
+    bearing_axes = ("x",)
+
+    def __init__(self, part: Any, index: int, placed: Any) -> None:
+        super().__init__(part, placed)
+        flex = part.flex
+        self.index, self.segments, self.flex = index, flex.segments, flex
+        self.length = float(part.length)
+        self.name = f"{part.name}_s{index}"
+        self.segment_of = part.name
+        self.free = ("x", "z")
+        self.drives = ("flex_beam",)
+
+    def drawing(self) -> Drawing:
+        h = self.length / self.segments
+        return Drawing(colour="rider", width=h, y=(self.index + 0.5) * h - self.length / 2)
+
+    def declare(self, machine: Any) -> None:
+        n, part, N = self.name, self.part, self.segments
+        machine.parameter(f"{n}.radius", part.radius)
+        machine.parameter(f"{n}.inertia", part.inertia / N)
+        machine.parameter(f"{n}.mass", part.mass / N)
+
+    def structure_tag(self) -> str:
+        return f"{super().structure_tag()}:{self.index}/{self.segments}"

@@ -1,6 +1,9 @@
 """Paper rolls (machines spec §1, §6, §8 ``[[roll]]``): bodies whose radius, mass and
 inertia grow as paper is wound on (``wound``) or shrink as it is paid off
-(``unwinding``), and the drives of an unwinding roll."""
+(``unwinding``), and the drives of an unwinding roll. A wound roll may be flexible (issue
+#25: ``flex = { segments = N, ... }``, :mod:`winder.parts.flex`): then N segment bodies
+(:class:`RollSegment`) that share one radius state, joined by the force element
+``flex_beam``."""
 
 from __future__ import annotations
 
@@ -15,11 +18,12 @@ from winder.model.locked_modes import AT_CORE, CORE_AUTO, ModeKind
 from winder.model.paper_roll import max_com_offset, paper_roll_mass
 from winder.parts._base import BodyElement, Drawing, SubTable, TableReader
 from winder.parts._keys import CENTRE, NAME
+from winder.parts.flex import ROLL_FLEX_KEYS, RollFlexPart, parse_roll_flex
 
 if TYPE_CHECKING:
     from winder.model.machine import BodyState, Evaluation, Machine
 
-__all__ = ["RollPart", "RollBody", "ROLL_KINDS", "AXES", "UnwindTorqueDrive",
+__all__ = ["RollPart", "RollBody", "RollSegment", "ROLL_KINDS", "AXES", "UnwindTorqueDrive",
            "TensionControl", "UNWIND_DRIVE_KINDS", "KEYS", "DRIVE_KEYS", "check_core"]
 
 #: Kinds of paper roll: ``wound`` (radius grows) and ``unwinding`` (radius shrinks; fixed
@@ -64,6 +68,9 @@ KEYS = Table((
         doc="paper thickness h, added to the radius once per revolution"),
     Key(name="drive", kind="table", default_text="none (free)",
         doc="unwinding rolls only: the unwind drive, a sub-table: keys below"),
+    Key(name="flex", kind="table", default_text="none: a rigid roll",
+        doc="wound rolls only: a flexible roll along its width, a sub-table: keys below "
+            "(issue #25); its nips are sliced, one slice per segment"),
 ))
 
 #: The keys of an unwinding roll's ``drive``; ``kinds``: the keys each drive kind takes.
@@ -128,6 +135,7 @@ class RollPart:
     caliper: float
     held_z: float | None = None
     drive: UnwindTorqueDrive | TensionControl | None = None
+    flex: RollFlexPart | None = None
 
 
 def check_core(fail: Callable[[str, str, str], Exception], table: str,
@@ -188,7 +196,9 @@ class RollBody(BodyElement):
     role = "roll"
     KEYS = KEYS
     SUB_TABLES = {"drive": SubTable(DRIVE_KEYS, (UnwindTorqueDrive, TensionControl),
-                                    heading="drive (unwinding rolls)")}
+                                    heading="drive (unwinding rolls)"),
+                  "flex": SubTable(ROLL_FLEX_KEYS, (RollFlexPart,),
+                                   heading="flex (wound rolls)")}
     part_cls = RollPart
     CHANNELS = (
         Channel(name="ROLL_radius", unit="m", doc="radius r of a paper roll"),
@@ -235,7 +245,20 @@ class RollBody(BodyElement):
                                                   f"[paper] {key} to default to)")
                 kw[key] = getattr(reader.paper, key)
         check_core(reader.fail, label, kw)
+        if "flex" in raw:
+            if kw["kind"] != "wound":
+                raise reader.fail(label, "flex", "a flexible roll must be wound (kind = "
+                                                 "'wound'); valid: no flex on an unwinding "
+                                                 "roll")
+            kw["flex"] = parse_roll_flex(reader, label, raw["flex"])
         return RollPart(**kw)
+
+    @classmethod
+    def elements(cls, part: Any, placed: Any) -> list[Any]:
+        """A rigid roll: itself; a flexible one: its segments (:class:`RollSegment`)."""
+        if getattr(part, "flex", None) is None:
+            return [cls(part, placed)]
+        return [RollSegment(part, i, placed) for i in range(part.flex.segments)]
 
     @classmethod
     def initial_circle(cls, part: Any) -> tuple[tuple[float, float], float]:
@@ -250,8 +273,13 @@ class RollBody(BodyElement):
     def initial_radius(self) -> float:
         return float(self.part.initial_radius)
 
+    @property
+    def roll_key(self) -> str:
+        """The prefix of its radius state, parameters and core mode: its name."""
+        return self.name
+
     def declare(self, machine: Machine) -> None:
-        n, part = self.name, self.part
+        n, part = self.roll_key, self.part
         machine.state(f"{n}.radius", part.initial_radius)
         machine.parameter(f"{n}.core_radius", part.core_radius)
         machine.parameter(f"{n}.core_mass", part.core_mass)
@@ -328,3 +356,72 @@ class RollBody(BodyElement):
         ``r² = r₀² + h L/π`` [m] once ``L`` = ``length`` [m] of paper is wound on."""
         part = self.part
         return math.sqrt(part.initial_radius**2 + part.caliper * length / math.pi)
+
+
+
+class RollSegment(RollBody):
+    """Segment ``i`` of a flexible wound roll (issue #25): a body ``NAME_s{i}`` free along
+    the roll's ``free`` axes, with its share ``1/N`` of ``m(r)``, ``J(r)`` (a roll of width
+    ``L/N`` on ``1/N`` of the core) and so of the ``−Ẏv`` terms. All segments share one
+    radius state ``NAME.radius`` and the parameters ``NAME.core_radius``, ``NAME.width``,
+    ... (declared by segment 0); the radius grows with their mean speed,
+    ``ṙ = h · mean(speed_i) / 2π``, and segment 0 holds the core mode ``NAME.core``.
+    Bending (``EI(r)``, no bearings) and torsion: the force element ``flex_beam``."""
+
+    #: no bearings: carried by its nips
+    bearing_axes: tuple[str, ...] = ()
+
+    def __init__(self, part: Any, index: int, placed: Any = None) -> None:
+        super().__init__(part, placed)
+        flex = part.flex
+        self.index, self.segments, self.flex = index, flex.segments, flex
+        self.length = float(part.width)
+        self.roll = part.name
+        self.name = f"{part.name}_s{index}"
+        self.segment_of = part.name
+        self.drives = ("flex_beam",)
+
+    def drawing(self) -> Drawing:
+        h = self.length / self.segments
+        return replace(super().drawing(), width=h, y=(self.index + 0.5) * h - self.length / 2)
+
+    @property
+    def roll_key(self) -> str:
+        """The roll's name: its segments share its radius state and parameters."""
+        return self.roll
+
+    def declare(self, machine: Machine) -> None:
+        if self.index == 0:  # the roll's radius, parameters and core mode, once
+            super().declare(machine)
+
+    def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
+        n, mathns, N = self.roll, ev.mathns, self.segments
+        r = ev.x(f"{n}.radius")
+        rc = ev.p(f"{n}.core_radius")
+        k = math.pi * ev.p(f"{n}.density") * ev.p(f"{n}.width") / N
+        bs.mass, bs.inertia, bs.dm_dr, bs.dJ_dr = paper_roll_mass(
+            r, rc, ev.p(f"{n}.core_mass") / N, ev.p(f"{n}.core_inertia") / N, k)
+        rates = [ev.x(f"{n}_s{j}.theta_dot") for j in range(N)]
+        speed = self.sense * sum(rates[1:], rates[0]) / N
+        core = ev.mode(f"{n}.core")
+        at_core = mathns.logic_or(core == AT_CORE, mathns.logic_and(
+            core == CORE_AUTO, mathns.logic_and(r <= rc, speed < 0.0)))
+        bs.r = r
+        bs.r_dot = mathns.if_else(at_core, 0.0,
+                                  ev.p(f"{n}.caliper") / (2.0 * math.pi) * speed)
+        if self.index == 0:
+            ev.switches[f"{n}.unwound"] = rc - r
+            ev.switches[f"{n}.forward"] = speed
+            ev.set_rate(f"{n}.radius", bs.r_dot)
+
+    def radius_of(self, y: Any, machine: Machine) -> float:
+        """The roll's shared radius [m] in state ``y``."""
+        return float(y[machine.index(f"{self.roll}.radius")])
+
+    def transverse_inertia(self, ev: Evaluation, mass: Any, inertia: Any) -> Any:
+        """A cylinder of width ``L/N``."""
+        h = ev.p(f"{self.roll}.width") / self.segments
+        return 0.5 * inertia + mass * h * h / 12.0
+
+    def structure_tag(self) -> str:
+        return f"{super().structure_tag()}:{self.index}/{self.segments}"

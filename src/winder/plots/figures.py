@@ -300,7 +300,8 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     coordinate (``x``, ``z``) of every body, each ``z`` followed by its bounce (``z`` less
     its mean over 0.5 s, in mm); ``STEM_slip.png``: a row per nip with its slip
     velocity; with a web span, ``STEM_span.png``: the span tension, the controller's
-    tension error, the unwind torque and the radii. ``STEM`` is the scene name made
+    tension error, the unwind torque and the radii; flexible parts:
+    :func:`winder.plots.flex.flex_figures`. ``STEM`` is the scene name made
     file-safe; part names appear only in titles and legends. A nip keeps its colour in
     every figure. Returns the paths.
     """
@@ -422,7 +423,9 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
         if f"{pre}span_tension" in result:
             paths.append(_span_figure(result, scene, bodies, w, pre,
                                       out / f"{stem}_{pre}span.png", name))
-    return paths
+    from winder.plots.flex import flex_figures  # flexible parts (issue #25)
+
+    return paths + flex_figures(result, scene, out, stem, name, _save)
 
 
 def _drive(body: BodyElement) -> bool:

@@ -33,6 +33,16 @@ def _types(bodies: Bodies) -> list[tuple[Any, Sequence[Any]]]:
     return [(cls, bodies.get(attr, ())) for attr, cls in PARTS.items()]
 
 
+def _segments(types: list[tuple[Any, Sequence[Any]]], name: str) -> int | None:
+    """The number of segments of the flexible body ``name`` (None: rigid)."""
+    for _, parts in types:
+        for p in parts:
+            if p.name == name:
+                flex = getattr(p, "flex", None)
+                return None if flex is None else flex.segments
+    return None
+
+
 def _tables_text() -> str:
     """``a [[drum]], [[roll]] or [[rider]]``: the registered body types' tables."""
     tables = [f"[[{cls.table}]]" for cls in PARTS.values()]
@@ -85,6 +95,12 @@ def check_references(source: str, bodies: Bodies, nips: list[NipPart],
                         "assembled: neither can move to carry its normal force; valid "
                         "names: a roll free to move or a rider: "
                         f"{', '.join(n for n in body_names if n not in fixed) or '(none)'}")
+        na, nb = (_segments(types, getattr(nip, key)) for key in ("a", "b"))
+        if na and nb and na != nb:
+            raise fail(source, label, "b",
+                        f"{nip.b!r} has {nb} segments (flex) and {nip.a!r} {na}: both "
+                        "flexible bodies of a nip need the same number of segments, one "
+                        f"slice each; valid: segments = {na} on {nip.b!r}")
         pair = frozenset((nip.a, nip.b))
         if pair in pairs:
             raise fail(source, label, "b", f"{nip.b!r}: nip {pairs[pair]!r} already joins "

@@ -30,6 +30,7 @@ from winder.forces.contact import rest_penetration
 from winder.model.backends import NumericBackend
 from winder.model.locked_modes import AUTO, CORE_AUTO, FREE, IN_CONTACT, ModeKind
 from winder.model.machine import Machine, Nip
+from winder.model.slices import entry_slice
 from winder.parts import BodyElement as Body
 from winder.scene.naming import naming_of
 
@@ -76,7 +77,7 @@ def body_key(machine: Machine, body: Body) -> str:
 def nip_key(machine: Machine, nip: Nip, key: str = "stiffness") -> str:
     """The scene key of a nip's contact law (``[[nip]] 'rider_nip' contact stiffness``; the
     single-drum format: ``[contact] stiffness``)."""
-    return naming_of(machine.scene).key("nip", nip.name, "contact", key)
+    return naming_of(machine.scene).key("nip", nip.part.name, "contact", key)
 
 
 def balance_keys(machine: Machine, body: Body) -> list[str]:
@@ -136,7 +137,7 @@ def resting_state(machine: Machine, x: np.ndarray, p: np.ndarray, movable: set[s
     order = [b for b in machine.bodies if b.name in movable and b.free]
     rank = {b.name: i for i, b in enumerate(machine.bodies)}
     placed0 = {b.name for b in machine.bodies if b.name not in movable or not b.free}
-    supports = {b.name: [n for n in machine.nips if n.b is b and
+    supports = {b.name: [n for n in machine.nips if n.b is b and _whole(machine, n) and
                          (n.a.name in placed0 or rank[n.a.name] < rank[b.name])]
                 for b in order}
     delta = {n.name: 0.0 for n in machine.nips}
@@ -171,8 +172,9 @@ def resting_state(machine: Machine, x: np.ndarray, p: np.ndarray, movable: set[s
         for n in machine.nips:
             if n.b.name not in supports or n not in supports[n.b.name]:
                 continue
-            d = rest_penetration(n.part.contact.law, _law(machine, p, n), load[n.name],
-                                 dd.get(n.name, 0.0))
+            share = n.count if n.b.segment_of is None else 1  # slices under a rigid b
+            d = rest_penetration(n.part.contact.law, _law(machine, p, n),
+                                 load[n.name] / share, dd.get(n.name, 0.0))
             ra, rb = radius[n.a.name], radius[n.b.name]
             if not d < min(ra, rb):
                 raise EquilibriumError(_too_soft(machine, n, load[n.name], d, min(ra, rb)))
@@ -180,6 +182,15 @@ def resting_state(machine: Machine, x: np.ndarray, p: np.ndarray, movable: set[s
     for b in order:
         _place(machine, b, supports[b.name], x, centre, radius, delta)
     return Resting(x, load, delta)
+
+
+def _whole(machine: Machine, nip: Nip) -> bool:
+    """Whether ``nip`` is a support in the resting state: an unsliced nip, a slice under
+    a segment of a flexible ``b`` (each carries its own), or the middle slice of a sliced
+    nip under a rigid ``b`` (which carries the whole load there, its law ``1/count`` of
+    the nip's)."""
+    return nip.whole is None or nip.b.segment_of is not None or \
+        nip is entry_slice(machine.nips, nip.whole)
 
 
 def _too_soft(machine: Machine, n: Nip, load: float, d: float, r: float) -> str:

@@ -1,0 +1,144 @@
+"""µs per evaluation and compile time of flexible machines (issue #25; writes
+docs/flex_speed.md and .json).
+
+The single-drum winder with a flexible drum of N segments (the roll rigid on it, the nip
+sliced): N = 1 is the rigid drum. For each N: the time to generate and compile its code
+into an empty cache, the generated right-hand side and exact Jacobian called the way the
+compiled integrators call them (numba, through the function address), and the numeric
+Pinocchio path (``MachineSystem(scene, backend="pinocchio").rhs``). Best of repeats (the
+machine may be loaded).
+
+Run:  python benchmarks/flex_speed.py [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+import winder
+from winder.io.files import atomic_write
+from winder.solve import integrators as integ
+from winder.solve.system import MachineSystem
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from rhs_speed import _loop, best_us  # noqa: E402  (the sibling module)
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+SCENE = """
+[scene]
+name = "flex_speed"
+duration = 1.0
+output_step = 0.01
+
+[paper]
+density = 650.0
+caliper = 70e-6
+
+[[drum]]
+name = "drum"
+radius = 0.5
+inertia = 1400.0
+mass = 5740.0
+centre = [0.0, 0.0]
+drive = { kind = "speed_profile", web_acceleration = 0.7, web_speed = 41.7 }
+FLEX
+
+[[roll]]
+name = "roll"
+centre = [0.0, 0.8]
+free = ["z"]
+core_radius = 0.05
+core_mass = 40.0
+core_inertia = 0.1
+width = 8.0
+initial_radius = 0.3
+
+[[nip]]
+name = "nip"
+a = "drum"
+b = "roll"
+contact = { law = "linear", stiffness = 2.5e7, damping = 1.5e4 }
+friction = { mu = 0.35, slip_velocity = 0.05, relaxation_length = 0.01, min_speed = 0.1 }
+
+[web]
+entry_nip = "nip"
+tension = 1000.0
+"""
+
+
+def scene(n: int) -> winder.Scene:
+    flex = "" if n == 1 else (
+        f"length = 8.0\nflex = {{ segments = {n}, EI = 2.26e9, kGA = 3.7e9, GJ = 1.7e9, "
+        "bearing_stiffness = 1e10, damping_ratio = 0.02 }")
+    return winder.scene_from_dict(tomllib.loads(SCENE.replace("FLEX", flex)),
+                                  source=f"flex_speed_{n}.toml")
+
+
+def measure(n: int, quick: bool) -> dict[str, float]:
+    sc = scene(n)
+    with tempfile.TemporaryDirectory() as cache:
+        old = os.environ.get("WINDER_CACHE_DIR")
+        os.environ["WINDER_CACHE_DIR"] = cache
+        try:
+            t0 = time.perf_counter()
+            gen = MachineSystem(sc)
+            compile_s = time.perf_counter() - t0
+        finally:
+            if old is None:
+                del os.environ["WINDER_CACHE_DIR"]
+            else:
+                os.environ["WINDER_CACHE_DIR"] = old
+        y = gen.initial_state()
+        fns, p, m = gen.fns, gen.params, gen.modes
+        calls, reps = (200, 3) if quick else (2000, 5)
+        out_rhs, out_jac = np.empty(gen.n_states), np.empty(gen.n_states ** 2)
+        _loop(fns, integ.F_RHS, 0.1, y, p, m, out_rhs, 1)
+        rhs_us = best_us(lambda: _loop(fns, integ.F_RHS, 0.1, y, p, m, out_rhs, calls),
+                         1, reps) / calls
+        jac_us = best_us(lambda: _loop(fns, integ.F_JAC, 0.1, y, p, m, out_jac, calls),
+                         1, reps) / calls
+    num = MachineSystem(sc, backend="pinocchio")
+    k = 20 if quick else 100
+    num_us = best_us(lambda: [num.rhs(0.1, y) for _ in range(k)], k, reps)
+    return {"segments": n, "states": gen.n_states, "compile_s": compile_s,
+            "rhs_us": rhs_us, "jac_us": jac_us, "numeric_rhs_us": num_us}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="fewer calls and repeats")
+    args = ap.parse_args()
+    rows = []
+    for n in (1, 4, 8, 16):
+        rows.append(measure(n, args.quick))
+        print(rows[-1], flush=True)
+    lines = ["# Flexible drum: cost per evaluation and compile time", "",
+             "`python benchmarks/flex_speed.py`: the single-drum winder with a flexible "
+             "drum of N segments (N = 1: rigid), its nip sliced; generated code called "
+             "through its address (numba), the numeric Pinocchio path from Python; best "
+             "of repeats on a shared 2-core machine.", "",
+             "| N | states | compile [s] | rhs [µs] | Jacobian [µs] | numeric rhs [µs] |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['segments']} | {r['states']} | {r['compile_s']:.1f} | "
+                     f"{r['rhs_us']:.2f} | {r['jac_us']:.1f} | {r['numeric_rhs_us']:.0f} |")
+    text = "\n".join(lines) + "\n"
+    atomic_write(DOCS / "flex_speed.md", lambda p: p.write_text(text, encoding="utf-8"))
+    atomic_write(DOCS / "flex_speed.json",
+                 lambda p: p.write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8"))
+    print(text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,227 @@
+"""The elastic and damping forces of flexible bodies (issue #25): bending between the
+segments of each flexible body through the condensed beam, its bearings and its Rayleigh
+damping (:mod:`winder.model.beam`), and torsion between neighbouring segments.
+
+Called for by every segment of a flexible body (its ``drives``: ``("flex_beam",)``), so a
+machine without flexible bodies never builds it. Per flexible body ``NAME`` with segments
+``NAME_s0 … NAME_s{N−1}`` (deflections ``u_i = c_i − c`` from its ``centre`` [m], rates
+``u̇_i`` [m/s]; angles ``θ_i`` [rad] and rates ``θ̇_i`` [rad/s] about ``+y``):
+
+    f_x,i = −Σ_j Kx_ij u_x,j − Σ_j Cx_ij u̇_x,j     (and in z with Kz, Cz)     [N]
+    τ_i   = k_t (θ_{i+1} − θ_i) + c_t (θ̇_{i+1} − θ̇_i)  on i, its reaction on i + 1  [N·m]
+
+with the run-time parameters ``NAME.flex.Kx_i_j`` [N/m], ``NAME.flex.Cx_i_j`` [N·s/m]
+(``i ≤ j``, symmetric; ``Kz``, ``Cz`` likewise), ``NAME.flex.k_t`` [N·m/rad] and
+``NAME.flex.c_t`` [N·m·s/rad]. The bearings hold the axes a segment lists in
+``bearing_axes`` (a drum: ``x`` and ``z``; a rider: ``x``); along the others the beam is
+free–free (it rests on its nip). The
+torsion torques go in as spatial forces (they are not part of a segment's ``NAME_s{i}_torque``
+channel, which keeps machines.md §9's meaning). Channel ``NAME_twist`` [rad]: the drive
+end's angle minus the far end's, operation sense.
+
+A scene nip ``NIP`` against a flexible body is sliced (:mod:`winder.model.slices`): its
+slices ``NIP_s{i}`` have the generic nip channels; this element writes the scene nip's own:
+``NIP_normal_force`` and ``NIP_friction_force`` the sums over its slices,
+``NIP_slip_velocity`` their mean, ``NIP_penetration`` their largest, and the line load
+``F_i / (L/N)`` [N/m] of its slices, ``NIP_line_load_min``, ``_max`` and ``_mean``. It runs
+after the contact and the slip relaxation (``uses`` their ``steady_friction``). Each
+flexible body also has ``NAME_speed`` and ``NAME_angle``, its segments' mean, and a paper
+roll ``NAME_radius``, ``NAME_mass``, ``NAME_inertia`` and their rates (sums).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+from winder._schema import Channel
+from winder.forces._base import ForceElement
+from winder.model.channels import BODY_CHANNELS, NIP_CHANNELS
+
+if TYPE_CHECKING:
+    from winder.model.machine import Evaluation, Machine
+
+__all__ = ["FlexBeam", "TWIST", "LINE_LOAD"]
+
+#: A flexible body's twist.
+TWIST = Channel(name="BODY_twist", unit="rad",
+                doc="flexible drum or rider: twist, angle of segment 0 (drive end) minus that "
+                    "of the last segment, operation sense")
+
+#: A sliced nip's line load along its width: least, largest and mean over its slices.
+LINE_LOAD = (
+    Channel(name="NIP_line_load_min", unit="N/m",
+            doc="nip against a flexible body: least line load of its slices, F_i/(L/N)"),
+    Channel(name="NIP_line_load_max", unit="N/m",
+            doc="nip against a flexible body: largest line load of its slices"),
+    Channel(name="NIP_line_load_mean", unit="N/m",
+            doc="nip against a flexible body: mean line load of its slices"),
+)
+
+
+class FlexBeam(ForceElement):
+    """Bending (condensed beam, bearings, Rayleigh damping) and torsion of flexible
+    bodies."""
+
+    name = "flex_beam"
+    doc = "bending and torsion between the segments of a flexible body"
+    provides = frozenset({"spatial_force"})
+    uses = frozenset({"steady_friction"})
+    CHANNELS = (TWIST, *LINE_LOAD)
+
+    def __init__(self) -> None:
+        #: the segment bodies of each flexible body, by its name, drive end first
+        self.groups: dict[str, list[Any]] = {}
+        #: the slices of each sliced scene nip, by its name
+        self.sliced: dict[str, list[Any]] = {}
+
+    def declare(self, machine: Machine) -> None:
+        from winder.model.beam import beam_matrices  # NumPy: not for checking a scene
+
+        self.groups = {}
+        for b in machine.bodies:
+            if self.name in b.drives:
+                self.groups.setdefault(b.segment_of, []).append(b)
+        for body, segs in self.groups.items():
+            segs.sort(key=lambda s: s.index)
+            first = segs[0]
+            flex, part, n = first.flex, first.part, len(segs)
+            if hasattr(flex, "core_EI"):  # a paper roll: EI(r), no bearings
+                unit = beam_matrices(n, first.length, float(n), 1.0, None, 0.0, 0.0, 0.0,
+                                     flex.GJ)
+                for i in range(n):
+                    for j in range(i, n):
+                        machine.parameter(f"{body}.flex.K1_{i}_{j}", unit.K[i, j])
+                machine.parameter(f"{body}.flex.mu1", unit.omega1 ** 2)
+                machine.parameter(f"{body}.flex.damping_ratio", flex.damping_ratio)
+                machine.parameter(f"{body}.flex.core_EI", flex.core_EI)
+                machine.parameter(f"{body}.flex.paper_E", flex.paper_E)
+                machine.parameter(f"{body}.flex.k_t", unit.k_t)
+                machine.channel(TWIST, body)
+                continue
+            for axis in ("x", "z"):
+                held = axis in first.bearing_axes
+                bm = beam_matrices(n, first.length, part.mass, flex.EI,
+                                   flex.kGA if flex.shear else None,
+                                   flex.bearing_stiffness if held else 0.0,
+                                   flex.bearing_damping if held else 0.0,
+                                   flex.damping_ratio, flex.GJ)
+                for kind, matrix in (("K", bm.K), ("C", bm.C)):
+                    for i in range(n):
+                        for j in range(i, n):
+                            machine.parameter(f"{body}.flex.{kind}{axis}_{i}_{j}",
+                                              matrix[i, j])
+            machine.parameter(f"{body}.flex.k_t", bm.k_t)  # the same for x and z
+            machine.parameter(f"{body}.flex.c_t", bm.c_t)
+            machine.channel(TWIST, body)
+        for body, segs in self.groups.items():  # the whole body's own channels
+            for ch in (*BODY_CHANNELS[:2], *(segs[0].CHANNELS if segs[0].radius_state
+                                             else ())):
+                machine.channel(ch, body)
+        self.sliced = {}
+        for nip in machine.nips:
+            if nip.whole is not None:
+                self.sliced.setdefault(nip.whole, []).append(nip)
+        for whole in self.sliced:
+            for ch in (*NIP_CHANNELS, *LINE_LOAD):
+                machine.channel(ch, whole)
+
+    def structure_tag(self, machine: Machine) -> str:
+        return ",".join(f"{body}:{len(segs)}" for body, segs in self.groups.items())
+
+    @staticmethod
+    def _roll_bending(ev: Evaluation, body: str, segs: list[Any], states: list[Any],
+                      ux: list[Any], uz: list[Any]) -> tuple[Any, Any]:
+        """A paper roll's bending, ``EI(r) K₁ (u + β u̇)`` with ``EI(r) = core_EI +
+        paper_E·π (r⁴ − r_c⁴)/4`` [N·m²] and ``β = 2ζ/ω₁(r)``, ``ω₁² = EI μ₁ / (m/N)``
+        (``K₁``, ``μ₁``: the free–free chain of unit ``EI`` and unit segment mass); its
+        torsion spring and damper ``(k_t, β k_t)``."""
+        p = ev.p
+        r, rc = states[0].r, p(f"{body}.core_radius")
+        r2, rc2 = r * r, rc * rc
+        ei = p(f"{body}.flex.core_EI") + p(f"{body}.flex.paper_E") * math.pi \
+            * (r2 * r2 - rc2 * rc2) / 4.0
+        beta = 2.0 * p(f"{body}.flex.damping_ratio") \
+            / ev.mathns.sqrt(ei * p(f"{body}.flex.mu1") / states[0].mass)
+        free = segs[0].free
+        for i, seg in enumerate(segs):
+            fx: Any = 0.0
+            fz: Any = 0.0
+            for j, bs in enumerate(states):
+                k = ei * p(f"{body}.flex.K1_{min(i, j)}_{max(i, j)}")
+                fx = fx - k * (ux[j] + beta * bs.vx)
+                fz = fz - k * (uz[j] + beta * bs.vz)
+            ev.add_force(seg.name, fx if "x" in free else 0.0, fz if "z" in free else 0.0)
+        kt = p(f"{body}.flex.k_t")
+        return kt, beta * kt
+
+    @staticmethod
+    def _body_channels(ev: Evaluation, body: str, segs: list[Any], states: list[Any]
+                       ) -> None:
+        """The whole body's ``NAME_speed`` and ``NAME_angle`` (its segments' mean) and, for a
+        paper roll, ``NAME_radius`` and the sums of its segments' mass, inertia and their
+        rates."""
+        n, s = len(states), segs[0].sense
+        speed, angle = BODY_CHANNELS[:2]
+        ev.output(speed, body, s * sum(bs.omega for bs in states) / n)
+        ev.output(angle, body, s * sum(bs.theta for bs in states) / n)
+        if segs[0].radius_state:
+            values = (states[0].r, sum(bs.mass for bs in states),
+                      sum(bs.inertia for bs in states), sum(bs.mass_rate for bs in states),
+                      sum(bs.inertia_rate for bs in states))
+            for ch, value in zip(segs[0].CHANNELS, values, strict=True):
+                ev.output(ch, body, value)
+
+    def _nip_channels(self, ev: Evaluation) -> None:
+        """The sliced scene nips' own channels (see the module text)."""
+        mathns = ev.mathns
+        normal, friction, slip, penetration = NIP_CHANNELS
+        for whole, slices in self.sliced.items():
+            states = [ev.nips[s.name] for s in slices]
+            n, h = len(states), slices[0].slice_length
+            fn = [ns.normal_force for ns in states]
+            total, least, most, deepest = fn[0], fn[0], fn[0], states[0].delta
+            ft, vs = states[0].friction_force, states[0].v_s
+            for ns, f in zip(states[1:], fn[1:], strict=True):
+                total, ft, vs = total + f, ft + ns.friction_force, vs + ns.v_s
+                least, most = mathns.fmin(least, f), mathns.fmax(most, f)
+                deepest = mathns.fmax(deepest, ns.delta)
+            ev.output(normal, whole, total)
+            ev.output(friction, whole, ft)
+            ev.output(slip, whole, vs / n)
+            ev.output(penetration, whole, deepest)
+            lo, hi, mean = LINE_LOAD
+            ev.output(lo, whole, least / h)
+            ev.output(hi, whole, most / h)
+            ev.output(mean, whole, total / (n * h))
+
+    def apply(self, ev: Evaluation) -> None:
+        for body, segs in self.groups.items():
+            n = len(segs)
+            states = [ev.bodies[s.name] for s in segs]
+            cx, cz = segs[0].centre
+            ux = [bs.cx - cx for bs in states]
+            uz = [bs.cz - cz for bs in states]
+
+            def entry(kind: str, i: int, j: int, body: str = body) -> Any:
+                return ev.p(f"{body}.flex.{kind}_{min(i, j)}_{max(i, j)}")
+
+            if hasattr(segs[0].flex, "core_EI"):
+                kt, ct = self._roll_bending(ev, body, segs, states, ux, uz)
+            else:
+                for i, seg in enumerate(segs):
+                    fx: Any = 0.0
+                    fz: Any = 0.0
+                    for j, bs in enumerate(states):
+                        fx = fx - entry("Kx", i, j) * ux[j] - entry("Cx", i, j) * bs.vx
+                        fz = fz - entry("Kz", i, j) * uz[j] - entry("Cz", i, j) * bs.vz
+                    ev.add_force(seg.name, fx, fz)
+                kt, ct = ev.p(f"{body}.flex.k_t"), ev.p(f"{body}.flex.c_t")
+            for i in range(n - 1):
+                a, b = states[i], states[i + 1]
+                tq = kt * (b.theta - a.theta) + ct * (b.omega - a.omega)
+                ev.add_spatial_force(segs[i].name, [0.0, 0.0, 0.0, 0.0, tq, 0.0])
+                ev.add_spatial_force(segs[i + 1].name, [0.0, 0.0, 0.0, 0.0, -tq, 0.0])
+            ev.output(TWIST, body, segs[0].sense * (states[0].theta - states[-1].theta))
+            self._body_channels(ev, body, segs, states)
+        self._nip_channels(ev)

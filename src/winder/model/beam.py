@@ -1,0 +1,135 @@
+"""A beam on two end bearings condensed onto N lumped segments (issue #25): the bending
+stiffness, the bearings' damping and the Rayleigh coefficient of a flexible body.
+
+The body of length ``L`` [m] is cut into ``N`` segments of length ``h = L/N``; segment
+``i`` is a mass ``m/N`` at its centre, the station ``y_i = (i + ½) h``. Its deflection
+``w_i`` (along ``x``, and separately the same way along ``z``) is its centre's offset from
+the line of support.
+
+**Stiffness: beam finite elements between the stations, condensed.** The nodes are the
+two bearings (``y = 0`` and ``y = L``) and the ``N`` stations, each node with a deflection
+``w`` and a slope ``ψ``; between neighbouring nodes one two-node Timoshenko element of
+length ``l`` (``h/2`` at the ends, ``h`` between stations) with ``Φ = 12 EI / (kGA l²)``
+(``Φ = 0``: Euler–Bernoulli)::
+
+    k_e = EI / ((1 + Φ) l³) · [[ 12,   6l,          −12,  6l         ],
+                               [ 6l,   (4 + Φ) l²,  −6l,  (2 − Φ) l² ],
+                               [−12,  −6l,           12, −6l         ],
+                               [ 6l,   (2 − Φ) l²,  −6l,  (4 + Φ) l² ]]
+
+and a spring ``k_b`` (``bearing_stiffness``) on ``w`` of each bearing node. Only the
+stations carry mass, so every other degree of freedom (the slopes and the bearings'
+deflections) is condensed statically (Guyan): with ``r`` the stations' ``w`` and ``c`` the
+rest, ``K = K_rr − K_rc K_cc⁻¹ K_cr`` [N/m] (N × N). This element is exact for a beam
+loaded at its nodes (shear included), so ``K`` is the exact inverse of the beam's
+flexibility at the stations: the discrete closed form of the chain is
+
+    K⁻¹ = F,  F_ij = δ(y_i; load at y_j)  (bending + shear + the bearings' springs)
+
+with, for a beam on two bearings (``a`` the load's station, ``b = L − a``, ``x ≤ a``)
+``δ = x b (L² − b² − x²) / (6 EI L) + x b / (kGA L) + ((L − x) b + x a) / (k_b L²)``
+(and its mirror for ``x > a``); the tests check the machine against it.
+
+**Damping.** The bearings' dashpots ``c_b`` (``bearing_damping``) act on the condensed
+bearing deflections ``w_b = T w`` (``T = −K_cc⁻¹ K_cr``, its bearing rows): projected
+onto the stations, ``C_b = c_b Σ_ends t_endᵀ t_end``. The beam's own damping is
+stiffness-proportional (Rayleigh, ``β K``) with ``β = 2 ζ / ω₁``: the first bending mode
+(the lowest non-zero ``ω`` of ``K w = ω² (m/N) w``) has the damping ratio ``ζ``
+(``damping_ratio``); the rigid-body modes of a free beam are not damped. Torsion uses the
+same ``β``.
+
+**Torsion.** Neighbouring segments are joined by a spring ``k_t = GJ / h`` [N·m/rad]; a
+chain of ``N`` free disks ``I_d`` has ``ω_k = 2 √(k_t / I_d) sin(k π / 2N)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["BeamMatrices", "beam_matrices", "element_stiffness", "station_flexibility"]
+
+
+@dataclass(frozen=True)
+class BeamMatrices:
+    """The condensed matrices of a flexible body: ``K`` [N/m] and ``C`` [N·s/m] (N × N,
+    on the stations' deflections, ``C = β K + C_b``), ``beta`` [s] the Rayleigh
+    coefficient, ``omega1`` [rad/s] the first bending frequency (``0``: none),
+    ``k_t`` [N·m/rad] and ``c_t = β k_t`` [N·m·s/rad] the torsion spring and damper
+    between neighbouring segments."""
+
+    K: np.ndarray
+    C: np.ndarray
+    beta: float
+    omega1: float
+    k_t: float
+    c_t: float
+
+
+def element_stiffness(EI: float, kGA: float | None, length: float) -> np.ndarray:
+    """The 4 × 4 stiffness of a two-node Timoshenko element of ``length`` [m] on ``(w₁,
+    ψ₁, w₂, ψ₂)`` [N/m, N, N·m]; ``kGA`` None: Euler–Bernoulli (``Φ = 0``)."""
+    ll = length
+    phi = 0.0 if kGA is None else 12.0 * EI / (kGA * ll * ll)
+    return EI / ((1.0 + phi) * ll ** 3) * np.array([
+        [12.0, 6 * ll, -12.0, 6 * ll],
+        [6 * ll, (4 + phi) * ll * ll, -6 * ll, (2 - phi) * ll * ll],
+        [-12.0, -6 * ll, 12.0, -6 * ll],
+        [6 * ll, (2 - phi) * ll * ll, -6 * ll, (4 + phi) * ll * ll]])
+
+
+def beam_matrices(n: int, length: float, mass: float, EI: float, kGA: float | None,
+                  bearing_stiffness: float, bearing_damping: float, damping_ratio: float,
+                  GJ: float) -> BeamMatrices:
+    """The condensed matrices of a body of ``length`` [m] and ``mass`` [kg] in ``n`` ≥ 2
+    segments (see the module text): ``EI`` [N·m²], ``kGA`` [N] (None: no shear),
+    ``bearing_stiffness`` [N/m] and ``bearing_damping`` [N·s/m] per end and direction,
+    ``damping_ratio`` [-] of the first bending mode, ``GJ`` [N·m²]."""
+    if n < 2:
+        raise ValueError(f"beam_matrices: n must be at least 2, got {n}")
+    h = length / n
+    stations = n + 2  # bearing, n stations, bearing
+    lengths = [h / 2, *([h] * (n - 1)), h / 2]
+    full = np.zeros((2 * stations, 2 * stations))
+    for e, le in enumerate(lengths):
+        dofs = slice(2 * e, 2 * e + 4)
+        full[dofs, dofs] += element_stiffness(EI, kGA, le)
+    ends = (0, 2 * (stations - 1))
+    for d in ends:
+        full[d, d] += bearing_stiffness
+    kept = [2 * (i + 1) for i in range(n)]
+    rest = [d for d in range(2 * stations) if d not in kept]
+    Krr, Krc = full[np.ix_(kept, kept)], full[np.ix_(kept, rest)]
+    Kcc = full[np.ix_(rest, rest)]
+    T = -np.linalg.solve(Kcc, Krc.T)  # condensed dofs per unit station deflection
+    K = Krr + Krc @ T
+    K = 0.5 * (K + K.T)
+    tb = T[[rest.index(d) for d in ends], :]
+    Cb = bearing_damping * (tb.T @ tb)
+    w2 = np.linalg.eigvalsh(K / (mass / n))
+    scale = max(float(np.max(np.abs(w2))), 1e-300)
+    bending = w2[w2 > 1e-9 * scale]
+    omega1 = float(np.sqrt(bending[0])) if bending.size else 0.0
+    beta = 2.0 * damping_ratio / omega1 if omega1 > 0.0 else 0.0
+    k_t = GJ / h
+    return BeamMatrices(K, beta * K + Cb, beta, omega1, k_t, beta * k_t)
+
+
+def station_flexibility(n: int, length: float, EI: float, kGA: float | None,
+                        bearing_stiffness: float) -> np.ndarray:
+    """The closed form ``F`` [m/N] of the module text: the deflection at each station per
+    unit load at each station of a beam on two bearings (bending, shear where ``kGA`` is
+    given, and the bearings' springs ``k_b`` > 0)."""
+    L, h = length, length / n
+    y = (np.arange(n) + 0.5) * h
+    F = np.empty((n, n))
+    for i, x0 in enumerate(y):
+        for j, a0 in enumerate(y):
+            x, a = (x0, a0) if x0 <= a0 else (L - x0, L - a0)
+            b = L - a
+            F[i, j] = x * b * (L * L - b * b - x * x) / (6 * EI * L)
+            if kGA is not None:
+                F[i, j] += x * b / (kGA * L)
+            F[i, j] += ((L - x0) * (L - a0) + x0 * a0) / (bearing_stiffness * L * L)
+    return F
