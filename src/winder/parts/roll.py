@@ -24,7 +24,8 @@ if TYPE_CHECKING:
     from winder.model.machine import BodyState, Evaluation, Machine
 
 __all__ = ["RollPart", "RollBody", "RollSegment", "ROLL_KINDS", "AXES", "UnwindTorqueDrive",
-           "TensionControl", "UNWIND_DRIVE_KINDS", "KEYS", "DRIVE_KEYS", "check_core"]
+           "TensionControl", "UNWIND_DRIVE_KINDS", "KEYS", "DRIVE_KEYS", "check_core",
+           "winding_rate"]
 
 #: Kinds of paper roll: ``wound`` (radius grows) and ``unwinding`` (radius shrinks; fixed
 #: centre, the start of a web span).
@@ -87,6 +88,22 @@ DRIVE_KEYS = Table((
         doc="kind tension_control: the closed loop's bandwidth ω_c (its three poles at "
             "−ω_c)"),
 ), kinds={"torque": ("kind", "torque"), "tension_control": ("kind", "tension", "bandwidth")})
+
+
+def winding_rate(ev: Evaluation, n: str, r: Any, rc: Any, speed: Any, *,
+                 switches: bool = True) -> Any:
+    """Spec §2: the radius rate ``ṙ = h·speed/2π`` [m/s] of the winding roll ``n``, held at
+    0 at its core (``r <= r_c``) while it turns backwards (its core mode); with
+    ``switches``, the switching functions ``n.unwound = r_c − r`` and ``n.forward =
+    speed`` the core events are located on. ``speed`` [rad/s] in the roll's sense."""
+    mathns = ev.mathns
+    core = ev.mode(f"{n}.core")
+    at_core = mathns.logic_or(core == AT_CORE, mathns.logic_and(
+        core == CORE_AUTO, mathns.logic_and(r <= rc, speed < 0.0)))
+    if switches:
+        ev.switches[f"{n}.unwound"] = rc - r
+        ev.switches[f"{n}.forward"] = speed
+    return mathns.if_else(at_core, 0.0, ev.p(f"{n}.caliper") / (2.0 * math.pi) * speed)
 
 
 @dataclass(frozen=True)
@@ -306,25 +323,19 @@ class RollBody(BodyElement):
         return {} if h is None else {"z": h}
 
     def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
-        n, mathns = self.name, ev.mathns
+        n = self.name
         r = ev.x(f"{n}.radius")
         rc = ev.p(f"{n}.core_radius")
         k = math.pi * ev.p(f"{n}.density") * ev.p(f"{n}.width")
         bs.mass, bs.inertia, bs.dm_dr, bs.dJ_dr = paper_roll_mass(
             r, rc, ev.p(f"{n}.core_mass"), ev.p(f"{n}.core_inertia"), k)
-        h2pi = ev.p(f"{n}.caliper") / (2.0 * math.pi)
         speed = bs.speed
         bs.r = r
         if self.unwinding:  # machines.md §1: ṙ = −h·speed/2π, down to the core
-            bs.r_dot = -h2pi * speed
+            bs.r_dot = -(ev.p(f"{n}.caliper") / (2.0 * math.pi)) * speed
             ev.switches[f"{n}.exhausted"] = rc - r
         else:
-            core = ev.mode(f"{n}.core")
-            at_core = mathns.logic_or(core == AT_CORE, mathns.logic_and(
-                core == CORE_AUTO, mathns.logic_and(r <= rc, speed < 0.0)))
-            bs.r_dot = mathns.if_else(at_core, 0.0, h2pi * speed)
-            ev.switches[f"{n}.unwound"] = rc - r
-            ev.switches[f"{n}.forward"] = speed
+            bs.r_dot = winding_rate(ev, n, r, rc, speed)
         ev.set_rate(f"{n}.radius", bs.r_dot)
 
     def transverse_inertia(self, ev: Evaluation, mass: Any, inertia: Any) -> Any:
@@ -395,7 +406,7 @@ class RollSegment(RollBody):
             super().declare(machine)
 
     def kinematics(self, ev: Evaluation, bs: BodyState) -> None:
-        n, mathns, N = self.roll, ev.mathns, self.segments
+        n, N = self.roll, self.segments
         r = ev.x(f"{n}.radius")
         rc = ev.p(f"{n}.core_radius")
         k = math.pi * ev.p(f"{n}.density") * ev.p(f"{n}.width") / N
@@ -403,15 +414,9 @@ class RollSegment(RollBody):
             r, rc, ev.p(f"{n}.core_mass") / N, ev.p(f"{n}.core_inertia") / N, k)
         rates = [ev.x(f"{n}_s{j}.theta_dot") for j in range(N)]
         speed = self.sense * sum(rates[1:], rates[0]) / N
-        core = ev.mode(f"{n}.core")
-        at_core = mathns.logic_or(core == AT_CORE, mathns.logic_and(
-            core == CORE_AUTO, mathns.logic_and(r <= rc, speed < 0.0)))
         bs.r = r
-        bs.r_dot = mathns.if_else(at_core, 0.0,
-                                  ev.p(f"{n}.caliper") / (2.0 * math.pi) * speed)
+        bs.r_dot = winding_rate(ev, n, r, rc, speed, switches=self.index == 0)
         if self.index == 0:
-            ev.switches[f"{n}.unwound"] = rc - r
-            ev.switches[f"{n}.forward"] = speed
             ev.set_rate(f"{n}.radius", bs.r_dot)
 
     def radius_of(self, y: Any, machine: Machine) -> float:
