@@ -40,7 +40,7 @@ from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
            "stats", "Link", "compile_flags", "link_flags", "run_compiler",
-           "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash"]
+           "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash", "write_source"]
 
 #: The generated functions, in the order of :attr:`Generated.addresses`.
 FUNCTIONS = ("rhs", "jac", "out", "sw")
@@ -232,6 +232,24 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Pat
     return path
 
 
+def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
+    """The cache key of a machine's generated code (:func:`generate`)."""
+    return hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(),
+                                    route, " ".join(cflags))).encode()).hexdigest()[:20]
+
+
+def write_source(machine: Machine, directory: Path, *, route: str | None = None
+                 ) -> tuple[Path, str]:
+    """Write the machine's generated C (the code :func:`generate` compiles, with its flat
+    entry points ``SYMBOL_{rhs,jac,out,sw}_flat``) into ``directory``: its path and
+    ``SYMBOL`` (for an FMU's ``sources/``; imports CasADi)."""
+    from winder.model.backends import default_route
+
+    route = default_route() if route is None else route
+    symbol = f"w{_key(machine, route, compile_flags())}"
+    return _c_source(machine, symbol, Path(directory), route), symbol
+
+
 @dataclass(frozen=True)
 class Link:
     """Objects linked into every machine's library, and a key of their sources and
@@ -253,8 +271,7 @@ def generate(machine: Machine, *, directory: Path | None = None,
 
     route = default_route() if route is None else route
     cflags = compile_flags()
-    key = hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(), route,
-                                   " ".join(cflags))).encode()).hexdigest()[:20]
+    key = _key(machine, route, cflags)
     symbol = f"w{key}"
     root = Path(directory) if directory is not None else cache_dir() / "generated"
     obj = root / f"{symbol}.o"
