@@ -291,11 +291,14 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
 
     out = check_output_file(args.out, "-o/--out", suffixes=(".fmu",))
     from winder.fmu.build import build_fmu
+    from winder.fmu.native import build_native_fmu
 
-    out = build_fmu(args.scene, out)
-    print(f"FMI 2.0 co-simulation FMU written to {out}")
-    print(f"  runs inside the host's Python: needs winder installed there (built with "
-          f"{sys.executable})")
+    out = (build_native_fmu if args.native else build_fmu)(args.scene, out)
+    print(f"FMI 2.0 co-simulation FMU{' (native: no Python inside)' * args.native} written "
+          f"to {out}\n  " + ("binaries/linux64 from the system C compiler; sources/ rebuild "
+                             "it elsewhere (fmpy compile)" if args.native else
+                             "runs inside the host's Python: needs winder installed there "
+                             f"(built with {sys.executable})"))
     if args.check:
         print("  " + _check_fmu(out))
     return 0
@@ -487,6 +490,9 @@ def _build_parser() -> argparse.ArgumentParser:
     fmu.add_argument("-o", "--out", default="winder.fmu", help="FMU file (default winder.fmu)")
     fmu.add_argument("--check", action=argparse.BooleanOptionalAction, default=True,
                      help="load the built FMU with FMPy and step it (default on)")
+    fmu.add_argument("--native", action="store_true",
+                     help="the compiled machine and C integrators behind FMI 2.0, no Python "
+                          "inside (binaries/linux64 and sources/; needs a C compiler)")
     fmu.set_defaults(func=_cmd_fmu)
     modes = sub.add_parser("modes", help="bounce modes against the wound roll's radius and "
                            "the rotation harmonics (resonance map)")
