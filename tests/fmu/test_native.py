@@ -123,7 +123,7 @@ def test_archive_has_no_python(paper_fmu, tmp_path, paper_scene) -> None:
         zf.extractall(tmp_path)
     so = tmp_path / "binaries" / "linux64" / f"{model}.so"
     assert so.is_file()
-    assert {"sources/fmi2_cs.c", "sources/dopri5.c", "sources/rk4.c", "sources/events.h",
+    assert {"sources/fmi2.c", "sources/dopri5.c", "sources/rk4.c", "sources/events.h",
             "sources/winder_model.h", "sources/fmi2Functions.h",
             "sources/LICENSE-FMI-headers.txt"} <= names
     assert "BSD" in (tmp_path / "sources" / "LICENSE-FMI-headers.txt").read_text()
@@ -403,6 +403,12 @@ def test_run_out_discards(tmp_path, models_dir) -> None:
     text = "\n".join(log)
     assert "[logStatusDiscard]" in text and "'parent' ran out of web" in text
     assert sim.ended.split(" at t")[0] in text and "the run has ended" in text
+    # model exchange: the end's event indicator stops the run there (terminateSimulation)
+    res = fmpy.simulate_fmu(str(fmu_path), fmi_type="ModelExchange", stop_time=4.0,
+                            output_interval=0.01, relative_tolerance=1e-8,
+                            output=["parent_radius"])
+    assert res["time"][-1] == pytest.approx(t, abs=1e-3)
+    assert res["parent_radius"][-1] == pytest.approx(0.4, abs=1e-6)
 
 
 # ---- a plain C host under AddressSanitizer ------------------------------------------------
@@ -432,3 +438,57 @@ def test_c_host_under_asan(tmp_path, models_dir) -> None:
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "Sanitizer" not in proc.stderr and "runtime error" not in proc.stderr
     assert "1000 cycles" in proc.stdout and "same radius" in proc.stdout, proc.stdout
+
+
+# ---- model exchange --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("which,file", [("paper_fmu", "paper_winding.toml"),
+                                        ("two_drum_fmu", "two_drum_winder.toml"),
+                                        ("line_fmu", "winder_line_fmu.toml")])
+def test_model_exchange_matches_simulate(which, file, request, models_dir) -> None:
+    """FMPy's CVode (rtol 1e-8) on the model-exchange interface, 2 s, against
+    winder.simulate (DOPRI5, rtol 1e-8) sampled every 10 ms: radii to 1e-6 m (measured
+    4e-13), speeds and forces to 1e-4 of their largest magnitude (measured at most 8e-5,
+    z_dot of the paper scene; the contact events switch the modes in
+    fmi2NewDiscreteStates)."""
+    path = request.getfixturevalue(which)
+    ref = winder.simulate(winder.load_scene(models_dir / file), t_end=2.0, output_step=0.01,
+                          method="DOPRI5", rtol=1e-8, atol=1e-10)
+    names = [k for k in _outputs(path) if k != "t"]
+    res = fmpy.simulate_fmu(str(path), fmi_type="ModelExchange", solver="CVode",
+                            stop_time=2.0, output_interval=0.01, relative_tolerance=1e-8,
+                            output=names)
+    assert res["time"][-1] == pytest.approx(2.0)
+    checked = 0
+    for k in names:
+        got = np.interp(ref.t, res["time"], res[k])
+        if k == "radius" or k.endswith("_radius"):
+            assert np.max(np.abs(got - ref[k])) < 1e-6, k
+            checked += 1
+        elif k.endswith(("speed", "force", "_dot")):
+            scale = max(float(np.max(np.abs(ref[k]))), 1e-9)
+            assert np.max(np.abs(got - ref[k])) / scale < 1e-4, k
+            checked += 1
+    assert checked >= 5
+
+
+def test_model_structure_from_the_jacobian(two_drum_fmu, models_dir) -> None:
+    """numberOfEventIndicators: the switching functions the mode table refers to; each
+    derivative's dependencies are the structural nonzeros of the generated Jacobian:
+    they contain every numerical nonzero at a state of the run, and an angle's rate
+    depends on its speed alone."""
+    from winder.fmu.native import indicators
+
+    scene = winder.load_scene(models_dir / "two_drum_winder.toml")
+    sy = winder.Stepper(scene).system
+    md = fmpy.read_model_description(str(two_drum_fmu))
+    assert md.numberOfEventIndicators == len(indicators(sy)) == 5  # core 2, 3 nips
+    deps = {u.variable.name: {d.name for d in u.dependencies}
+            for u in md.derivatives}
+    assert list(deps) == [f"der({n})" for n in sy.state_names]
+    assert deps["der(set.theta)"] == {"set.theta_dot"}
+    y = sy.initial_state() * (1 + 1e-3)
+    J = sy.jac(0.5, y)
+    for i, name in enumerate(sy.state_names):
+        numeric = {sy.state_names[j] for j in np.nonzero(J[i])[0]}
+        assert numeric <= deps[f"der({name})"], name

@@ -4,7 +4,7 @@
 The archive holds ``binaries/linux64/MODEL.so``, built with the system C compiler from
 the machine's generated C (:func:`winder.model.codegen.write_source`: the same functions
 :func:`winder.simulate` calls), winder's C integrators (``solve/c/``: the same DOPRI5 and
-RK4 with located events and switched modes) and the wrapper ``fmu/c/fmi2_cs.c``;
+RK4 with located events and switched modes) and the wrapper ``fmu/c/fmi2.c``;
 ``sources/`` with all of them, the machine's data (``winder_model.h``) and the FMI 2.0
 headers of FMPy's ``c-code/`` (BSD-2, their license beside them), listed in
 ``<SourceFiles>`` so that ``fmpy compile`` rebuilds it for another platform; and
@@ -152,7 +152,7 @@ def _runtime_parameters(scene: Scene, machine: Machine
 
 def native_interface(scene: Scene) -> NativeInterface:
     """The variables of ``scene``'s native FMU, with value references in the wrapper's
-    layout (``fmu/c/fmi2_cs.c``): outputs, inputs, parameters, solver settings, states,
+    layout (``fmu/c/fmi2.c``): outputs, inputs, parameters, solver settings, states,
     derivatives."""
     system = MachineSystem(scene)
     if system.generated is None:
@@ -234,14 +234,14 @@ def _model_header(iface: NativeInterface, symbol: str, guid: str) -> str:
     sy, m = iface.system, iface.system.machine
     owners = [f'"{mode.owner}"' for mode in m.modes] + ["0"]
     lines = [
-        "/* The machine of one scene for fmi2_cs.c (written by winder.fmu.native). */",
+        "/* The machine of one scene for fmi2.c (written by winder.fmu.native). */",
         "#ifndef WINDER_MODEL_H", "#define WINDER_MODEL_H", "#include <stdint.h>",
         f'#define W_GUID "{guid}"',
         f"#define W_N {sy.n_states}", f"#define W_NP {len(m.param_names)}",
         f"#define W_NSLOTS {len(sy.table)}", f"#define W_NSW {len(m.switch_names)}",
         f"#define W_NCH {len(m.channel_names)}", f"#define W_NOUT {len(iface.outputs)}",
         f"#define W_NIN {len(iface.inputs)}", f"#define W_NPAR {len(iface.parameters)}",
-        f"#define W_NRAMP {len(iface.ramps)}",
+        f"#define W_NRAMP {len(iface.ramps)}", f"#define W_NZ {len(indicators(sy))}",
     ]
     for k in ("rhs", "jac", "out", "sw"):
         lines.append(f"int {symbol}_{k}_flat(const double* t, const double* x, "
@@ -255,8 +255,36 @@ def _model_header(iface: NativeInterface, symbol: str, guid: str) -> str:
     text += _c_array("int", "W_IN_P", iface.input_params)
     text += _c_array("int", "W_PAR_P", iface.parameter_params)
     text += _c_array("int", "W_RAMP", [i for r in iface.ramps for i in r])
+    text += _c_array("int", "W_Z", indicators(sy))
     text += f"static const char* const W_SLOT_OWNER[] = {{{', '.join(owners)}}};\n"
     return text + "#endif\n"
+
+
+def indicators(system: MachineSystem) -> list[int]:
+    """The event indicators of model exchange: the switching functions (indices into
+    ``machine.switch_names``) the mode table switches on, in the table's order: a
+    contact's ``g1``, a core's ``g1`` and ``g2``, an unwinding roll's end ``g1``."""
+    out: list[int] = []
+    for kind, g1, g2, _, _ in system.table.tolist():
+        for g in (g1, g2) if kind == 1 else (g1,):
+            if g not in out:
+                out.append(int(g))
+    return out
+
+
+def _dependencies(iface: NativeInterface, pattern: dict[str, np.ndarray]
+                  ) -> list[str]:
+    """Per state derivative, the ModelVariables indices (1-based) of the states and inputs
+    it depends on: the structural sparsity of the generated Jacobians."""
+    n = len(iface.states)
+    deps: list[set[int]] = [set() for _ in range(n)]
+    for row, col in pattern["x"].tolist():
+        deps[row].add(iface.states[col].vr + 1)
+    by_param = {p: v for p, v in zip(iface.input_params, iface.inputs, strict=True)}
+    for row, col in pattern["p"].tolist():
+        if col in by_param:
+            deps[row].add(by_param[col].vr + 1)
+    return [" ".join(map(str, sorted(d))) for d in deps]
 
 
 def _scalar(parent: ET.Element, v: Variable) -> None:
@@ -278,12 +306,21 @@ def _scalar(parent: ET.Element, v: Variable) -> None:
 
 
 def _model_description(iface: NativeInterface, model: str, guid: str, scene: Scene,
-                       sources: list[str]) -> bytes:
+                       sources: list[str], pattern: dict[str, np.ndarray]) -> bytes:
     root = ET.Element("fmiModelDescription", {
         "fmiVersion": "2.0", "modelName": scene.name or model, "guid": guid,
         "description": f"winder machine of scene {scene.name!r} (native: no Python)",
         "generationTool": "winder", "variableNamingConvention": "flat",
-        "numberOfEventIndicators": "0"})
+        "numberOfEventIndicators": str(len(indicators(iface.system)))})
+    me = ET.SubElement(root, "ModelExchange", {
+        "modelIdentifier": model, "needsExecutionTool": "false",
+        "completedIntegratorStepNotNeeded": "true",
+        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions":
+        "true", "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
+        "providesDirectionalDerivative": "true"})
+    files = ET.SubElement(me, "SourceFiles")
+    for f in sources:
+        ET.SubElement(files, "File", {"name": f})
     cs = ET.SubElement(root, "CoSimulation", {
         "modelIdentifier": model, "needsExecutionTool": "false",
         "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
@@ -327,8 +364,8 @@ def _model_description(iface: NativeInterface, model: str, guid: str, scene: Sce
     for v in iface.outputs:
         ET.SubElement(outs, "Unknown", {"index": str(v.vr + 1)})
     ders = ET.SubElement(ms, "Derivatives")
-    for v in iface.derivatives:
-        ET.SubElement(ders, "Unknown", {"index": str(v.vr + 1)})
+    for v, dep in zip(iface.derivatives, _dependencies(iface, pattern), strict=True):
+        ET.SubElement(ders, "Unknown", {"index": str(v.vr + 1), "dependencies": dep})
     init = ET.SubElement(ms, "InitialUnknowns")
     for v in iface.derivatives:
         ET.SubElement(init, "Unknown", {"index": str(v.vr + 1)})
@@ -343,7 +380,7 @@ def _compile(sources: Path, model: str, out: Path, symbol: str,
         base = ["-O1" if f == "-O3" else f for f in base] + list(SANITIZE_CFLAGS)
     strict = [*base, "-ffp-contract=off", "-std=c99"]  # as solve/cint.py compiles them
     objs = []
-    for src in (f"{symbol}.c", *_INTEGRATORS, "fmi2_cs.c"):
+    for src in (f"{symbol}.c", *_INTEGRATORS, "fmi2.c"):
         flags = base if src == f"{symbol}.c" else strict
         obj = sources.parent.parent / (Path(src).stem + ".o")
         run_compiler([*flags, "-I", str(sources), "-c", str(sources / src), "-o", str(obj)],
@@ -398,10 +435,10 @@ def build_native_fmu(scene_path: str | Path, out: str | Path, *,
         stage, src = d / "fmu", d / "fmu" / "sources"
         (stage / "binaries" / "linux64").mkdir(parents=True)
         src.mkdir()
-        _, symbol = write_source(iface.system.machine, src)
+        _, symbol, pattern = write_source(iface.system.machine, src)
         for f in (*_INTEGRATORS, "events.h"):
             shutil.copyfile(_SOLVE_C / f, src / f)
-        shutil.copyfile(_C / "fmi2_cs.c", src / "fmi2_cs.c")
+        shutil.copyfile(_C / "fmi2.c", src / "fmi2.c")
         for h in _HEADERS:
             shutil.copyfile(headers / h, src / h)
         (src / "LICENSE-FMI-headers.txt").write_text(
@@ -416,9 +453,9 @@ def build_native_fmu(scene_path: str | Path, out: str | Path, *,
                                             encoding="utf-8")
         _compile(src, model, stage / "binaries" / "linux64" / f"{model}.so", symbol,
                  sanitize)
-        sources = [f"{symbol}.c", *_INTEGRATORS, "fmi2_cs.c"]
+        sources = [f"{symbol}.c", *_INTEGRATORS, "fmi2.c"]
         (stage / "modelDescription.xml").write_bytes(
-            _model_description(iface, model, guid, scene, sources))
+            _model_description(iface, model, guid, scene, sources, pattern))
         staged = d / "out.fmu"
         with zipfile.ZipFile(staged, "w", zipfile.ZIP_DEFLATED) as zf:
             for f in sorted(stage.rglob("*")):

@@ -190,7 +190,8 @@ class Generated:
         return f"w{self.key}"
 
 
-def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Path:
+def _c_source(machine: Machine, symbol: str, directory: Path, route: str
+              ) -> tuple[Path, dict[str, np.ndarray]]:
     import casadi as ca
 
     from winder.model.backends import SymbolicBackend
@@ -207,6 +208,11 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Pat
         "out": ca.vertcat(*[ev.channels[n] for n in machine.channel_names]),
         "sw": ca.vertcat(*[ev.switches[n] for n in machine.switch_names]),
     }
+    # the structural sparsity of dxdot/dx and dxdot/dp: (row, column) of each nonzero
+    pattern = {}
+    for name, wrt in (("x", x), ("p", p)):
+        sp = ca.jacobian(xdot, wrt).sparsity()
+        pattern[name] = np.array(sp.get_triplet(), dtype=np.int64).reshape(2, -1).T
     funcs = {k: ca.Function(f"{symbol}_{k}", [t, x, p, m], [ca.densify(v)], {"cse": True})
              for k, v in outs.items()}
     name = f"{symbol}.c"
@@ -229,7 +235,7 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Pat
             f"  return {symbol}_{k}(arg, res, iw, w, 0);\n}}")
     with open(path, "a") as fh:
         fh.write("\n".join(wrap) + "\n")
-    return path
+    return path, pattern
 
 
 def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
@@ -239,15 +245,18 @@ def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
 
 
 def write_source(machine: Machine, directory: Path, *, route: str | None = None
-                 ) -> tuple[Path, str]:
+                 ) -> tuple[Path, str, dict[str, np.ndarray]]:
     """Write the machine's generated C (the code :func:`generate` compiles, with its flat
-    entry points ``SYMBOL_{rhs,jac,out,sw}_flat``) into ``directory``: its path and
-    ``SYMBOL`` (for an FMU's ``sources/``; imports CasADi)."""
+    entry points ``SYMBOL_{rhs,jac,out,sw}_flat``) into ``directory``: its path,
+    ``SYMBOL`` and the structural sparsity of the right-hand side's Jacobians w.r.t. the
+    states (``"x"``) and the parameters (``"p"``), ``(row, column)`` per nonzero (for an
+    FMU's ``sources/`` and ``ModelStructure``; imports CasADi)."""
     from winder.model.backends import default_route
 
     route = default_route() if route is None else route
     symbol = f"w{_key(machine, route, compile_flags())}"
-    return _c_source(machine, symbol, Path(directory), route), symbol
+    path, pattern = _c_source(machine, symbol, Path(directory), route)
+    return path, symbol, pattern
 
 
 @dataclass(frozen=True)
@@ -283,7 +292,7 @@ def generate(machine: Machine, *, directory: Path | None = None,
         compiled = not obj.exists()
         with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
             if compiled:
-                src = _c_source(machine, symbol, Path(tmp), route)
+                src = _c_source(machine, symbol, Path(tmp), route)[0]
                 tmp_obj = Path(tmp) / obj.name
                 run_compiler([*cflags, "-c", str(src), "-o", str(tmp_obj)],
                              "the generated model")

@@ -1,6 +1,9 @@
-/* winder's native FMI 2.0 co-simulation wrapper: the machine's generated functions and
- * winder's C integrators (DOPRI5 with located events and switched modes, or fixed-step
- * RK4) behind fmi2Functions.h. No Python: the machine's data (its parameters, initial
+/* winder's native FMI 2.0 wrapper: the machine's generated functions and winder's C
+ * integrators behind fmi2Functions.h. Co-simulation: DOPRI5 with located events and
+ * switched modes, or fixed-step RK4, inside each communication step. Model exchange: the
+ * states and their derivatives in locked modes, the switching functions of the mode
+ * table as event indicators, the modes switched (from the state, as every integrator
+ * call does) in fmi2NewDiscreteStates, the drums' ramp ends as time events. No Python: the machine's data (its parameters, initial
  * state, mode table, breakpoints, variables) is in winder_model.h, written by
  * winder.fmu.native for one scene.
  *
@@ -68,6 +71,7 @@ typedef struct {
 
 typedef struct {
     Core c;
+    int me; /* instantiated for model exchange */
     fmi2CallbackFunctions cb;
     char name[128];
     int logging;
@@ -116,6 +120,10 @@ static void channels(Comp* s) {
 /* dy/dt at (t, y) in the modes a DOPRI5 step from there runs in */
 static void rates(Comp* s, const double* y, const double* p, double* dy) {
     double tb[1] = {s->c.t};
+    if (s->me) { /* model exchange: the modes locked since the last event */
+        W_RHS_FN(tb, y, p, s->c.m, dy);
+        return;
+    }
     winder_modes(s->fns, W_TABLE, W_NSLOTS, W_NSW, s->c.t, y, W_N, p, s->mw, 0);
     W_RHS_FN(tb, y, p, s->mw, dy);
 }
@@ -155,11 +163,6 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     (void)visible;
     if (!functions || !functions->logger)
         return NULL;
-    if (fmuType != fmi2CoSimulation) {
-        functions->logger(functions->componentEnvironment, instanceName, fmi2Error,
-                          "logStatusError", "this FMU is co-simulation only");
-        return NULL;
-    }
     if (!guid || strcmp(guid, W_GUID) != 0) {
         functions->logger(functions->componentEnvironment, instanceName, fmi2Error,
                           "logStatusError", "wrong GUID %s (expected %s)",
@@ -172,6 +175,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     s->cb = *functions;
     snprintf(s->name, sizeof s->name, "%s", instanceName ? instanceName : "winder");
     s->logging = loggingOn;
+    s->me = fmuType == fmi2ModelExchange;
     s->fns[0] = (int64_t)(intptr_t)&W_RHS_FN;
     s->fns[1] = (int64_t)(intptr_t)&W_JAC_FN;
     s->fns[2] = (int64_t)(intptr_t)&W_OUT_FN;
@@ -214,6 +218,8 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     if (!(s->c.hrk4 > 0.0 && isfinite(s->c.hrk4)))
         return fail(s, "%s", "rk4_step must be finite and > 0 [s]");
     apply_ramps(&s->c);
+    if (s->me)
+        winder_modes(s->fns, W_TABLE, W_NSLOTS, W_NSW, s->c.t, s->c.y, W_N, s->c.p, s->c.m, 0);
     s->out_valid = 0;
     s->c.mode = M_STEP;
     return fmi2OK;
@@ -467,7 +473,11 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
         if (!J)
             return fail(s, "%s", "out of memory");
         double tb[1] = {s->c.t};
-        winder_modes(s->fns, W_TABLE, W_NSLOTS, W_NSW, s->c.t, s->c.y, W_N, s->c.p, s->mw, 0);
+        if (s->me)
+            memcpy(s->mw, s->c.m, sizeof(double) * W_NSLOTS);
+        else
+            winder_modes(s->fns, W_TABLE, W_NSLOTS, W_NSW, s->c.t, s->c.y, W_N, s->c.p, s->mw,
+                         0);
         W_JAC_FN(tb, s->c.y, s->c.p, s->mw, J);
         for (size_t i = 0; i < nU; i++) {
             size_t row = vU[i] - VR_DX;
@@ -683,4 +693,116 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     (void)order;
     (void)value;
     return nvr ? fail(c, "%s", "output derivatives are not supported") : fmi2OK;
+}
+
+/* ---- model exchange ------------------------------------------------------------------ */
+
+fmi2Status fmi2EnterEventMode(fmi2Component c) {
+    (void)c;
+    return fmi2OK;
+}
+
+/* The modes from the state (the new side of a located crossing), the run-out of an
+ * unwinding roll (terminateSimulation, the reason logged), the next ramp end. */
+fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo* ev) {
+    Comp* s = c;
+    Core* k = &s->c;
+    double g[W_NSW + 1];
+    double tb[1] = {k->t};
+    winder_modes(s->fns, W_TABLE, W_NSLOTS, W_NSW, k->t, k->y, W_N, k->p, k->m, 0);
+    W_SW_FN(tb, k->y, k->p, k->m, g);
+    s->out_valid = 0;
+    ev->newDiscreteStatesNeeded = fmi2False;
+    ev->terminateSimulation = fmi2False;
+    ev->nominalsOfContinuousStatesChanged = fmi2False;
+    ev->valuesOfContinuousStatesChanged = fmi2False;
+    ev->nextEventTimeDefined = fmi2False;
+    ev->nextEventTime = 0.0;
+    for (int slot = 0; slot < W_NSLOTS; slot++)
+        if (W_TABLE[5 * slot] == K_END && g[W_TABLE[5 * slot + 1]] >= 0.0 && !k->ended) {
+            ended(s, k->t);
+            logf_(s, fmi2Warning, "logStatusDiscard", "%s", k->why);
+        }
+    if (k->ended) {
+        ev->terminateSimulation = fmi2True;
+        return fmi2OK;
+    }
+    double next = INFINITY;
+    for (int i = 0; i < W_NRAMP; i++) {
+        double tr = k->p[W_RAMP[3 * i + 2]];
+        if (k->p[W_RAMP[3 * i]] > 0.0 && tr > k->t + 1e-12 * fmax(1.0, fabs(k->t)) && tr < next)
+            next = tr;
+    }
+    if (isfinite(next)) {
+        ev->nextEventTimeDefined = fmi2True;
+        ev->nextEventTime = next;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
+    (void)c;
+    return fmi2OK;
+}
+
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetPrior,
+                                       fmi2Boolean* enterEventMode,
+                                       fmi2Boolean* terminateSimulation) {
+    (void)c;
+    (void)noSetPrior;
+    *enterEventMode = fmi2False;
+    *terminateSimulation = fmi2False;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
+    Comp* s = c;
+    s->c.t = time;
+    s->out_valid = 0;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
+    Comp* s = c;
+    if (nx != W_N)
+        return fail(s, "%s", "fmi2SetContinuousStates: wrong number of states");
+    memcpy(s->c.y, x, sizeof(double) * W_N);
+    s->out_valid = 0;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real dx[], size_t nx) {
+    Comp* s = c;
+    if (nx != W_N)
+        return fail(s, "%s", "fmi2GetDerivatives: wrong number of states");
+    rates(s, s->c.y, s->c.p, dx);
+    return fmi2OK;
+}
+
+/* the switching functions the mode table refers to, in the machine's locked modes */
+fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real z[], size_t ni) {
+    Comp* s = c;
+    double g[W_NSW + 1];
+    double tb[1] = {s->c.t};
+    if (ni != W_NZ)
+        return fail(s, "%s", "fmi2GetEventIndicators: wrong number of event indicators");
+    W_SW_FN(tb, s->c.y, s->c.p, s->c.m, g);
+    for (int i = 0; i < W_NZ; i++)
+        z[i] = g[W_Z[i]];
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
+    Comp* s = c;
+    if (nx != W_N)
+        return fail(s, "%s", "fmi2GetContinuousStates: wrong number of states");
+    memcpy(x, s->c.y, sizeof(double) * W_N);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
+    (void)c;
+    for (size_t i = 0; i < nx; i++)
+        x[i] = 1.0;
+    return fmi2OK;
 }
