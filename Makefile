@@ -79,6 +79,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/compiled_machine.py $(if $(BASELINE),--baseline $(BASELINE))
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_realtime.py
+	$(PY) benchmarks/fmu_native.py
 	$(PY) benchmarks/cli_speed.py
 	$(PY) benchmarks/sweep_scaling.py
 
@@ -107,6 +108,9 @@ fmu: $(STAMP)
 	$(PY) examples/speed_control_fmu.py --out $(OUT)
 	$(PY) -m winder fmu models/winder_line.toml -o $(OUT)/winder_line.fmu
 	$(PY) -m winder fmu models/winder_line_small.toml -o $(OUT)/winder_line_small.fmu
+	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/paper_native.fmu --native
+	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/two_drum_native.fmu --native
+	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/winder_line_native.fmu --native
 	$(PY) examples/tension_control_fmu.py --out $(OUT)
 
 lint: $(STAMP)
