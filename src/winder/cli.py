@@ -295,11 +295,11 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
     else:
         from winder.fmu.build import build_fmu
     out = build_fmu(args.scene, out)
-    print(f"FMI 2.0 co-simulation FMU{' (native: no Python inside)' * args.native} written "
-          f"to {out}\n  " + ("binaries/linux64 from the system C compiler; sources/ rebuild "
-                             "it elsewhere (fmpy compile)" if args.native else
-                             "runs inside the host's Python: needs winder installed there "
-                             f"(built with {sys.executable})"))
+    print(f"FMI 2.0 co-simulation{' and model-exchange' * args.native} FMU"
+          f"{' (native: no Python inside)' * args.native} written to {out}\n  "
+          + ("binaries/linux64 from the system C compiler; sources/ rebuild it elsewhere "
+             "(fmpy compile)" if args.native else "runs inside the host's Python: needs "
+             f"winder installed there (built with {sys.executable})"))
     if args.check:
         print("  " + _check_fmu(out))
     return 0
