@@ -515,3 +515,29 @@ def test_c_host_under_valgrind(paper_fmu, tmp_path) -> None:
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "ERROR SUMMARY: 0 errors" in proc.stderr, proc.stderr[-3000:]
     assert "50 cycles" in proc.stdout and "same radius" in proc.stdout
+
+
+@pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
+def test_parameters_act_at_run_time(fmi_type, paper_fmu, paper_scene) -> None:
+    """Parameters set by the host act without compiling: the paper scene's profile at
+    5 m/s reached at 2 m/s² (its ramp end, a breakpoint and a time event, moves from
+    40 s to 2.5 s) and twice the caliper, 4 s, equal winder.simulate of the scene with
+    those values (whose initial balance is the scene's: none of them enters it) within
+    the tolerances above."""
+    from winder.fmu.build import scene_with_parameters
+
+    values = {"profile_web_speed": 5.0, "web_acceleration": 2.0, "caliper": 3.2e-4}
+    scene = scene_with_parameters(paper_scene, values, speed_profile=True)
+    ref = winder.simulate(scene, t_end=4.0, output_step=0.01, method="DOPRI5", rtol=1e-8,
+                          atol=1e-10)
+    names = ["radius", "drum_speed", "roll_speed", "normal_force"]
+    res = fmpy.simulate_fmu(str(paper_fmu), fmi_type=fmi_type, stop_time=4.0,
+                            output_interval=0.01, relative_tolerance=1e-8,
+                            start_values=values, output=names)
+    tol = 1e-5 if fmi_type == "CoSimulation" else 1e-4
+    for k in names:
+        got = np.interp(ref.t, res["time"], res[k])
+        err = np.max(np.abs(got - ref[k]))
+        assert err < (1e-6 if k == "radius" else tol * np.max(np.abs(ref[k]))), (k, err)
+    # the drum follows the new profile: ratio · min(2 t, 5) / R
+    assert ref["drum_speed"][-1] == pytest.approx(5.0 / 0.5, rel=1e-9)
