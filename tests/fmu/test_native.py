@@ -577,3 +577,32 @@ def test_second_host_ecospy(two_drum_fmu, line_fmu) -> None:
                 fmu.doStep(i * 0.01, 0.01)
             want = fmu.getReal([refs[k] for k in names])
         assert got == want, path.name
+
+
+@pytest.mark.parametrize("which,file,values", [
+    ("two_drum_fmu", "two_drum_winder.toml",
+     {"web_tension": 1500.0, "rear_nip_contact_stiffness": 3e7, "set_density": 700.0}),
+    ("paper_fmu", "paper_winding.toml", {"contact_stiffness": 3e7, "density": 900.0})])
+def test_static_balance_of_the_hosts_parameters(which, file, values, request,
+                                                models_dir) -> None:
+    """Parameters set during initialisation that move the static balance (the two-drum
+    winder's set and rider by 0.55 mm): fmi2ExitInitializationMode solves it in C (Newton
+    on the generated residual), and the states equal winder's balance of the scene with
+    those values (scipy's root) to 1e-15 m (measured 7e-17); unchanged parameters keep the
+    built state bit for bit."""
+    from winder.fmu.build import scene_with_parameters
+    from winder.solve.system import MachineSystem
+
+    path = request.getfixturevalue(which)
+    scene = winder.load_scene(models_dir / file)
+    profile = True if scene.naming.fmu is not None else None
+    system = MachineSystem(scene_with_parameters(scene, values, speed_profile=profile))
+    want = system.initial_state()
+    base = MachineSystem(scene).initial_state()
+    assert np.max(np.abs(want - base)) > 1e-6
+    names = list(system.state_names)
+    with slave(path, **values) as (fmu, refs, _):
+        got = np.array(fmu.getReal([refs[n] for n in names]))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
+    with slave(path) as (fmu, refs, _):
+        assert fmu.getReal([refs[n] for n in names]) == list(base)

@@ -30,7 +30,10 @@ Interface (every name from the machine's and the scene's names):
 
 The initial state is the static balance (:meth:`MachineSystem.initial_state
 <winder.solve.system.MachineSystem.initial_state>`) of the scene's parameter values,
-computed here at build time: a parameter changed by the host does not re-solve it.
+computed here at build time; where the host sets parameters, ``fmi2ExitInitializationMode``
+solves the balance again in C (Newton on the generated force residual and its exact
+Jacobian, from the built balance and in its active set: :mod:`winder.fmu.balance`). The
+rest of the initial state (speeds, radii) stays the scene's.
 """
 
 from __future__ import annotations
@@ -48,6 +51,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from winder._errors import WinderError
+from winder.fmu.balance import Balance, balance_of, write_balance_source
 from winder.fmu.build import (
     FmuError,
     fmu_parameters,
@@ -229,7 +233,7 @@ def _c_array(ctype: str, name: str, values: Any, fmt: Any = str) -> str:
     return f"static const {ctype} {name}[] = {{{', '.join(items)}}};\n"
 
 
-def _model_header(iface: NativeInterface, symbol: str, guid: str) -> str:
+def _model_header(iface: NativeInterface, symbol: str, guid: str, balance: Balance) -> str:
     """``winder_model.h``: the machine's sizes, data and generated functions."""
     sy, m = iface.system, iface.system.machine
     owners = [f'"{mode.owner}"' for mode in m.modes] + ["0"]
@@ -243,6 +247,9 @@ def _model_header(iface: NativeInterface, symbol: str, guid: str) -> str:
         f"#define W_NIN {len(iface.inputs)}", f"#define W_NPAR {len(iface.parameters)}",
         f"#define W_NRAMP {len(iface.ramps)}", f"#define W_NZ {len(indicators(sy))}",
     ]
+    lines += [f"#define W_NU {len(balance.unknowns)}",
+              f"int {symbol}_balance_flat(const double* t, const double* x, const double* p, "
+              "const double* m, double* out);", f"#define W_BAL_FN {symbol}_balance_flat"]
     for k in ("rhs", "jac", "out", "sw"):
         lines.append(f"int {symbol}_{k}_flat(const double* t, const double* x, "
                      "const double* p, const double* m, double* out);")
@@ -256,6 +263,8 @@ def _model_header(iface: NativeInterface, symbol: str, guid: str) -> str:
     text += _c_array("int", "W_PAR_P", iface.parameter_params)
     text += _c_array("int", "W_RAMP", [i for r in iface.ramps for i in r])
     text += _c_array("int", "W_Z", indicators(sy))
+    text += _c_array("int", "W_U", balance.unknowns)
+    text += _c_array("double", "W_MB", balance.modes, float.hex)
     text += f"static const char* const W_SLOT_OWNER[] = {{{', '.join(owners)}}};\n"
     return text + "#endif\n"
 
@@ -380,8 +389,8 @@ def _compile(sources: Path, model: str, out: Path, symbol: str,
         base = ["-O1" if f == "-O3" else f for f in base] + list(SANITIZE_CFLAGS)
     strict = [*base, "-ffp-contract=off", "-std=c99"]  # as solve/cint.py compiles them
     objs = []
-    for src in (f"{symbol}.c", *_INTEGRATORS, "fmi2.c"):
-        flags = base if src == f"{symbol}.c" else strict
+    for src in (f"{symbol}.c", f"{symbol}_balance.c", *_INTEGRATORS, "fmi2.c"):
+        flags = base if src.startswith(symbol) else strict
         obj = sources.parent.parent / (Path(src).stem + ".o")
         run_compiler([*flags, "-I", str(sources), "-c", str(sources / src), "-o", str(obj)],
                      src)
@@ -436,6 +445,8 @@ def build_native_fmu(scene_path: str | Path, out: str | Path, *,
         (stage / "binaries" / "linux64").mkdir(parents=True)
         src.mkdir()
         _, symbol, pattern = write_source(iface.system.machine, src)
+        balance = balance_of(iface.system.machine, iface.x0, iface.system.params)
+        write_balance_source(iface.system.machine, balance, f"{symbol}_balance", src)
         for f in (*_INTEGRATORS, "events.h"):
             shutil.copyfile(_SOLVE_C / f, src / f)
         shutil.copyfile(_C / "fmi2.c", src / "fmi2.c")
@@ -449,11 +460,11 @@ def build_native_fmu(scene_path: str | Path, out: str | Path, *,
         for f in sorted(src.iterdir()):
             digest.update(f.name.encode() + f.read_bytes())
         guid = "{" + str(uuid.UUID(digest.hexdigest()[:32])) + "}"
-        (src / "winder_model.h").write_text(_model_header(iface, symbol, guid),
+        (src / "winder_model.h").write_text(_model_header(iface, symbol, guid, balance),
                                             encoding="utf-8")
         _compile(src, model, stage / "binaries" / "linux64" / f"{model}.so", symbol,
                  sanitize)
-        sources = [f"{symbol}.c", *_INTEGRATORS, "fmi2.c"]
+        sources = [f"{symbol}.c", f"{symbol}_balance.c", *_INTEGRATORS, "fmi2.c"]
         (stage / "modelDescription.xml").write_bytes(
             _model_description(iface, model, guid, scene, sources, pattern))
         staged = d / "out.fmu"

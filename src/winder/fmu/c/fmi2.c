@@ -211,6 +211,62 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
     return fmi2OK;
 }
 
+/* The static balance of the parameters set by the host (machines.md §7): Newton on the
+ * generated force residual and its exact Jacobian from the build-time balance, in its
+ * locked modes (W_MB). Returns 0 where it does not converge. */
+static int rebalance(Comp* s) {
+    double out[W_NU + W_NU * W_NU + 1], J[W_NU * W_NU + 1], du[W_NU + 1];
+    double tb[1] = {0.0};
+    Core* k = &s->c;
+    for (int it = 0; it < 50; it++) {
+        W_BAL_FN(tb, k->y, k->p, W_MB, out);
+        memcpy(J, out + W_NU, sizeof(double) * W_NU * W_NU);
+        for (int i = 0; i < W_NU; i++)
+            du[i] = -out[i];
+        for (int col = 0; col < W_NU; col++) { /* LU with partial pivoting */
+            int piv = col;
+            for (int r = col + 1; r < W_NU; r++)
+                if (fabs(J[col * W_NU + r]) > fabs(J[col * W_NU + piv]))
+                    piv = r;
+            if (!(fabs(J[col * W_NU + piv]) > 0.0))
+                return 0;
+            if (piv != col) {
+                for (int cc = 0; cc < W_NU; cc++) {
+                    double tmp = J[cc * W_NU + col];
+                    J[cc * W_NU + col] = J[cc * W_NU + piv];
+                    J[cc * W_NU + piv] = tmp;
+                }
+                double tmp = du[col];
+                du[col] = du[piv];
+                du[piv] = tmp;
+            }
+            for (int r = col + 1; r < W_NU; r++) {
+                double f = J[col * W_NU + r] / J[col * W_NU + col];
+                for (int cc = col; cc < W_NU; cc++)
+                    J[cc * W_NU + r] -= f * J[cc * W_NU + col];
+                du[r] -= f * du[col];
+            }
+        }
+        for (int r = W_NU - 1; r >= 0; r--) {
+            for (int cc = r + 1; cc < W_NU; cc++)
+                du[r] -= J[cc * W_NU + r] * du[cc];
+            du[r] /= J[r * W_NU + r];
+        }
+        int done = 1;
+        for (int i = 0; i < W_NU; i++) {
+            double u = k->y[W_U[i]];
+            if (!isfinite(du[i]))
+                return 0;
+            k->y[W_U[i]] = u + du[i];
+            if (fabs(du[i]) > 1e-15 * fmax(1.0, fabs(u)))
+                done = 0;
+        }
+        if (done)
+            return 1;
+    }
+    return 0;
+}
+
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     Comp* s = c;
     if (!(s->c.rtol > 0.0 && s->c.rtol <= 0.1) || !(s->c.atol > 0.0 && s->c.atol <= 1e-3))
@@ -218,6 +274,13 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     if (!(s->c.hrk4 > 0.0 && isfinite(s->c.hrk4)))
         return fail(s, "%s", "rk4_step must be finite and > 0 [s]");
     apply_ramps(&s->c);
+    if (W_NU > 0 && memcmp(s->c.p, W_P0, sizeof(double) * W_NP) != 0) {
+        memcpy(s->c.y, W_X0, sizeof(double) * W_N);
+        if (!rebalance(s))
+            return fail(s, "%s", "no static balance for the parameters set: Newton on the "
+                        "force residual did not converge from the built balance (a nip "
+                        "that would pull, or a change too large)");
+    }
     if (s->me)
         winder_modes(s->fns, W_TABLE, W_NSLOTS, W_NSW, s->c.t, s->c.y, W_N, s->c.p, s->c.m, 0);
     s->out_valid = 0;
