@@ -606,3 +606,24 @@ def test_static_balance_of_the_hosts_parameters(which, file, values, request,
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
     with slave(path) as (fmu, refs, _):
         assert fmu.getReal([refs[n] for n in names]) == list(base)
+
+
+def test_misuse_is_refused_with_a_reason(line_fmu) -> None:
+    """A step from a time the FMU is not at, a fixed parameter set after initialisation,
+    a non-finite input: fmi2Error, each with its reason logged; the FMU stays usable."""
+    from fmpy.fmi2 import fmi2Error
+
+    with slave(line_fmu) as (fmu, refs, log):
+        fmu.doStep(0.0, 0.01)
+        for call in (lambda: fmu.doStep(0.5, 0.01),
+                     lambda: fmu.setReal([refs["span_EA"]], [2e6]),
+                     lambda: fmu.setReal([refs["parent_torque"]], [float("nan")]),
+                     lambda: fmu.setBoolean([refs["rk4"]], [True])):
+            with pytest.raises(FMICallException) as exc:
+                call()
+            assert exc.value.status == fmi2Error
+        fmu.doStep(0.01, 0.01)
+        assert fmu.getReal([refs["t"]])[0] == pytest.approx(0.02, abs=1e-15)
+    text = "\n".join(log)
+    assert "steps must be contiguous" in text and "fixed parameter" in text
+    assert "is not finite" in text and "rk4 is a fixed parameter" in text
