@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.winder-installed
 OUT    ?= out
 
-.PHONY: demo test test-slow bench peers fmu docs-figures lint chromium clean venv pin-casadi \
+.PHONY: demo test test-slow bench peers fmu docs-figures lint chromium libtbb clean venv pin-casadi \
 	scene-reference readme-numbers
 
 $(STAMP): pyproject.toml
@@ -33,6 +33,15 @@ chromium:
 	    || echo "warning: could not install chromium; browser tests will be skipped"; \
 	else echo "warning: chromium not found and not root; browser tests will be skipped"; fi
 
+# TBB for ecospy, the second FMI host of the native FMU's tests (Debian package; root only).
+libtbb:
+	@if ldconfig -p 2>/dev/null | grep -q 'libtbb.so.12'; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  echo "installing libtbb12 (apt-get)"; \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libtbb12 >/dev/null) \
+	    || echo "warning: could not install libtbb12; the ecospy host test will be skipped"; \
+	else echo "warning: libtbb12 not found and not root; the ecospy host test will be skipped"; fi
+
 demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
@@ -48,7 +57,7 @@ demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder view $(OUT)/winder_line.npz --html $(OUT)/winder_line.html --snapshots $(OUT)/snapshots_line --every 100
 	@echo "demo outputs in $(OUT)/"
 
-test: $(STAMP) pin-casadi chromium
+test: $(STAMP) pin-casadi chromium libtbb
 	$(PY) -m ruff check src viewer tests examples benchmarks
 	$(VENV)/bin/lint-imports
 	$(PY) -m pytest -q
@@ -79,6 +88,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/compiled_machine.py $(if $(BASELINE),--baseline $(BASELINE))
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_realtime.py
+	$(PY) benchmarks/fmu_native.py
 	$(PY) benchmarks/cli_speed.py
 	$(PY) benchmarks/sweep_scaling.py
 	$(PY) benchmarks/flex_speed.py
@@ -108,6 +118,9 @@ fmu: $(STAMP)
 	$(PY) examples/speed_control_fmu.py --out $(OUT)
 	$(PY) -m winder fmu models/winder_line.toml -o $(OUT)/winder_line.fmu
 	$(PY) -m winder fmu models/winder_line_small.toml -o $(OUT)/winder_line_small.fmu
+	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/paper_native.fmu --native
+	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/two_drum_native.fmu --native
+	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/winder_line_native.fmu --native
 	$(PY) examples/tension_control_fmu.py --out $(OUT)
 
 lint: $(STAMP)

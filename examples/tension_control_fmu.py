@@ -1,9 +1,11 @@
 """Purpose: closed-loop tension control of the winder line through its FMU, a whole parent roll.
 
 The FMU is exported from ``models/winder_line_fmu.toml`` (the small line, its parent roll
-torque-driven: input ``parent_torque``). Every communication step the controller reads
-the FMU's outputs (span tension, the parent's radius and speed, the entry drum's speed
-and acceleration) and writes the unwind torque by the rule of
+torque-driven: input ``parent_torque``) as a native FMU (``winder fmu --native``: the
+compiled machine, no Python inside; ``--pythonfmu``: the pythonfmu FMU instead). Every
+communication step the controller reads the FMU's outputs (span tension, the parent's
+radius and speed, the entry drum's speed and acceleration) and writes the unwind torque
+by the rule of
 ``src/winder/forces/tension_control.py`` (the model's own controller, here outside it)::
 
     τ = J(r) ω̇_ref − r T* − k_p e − k_i ∫e dt + k_d dT/dt,      e = T* − T
@@ -19,6 +21,7 @@ on until the parent reaches its core (the FMU's step then fails with the reason 
 Writes ``tension_control_fmu.png`` and ``tension_control_fmu.npz`` to ``--out``.
 
     python examples/tension_control_fmu.py [--t-end 60] [--step 0.002] [--out out]
+                                           [--pythonfmu]
 """
 
 from __future__ import annotations
@@ -158,6 +161,7 @@ def plot(log: dict[str, np.ndarray], T_set: float, path: Path) -> None:
 def main(argv: list[str] | None = None) -> int:
     import winder
     from winder.fmu.build import build_fmu
+    from winder.fmu.native import build_native_fmu
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=60.0,
@@ -169,12 +173,16 @@ def main(argv: list[str] | None = None) -> int:
                     help="the drum's web-speed rate in J(r)·ω̇_ref: the profile's mean over "
                          "the step, or the measured acceleration at its start")
     ap.add_argument("--out", type=Path, default=ROOT / "out", help="output folder")
+    ap.add_argument("--pythonfmu", action="store_true",
+                    help="the pythonfmu FMU (needs winder in the host's Python) instead of "
+                         "the native one")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     scene = winder.load_scene(SCENE)
     law = TensionLaw(scene, args.tension, args.bandwidth, args.feedforward)
     wall0 = time.perf_counter()
-    fmu_file = build_fmu(SCENE, args.out / "winder_line_fmu.fmu")
+    fmu_file = (build_fmu if args.pythonfmu else build_native_fmu)(
+        SCENE, args.out / "winder_line_fmu.fmu")
     wall1 = time.perf_counter()
     log, ended = run(fmu_file, law, args.t_end, args.step)
     wall = time.perf_counter() - wall1
@@ -183,7 +191,8 @@ def main(argv: list[str] | None = None) -> int:
     settled = t >= 1.0
     k1 = int(np.argmax(np.abs(e) * settled))
     print(f"{t[-1]:.4f} s simulated in {wall:.1f} s wall ({t[-1] / wall:.2f}× real time; "
-          f"FMU built in {wall1 - wall0:.1f} s), {args.step * 1e3:g} ms steps, "
+          f"{'pythonfmu' if args.pythonfmu else 'native'} FMU built in "
+          f"{wall1 - wall0:.1f} s), {args.step * 1e3:g} ms steps, "
           f"{len(t) - 1} steps, feed-forward: {args.feedforward}")
     print(f"run-out: {ended}" if ended else "the parent did not run out")
     print(f"parent radius {log['parent_radius'][-1]:.6f} m, set radius "

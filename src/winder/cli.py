@@ -290,12 +290,16 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
     from winder.io.files import check_output_file
 
     out = check_output_file(args.out, "-o/--out", suffixes=(".fmu",))
-    from winder.fmu.build import build_fmu
-
+    if args.native:  # the native build imports the solver: only where asked for
+        from winder.fmu.native import build_native_fmu as build_fmu
+    else:
+        from winder.fmu.build import build_fmu
     out = build_fmu(args.scene, out)
-    print(f"FMI 2.0 co-simulation FMU written to {out}")
-    print(f"  runs inside the host's Python: needs winder installed there (built with "
-          f"{sys.executable})")
+    print(f"FMI 2.0 co-simulation{' and model-exchange' * args.native} FMU"
+          f"{' (native: no Python inside)' * args.native} written to {out}\n  "
+          + ("binaries/linux64 from the system C compiler; sources/ rebuild it elsewhere "
+             "(fmpy compile)" if args.native else "runs inside the host's Python: needs "
+             f"winder installed there (built with {sys.executable})"))
     if args.check:
         print("  " + _check_fmu(out))
     return 0
@@ -487,6 +491,9 @@ def _build_parser() -> argparse.ArgumentParser:
     fmu.add_argument("-o", "--out", default="winder.fmu", help="FMU file (default winder.fmu)")
     fmu.add_argument("--check", action=argparse.BooleanOptionalAction, default=True,
                      help="load the built FMU with FMPy and step it (default on)")
+    fmu.add_argument("--native", action="store_true",
+                     help="the compiled machine and C integrators behind FMI 2.0, no Python "
+                          "inside (binaries/linux64 and sources/; needs a C compiler)")
     fmu.set_defaults(func=_cmd_fmu)
     modes = sub.add_parser("modes", help="bounce modes against the wound roll's radius and "
                            "the rotation harmonics (resonance map)")

@@ -40,7 +40,7 @@ from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
            "stats", "Link", "compile_flags", "link_flags", "run_compiler",
-           "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash"]
+           "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash", "write_source"]
 
 #: The generated functions, in the order of :attr:`Generated.addresses`.
 FUNCTIONS = ("rhs", "jac", "out", "sw")
@@ -190,7 +190,8 @@ class Generated:
         return f"w{self.key}"
 
 
-def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Path:
+def _c_source(machine: Machine, symbol: str, directory: Path, route: str
+              ) -> tuple[Path, dict[str, np.ndarray]]:
     import casadi as ca
 
     from winder.model.backends import SymbolicBackend
@@ -207,6 +208,11 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Pat
         "out": ca.vertcat(*[ev.channels[n] for n in machine.channel_names]),
         "sw": ca.vertcat(*[ev.switches[n] for n in machine.switch_names]),
     }
+    # the structural sparsity of dxdot/dx and dxdot/dp: (row, column) of each nonzero
+    pattern = {}
+    for name, wrt in (("x", x), ("p", p)):
+        sp = ca.jacobian(xdot, wrt).sparsity()
+        pattern[name] = np.array(sp.get_triplet(), dtype=np.int64).reshape(2, -1).T
     funcs = {k: ca.Function(f"{symbol}_{k}", [t, x, p, m], [ca.densify(v)], {"cse": True})
              for k, v in outs.items()}
     name = f"{symbol}.c"
@@ -229,7 +235,28 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str) -> Pat
             f"  return {symbol}_{k}(arg, res, iw, w, 0);\n}}")
     with open(path, "a") as fh:
         fh.write("\n".join(wrap) + "\n")
-    return path
+    return path, pattern
+
+
+def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
+    """The cache key of a machine's generated code (:func:`generate`)."""
+    return hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(),
+                                    route, " ".join(cflags))).encode()).hexdigest()[:20]
+
+
+def write_source(machine: Machine, directory: Path, *, route: str | None = None
+                 ) -> tuple[Path, str, dict[str, np.ndarray]]:
+    """Write the machine's generated C (the code :func:`generate` compiles, with its flat
+    entry points ``SYMBOL_{rhs,jac,out,sw}_flat``) into ``directory``: its path,
+    ``SYMBOL`` and the structural sparsity of the right-hand side's Jacobians w.r.t. the
+    states (``"x"``) and the parameters (``"p"``), ``(row, column)`` per nonzero (for an
+    FMU's ``sources/`` and ``ModelStructure``; imports CasADi)."""
+    from winder.model.backends import default_route
+
+    route = default_route() if route is None else route
+    symbol = f"w{_key(machine, route, compile_flags())}"
+    path, pattern = _c_source(machine, symbol, Path(directory), route)
+    return path, symbol, pattern
 
 
 @dataclass(frozen=True)
@@ -253,8 +280,7 @@ def generate(machine: Machine, *, directory: Path | None = None,
 
     route = default_route() if route is None else route
     cflags = compile_flags()
-    key = hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(), route,
-                                   " ".join(cflags))).encode()).hexdigest()[:20]
+    key = _key(machine, route, cflags)
     symbol = f"w{key}"
     root = Path(directory) if directory is not None else cache_dir() / "generated"
     obj = root / f"{symbol}.o"
@@ -266,7 +292,7 @@ def generate(machine: Machine, *, directory: Path | None = None,
         compiled = not obj.exists()
         with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
             if compiled:
-                src = _c_source(machine, symbol, Path(tmp), route)
+                src = _c_source(machine, symbol, Path(tmp), route)[0]
                 tmp_obj = Path(tmp) / obj.name
                 run_compiler([*cflags, "-c", str(src), "-o", str(tmp_obj)],
                              "the generated model")
