@@ -74,3 +74,21 @@ def test_library_entry_points_agree_with_the_generated_functions(paper_scene) ->
                                                                   system.params, m))
     with pytest.raises(ValueError, match="which must be"):
         lib.repeat(system.fns, 4, 1, 0.0, y, system.params, m, out)
+
+
+def test_arrays_of_the_wrong_size_are_refused(paper_scene) -> None:
+    """The generated code reads and writes the machine's sizes: a state, parameter or
+    output array of another length is a ValueError, not a write past its end."""
+    system = MachineSystem(paper_scene)
+    lib, fns, table = system.kernels, system.fns, system.table
+    y, p, m = system.initial_state(), system.params, system.modes.copy()
+    stats, t_out = np.zeros(5, dtype=np.int64), np.empty(0)
+    with pytest.raises(ValueError, match="states"):
+        lib.dopri5(fns, table, 0.0, 1.0, y[:-1].copy(), p, m, 1e-6, 1e-8, 0.0, np.inf, t_out,
+                   np.empty((len(y) - 1, 0)), 0, 100, stats)
+    with pytest.raises(ValueError, match="parameters"):
+        lib.modes(fns, table, 0.0, y, p[:-1].copy(), m, contact_auto=False)
+    with pytest.raises(ValueError, match="out must hold"):
+        lib.repeat(fns, integ.F_JAC, 1, 0.0, y, p, m, np.empty(len(y)))
+    with pytest.raises(ValueError, match="h must be"):
+        lib.rk4(fns, table, 0.0, 1.0, y, p, m, 0.0, t_out, np.empty((len(y), 0)), 0, stats)

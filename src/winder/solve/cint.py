@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -49,8 +50,9 @@ def link() -> Link:
     """The integrators' objects (compiled once, cached) for
     :func:`~winder.model.codegen.generate`."""
     flags = (*compile_flags(), *EXTRA_CFLAGS)
-    if flags in _LINKS:
-        return _LINKS[flags]
+    memo = (*flags, str(cache_dir()))
+    if memo in _LINKS and all(o.exists() for o in _LINKS[memo].objects):
+        return _LINKS[memo]
     h = hashlib.sha256(" ".join(flags).encode())
     for f in sorted(_DIR.glob("*.[ch]")):  # every source and header: the key
         h.update(f.name.encode() + b"\0" + f.read_bytes())
@@ -66,7 +68,7 @@ def link() -> Link:
             root.mkdir(exist_ok=True)
             for obj in objects:
                 os.replace(Path(tmp) / obj.name, obj)  # atomic per file; a race writes equal
-    _LINKS[flags] = result = Link(objects, key)
+    _LINKS[memo] = result = Link(objects, key)
     return result
 
 
@@ -94,6 +96,8 @@ class Kernels:
                             "(generate(machine, link=cint.link())) is needed")
         self.n_switches = generated.n_switches
         self.n_channels = generated.n_channels
+        self.n_states = generated.n_states
+        self.n_params = generated.n_params
         adaptive = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
                     _f64, _dp, _i64, _dp, _i64, _i64, _ip]
         self._dopri5 = self._fn(lib.winder_dopri5, [*adaptive, _i64, _dp, _dp, _ip])
@@ -110,6 +114,13 @@ class Kernels:
         self._repeat.argtypes = [_ip, _i64, _i64, _f64, _dp, _dp, _dp, _dp]
         self._lib = lib  # keep the library loaded
 
+    def _sizes(self, y: np.ndarray, p: np.ndarray) -> None:
+        """The state and parameters have the machine's lengths (the generated code writes
+        and reads that many values)."""
+        if y.shape != (self.n_states,) or p.shape != (self.n_params,):
+            raise ValueError(f"y and p must hold {self.n_states} states and {self.n_params} "
+                             f"parameters, got {y.shape} and {p.shape}")
+
     @staticmethod
     def _fn(fn: Any, argtypes: list[Any]) -> Any:
         fn.restype = ctypes.c_int
@@ -123,6 +134,7 @@ class Kernels:
         """DOPRI5 from ``t0`` towards ``t1`` [s] until done, an event that ends the run,
         or ``budget`` evaluations (``PAUSED``); ``h <= 0``: it picks the first step."""
         n = _check(fns, table, y, m, t_out, Y_out, stats)
+        self._sizes(y, p)
         tr, hr, kr = _f64(), _f64(), _i64()
         status = self._dopri5(
             _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
@@ -141,6 +153,7 @@ class Kernels:
         """The Rosenbrock ROS2 on the exact Jacobian, as :meth:`dopri5` (``stats`` needs
         5 counters: ``stats[4]`` counts Jacobians)."""
         n = _check(fns, table, y, m, t_out, Y_out, stats)
+        self._sizes(y, p)
         if stats.shape[0] < 5:
             raise ValueError("stats must hold 5 counters")
         tr, hr, kr = _f64(), _f64(), _i64()
@@ -159,7 +172,10 @@ class Kernels:
             k: int, stats: np.ndarray) -> tuple[int, float, float, int]:
         """Fixed-step RK4 with steps of at most ``h`` [s] evenly dividing
         ``[t0, t1]``."""
+        if not (math.isfinite(h) and h > 0.0):
+            raise ValueError(f"h must be a finite step > 0 s, got {h!r}")
         n = _check(fns, table, y, m, t_out, Y_out, stats)
+        self._sizes(y, p)
         tr, hr, kr = _f64(), _f64(), _i64()
         status = self._rk4(
             _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
@@ -178,6 +194,9 @@ class Kernels:
         ``contact_auto``), a roll at its core where ``r <= r_c`` and it does not turn
         forwards."""
         y = np.ascontiguousarray(y, dtype=np.float64)
+        self._sizes(y, p)
+        if m.shape != (table.shape[0],):
+            raise ValueError(f"m must hold one mode per slot ({table.shape[0]}), got {m.shape}")
         status = self._modes(_ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"),
                              table.shape[0], self.n_switches, float(t),
                              _ptr(y, np.float64, "y"), y.shape[0],
@@ -193,6 +212,10 @@ class Kernels:
         if not 0 <= which < 4:
             raise ValueError(f"which must be 0–3 (rhs, jac, out, sw), got {which}")
         y = np.ascontiguousarray(y, dtype=np.float64)
+        self._sizes(y, p)
+        size = (self.n_states, self.n_states ** 2, self.n_channels, self.n_switches)[which]
+        if out.shape[0] < size:
+            raise ValueError(f"out must hold {size} values, got {out.shape}")
         return float(self._repeat(_ptr(fns, np.int64, "fns"), int(which), int(count),
                                   float(t), _ptr(y, np.float64, "y"),
                                   _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m"),
@@ -204,8 +227,9 @@ class Kernels:
         the modes of its state with the nips' clamped law."""
         t = np.ascontiguousarray(t, dtype=np.float64)
         Y = np.ascontiguousarray(Y, dtype=np.float64)
-        if Y.ndim != 2 or Y.shape[1] != t.shape[0]:
-            raise ValueError(f"Y must be (n, {t.shape[0]}), got {Y.shape}")
+        if Y.ndim != 2 or Y.shape != (self.n_states, t.shape[0]):
+            raise ValueError(f"Y must be ({self.n_states}, {t.shape[0]}), got {Y.shape}")
+        self._sizes(Y[:, 0] if Y.shape[1] else np.empty(self.n_states), p)
         out = np.empty((self.n_channels, t.shape[0]))
         m = np.empty(table.shape[0])
         status = self._channels(_ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"),

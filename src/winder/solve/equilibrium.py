@@ -368,6 +368,7 @@ def cached_static_state(machine: Machine, p: np.ndarray | None = None) -> Equili
     balances that were found are kept; a refused one is refused again every time. A
     machine whose scene cannot be written out (``to_dict``: the tests' stand-ins) is
     solved every time."""
+    import contextlib
     import json
     import os
     import tempfile
@@ -389,12 +390,18 @@ def cached_static_state(machine: Machine, p: np.ndarray | None = None) -> Equili
     eq = static_state(machine, p)
     text = json.dumps({"state": [float(v).hex() for v in eq.state],
                        "residual": float(eq.residual).hex(), "scale": float(eq.scale).hex()})
-    try:  # atomic; a cache that cannot be written is skipped
+    tmp = None
+    try:  # atomic; a cache that cannot be written is skipped, and leaves no temporary
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".balance-", suffix=".json")
         with os.fdopen(fd, "w") as fh:
             fh.write(text)
         os.replace(tmp, path)
+        tmp = None
     except OSError:
         pass
+    finally:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
     return eq
