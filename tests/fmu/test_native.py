@@ -726,3 +726,17 @@ def test_speed_control_example_native_equals_pythonfmu(tmp_path) -> None:
     diffs = json.loads(proc.stdout.strip().splitlines()[-1])
     for k, (diff, scale) in diffs.items():
         assert diff < (1e-6 if k == "radius" else 1e-5 * max(scale, 1e-9)), (k, diff)
+
+
+def test_tension_example_runs_a_built_fmu(line_fmu, tmp_path) -> None:
+    """examples/tension_control_fmu.py --fmu (make demo's way): the native FMU given is
+    run, none built; its figure and log written to --out."""
+    example = Path(__file__).resolve().parents[2] / "examples" / "tension_control_fmu.py"
+    proc = subprocess.run([sys.executable, str(example), "--t-end", "1", "--fmu",
+                           str(line_fmu), "--out", str(tmp_path)],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert f"native FMU {line_fmu})" in proc.stdout, proc.stdout
+    assert not (tmp_path / "winder_line_fmu.fmu").exists()
+    assert len(np.load(tmp_path / "tension_control_fmu.npz")["t"]) == 501
+    assert (tmp_path / "tension_control_fmu.png").stat().st_size > 10_000
