@@ -24,7 +24,8 @@ HOST = Path(__file__).with_name("fmu_host.py")
 def fmu_path(tmp_path_factory, models_dir) -> Path:
     out = tmp_path_factory.mktemp("fmu") / "winder.fmu"
     proc = subprocess.run([sys.executable, "-m", "winder", "fmu",
-                           str(models_dir / "paper_winding.toml"), "-o", str(out)],
+                           str(models_dir / "paper_winding.toml"), "-o", str(out),
+                           "--pythonfmu"],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert "run-checked with FMPy" in proc.stdout
@@ -167,7 +168,8 @@ def _scene_file(scene: winder.Scene, path: Path) -> Path:
 
 def _cli_fmu(scene_file: Path, out: Path) -> Path:
     proc = subprocess.run([sys.executable, "-m", "winder", "fmu", str(scene_file), "-o",
-                           str(out)], capture_output=True, text=True, timeout=300)
+                           str(out), "--pythonfmu"], capture_output=True, text=True,
+                          timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert "run-checked with FMPy" in proc.stdout and "set_radius 0.05" in proc.stdout
     return out

@@ -37,9 +37,10 @@ from winder.fmu.native import build_native_fmu, model_identifier  # noqa: E402
 HOST_C = Path(__file__).with_name("native_host.c")
 
 
-def _cli_native(scene: Path, out: Path) -> Path:
+def _cli_native(scene: Path, out: Path, *options: str) -> Path:
+    """``winder fmu`` (the native FMU is the default)."""
     proc = subprocess.run([sys.executable, "-m", "winder", "fmu", str(scene), "-o", str(out),
-                           "--native"], capture_output=True, text=True, timeout=600)
+                           *options], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert "native" in proc.stdout and "run-checked with FMPy" in proc.stdout, proc.stdout
     return out
@@ -740,3 +741,19 @@ def test_tension_example_runs_a_built_fmu(line_fmu, tmp_path) -> None:
     assert not (tmp_path / "winder_line_fmu.fmu").exists()
     assert len(np.load(tmp_path / "tension_control_fmu.npz")["t"]) == 501
     assert (tmp_path / "tension_control_fmu.png").stat().st_size > 10_000
+
+
+def test_cli_builds_either_single_drum_machine(tmp_path, models_dir) -> None:
+    """winder fmu --no-speed-profile: the free drum (the native FMU, by default);
+    --speed-profile is refused with --pythonfmu (whose switch is a parameter)."""
+    path = _cli_native(models_dir / "paper_winding.toml", tmp_path / "free.fmu",
+                       "--no-speed-profile")
+    md = fmpy.read_model_description(str(path))
+    by = {v.name: v for v in md.modelVariables}
+    assert by["speed_profile"].start == "false" and "drum_torque_command" in by
+    proc = subprocess.run([sys.executable, "-m", "winder", "fmu",
+                           str(models_dir / "paper_winding.toml"), "-o",
+                           str(tmp_path / "old.fmu"), "--pythonfmu", "--speed-profile"],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode != 0 and "speed_profile" in proc.stderr, proc.stderr
+    assert not (tmp_path / "old.fmu").exists()

@@ -489,8 +489,10 @@ def build_native_fmu(scene_path: str | Path, out: str | Path, *,
     if out.suffix != ".fmu":
         raise FmuError(f"output file must end in .fmu, got {str(out)!r}")
     if len(scene.webs) > 1:
-        raise FmuError(f"{scene_path}: [[web]]: {len(scene.webs)} webs; the FMU takes a "
-                       "scene with one web (one winding station)")
+        raise FmuError(f"{scene_path}: [[web]]: {len(scene.webs)} webs "
+                       f"({', '.join(w.name for w in scene.webs)}); the FMU takes a scene "
+                       "with one web (one winding station); valid: one [web] table (run "
+                       "several stations with winder run)")
     iface = native_interface(scene, profile)
     model = model_identifier(scene)
     headers = _headers_dir()
