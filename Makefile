@@ -49,7 +49,11 @@ demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
 	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
 	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
-	$(PY) examples/tension_control_fmu.py --out $(OUT)
+	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/fmu/paper_winding.fmu --native
+	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/fmu/two_drum_winder.fmu --native
+	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/fmu/winder_line_fmu.fmu --native
+	$(PY) examples/tension_control_fmu.py --fmu $(OUT)/fmu/winder_line_fmu.fmu --out $(OUT)
+	$(PY) examples/speed_control_fmu.py --out $(OUT)
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/two_drum_winder.npz --html $(OUT)/two_drum_winder.html --snapshots $(OUT)/snapshots_two_drum --every 100
 	$(PY) -m winder modes models/two_drum_winder.toml --plot $(OUT)/plots/two_drum_modes.png --csv $(OUT)/two_drum_modes.csv
@@ -121,7 +125,7 @@ fmu: $(STAMP)
 	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/paper_native.fmu --native
 	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/two_drum_native.fmu --native
 	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/winder_line_native.fmu --native
-	$(PY) examples/tension_control_fmu.py --out $(OUT)
+	$(PY) examples/tension_control_fmu.py --fmu $(OUT)/winder_line_native.fmu --out $(OUT)
 
 lint: $(STAMP)
 	$(PY) -m ruff check src viewer tests examples benchmarks

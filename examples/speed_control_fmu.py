@@ -1,10 +1,12 @@
 """Purpose: a PI drum-speed controller drives the winder FMU through FMPy (paper's Fig. 17).
 
-The FMU is exported from ``models/paper_winding.toml`` with the drum freed
-(``speed_profile = false``): the controller reads the web-speed reference and the drum
-speed, and writes ``drum_torque_command`` every communication step while the roll grows.
+The native FMU (no Python inside) is exported from ``models/paper_winding.toml`` with
+the drum freed (``speed_profile = false``, a build option: the free drum is another
+machine): the controller reads the web-speed reference and the drum speed, and writes
+``drum_torque_command`` every communication step while the roll grows. ``--pythonfmu``
+runs the same loop through the old pythonfmu FMU (same interface).
 
-    python examples/speed_control_fmu.py [--t-end 700] [--step 0.01] [--out out]
+    python examples/speed_control_fmu.py [--t-end 700] [--step 0.01] [--out out] [--pythonfmu]
 """
 
 from __future__ import annotations
@@ -35,19 +37,28 @@ class PI:
         return float(np.clip(u, -self.limit, self.limit))
 
 
-def main(argv: list[str] | None = None) -> int:
+NAMES = ["web_speed_reference", "drum_speed", "roll_speed", "radius", "normal_force",
+         "friction_force"]
+R = 0.5  # drum radius [m] (the scene's)
+
+
+def build(out: Path, *, pythonfmu: bool = False) -> Path:
+    """The paper scene's FMU with its drum freed, at ``out / winder.fmu``."""
+    fmu_file = out / "winder.fmu"
+    if pythonfmu:
+        from winder.fmu.build import build_fmu
+        return build_fmu(ROOT / "models" / "paper_winding.toml", fmu_file)
+    from winder.fmu.native import build_native_fmu
+    return build_native_fmu(ROOT / "models" / "paper_winding.toml", fmu_file,
+                            speed_profile=False)
+
+
+def closed_loop(fmu_file: Path, t_end: float, step: float, progress: bool = False
+                ) -> tuple[np.ndarray, float]:
+    """The PI loop through the FMU: per communication point ``t``, the torque written
+    and the outputs :data:`NAMES`; and the wall time [s]."""
     import fmpy
     from fmpy.fmi2 import FMU2Slave
-
-    from winder.fmu.build import build_fmu
-
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--t-end", type=float, default=700.0, help="end time [s]")
-    ap.add_argument("--step", type=float, default=0.01, help="communication step [s]")
-    ap.add_argument("--out", type=Path, default=ROOT / "out", help="output folder")
-    args = ap.parse_args(argv)
-    args.out.mkdir(parents=True, exist_ok=True)
-    fmu_file = build_fmu(ROOT / "models" / "paper_winding.toml", args.out / "winder.fmu")
 
     md = fmpy.read_model_description(str(fmu_file))
     refs = {v.name: v.valueReference for v in md.modelVariables}
@@ -60,14 +71,12 @@ def main(argv: list[str] | None = None) -> int:
     fmu.setBoolean([refs["speed_profile"]], [False])  # free drum, torque input
     fmu.exitInitializationMode()
 
-    R = 0.5          # drum radius [m] (the scene's)
     J_d = 400.0      # drum inertia [kg m²]
     bandwidth = 10.0  # speed loop crossover [rad/s]
     kp = bandwidth * J_d / R            # [N·m per m/s]
     pi = PI(kp=kp, ki=kp * bandwidth / 4.0, limit=4000.0)
-    names = ["web_speed_reference", "drum_speed", "roll_speed", "radius", "normal_force",
-             "friction_force"]
-    n = int(round(args.t_end / args.step))
+    names = NAMES
+    n = int(round(t_end / step))
     log = np.empty((n + 1, len(names) + 2))
     vr = [refs[k] for k in names]
     wall0 = time.perf_counter()
@@ -78,27 +87,42 @@ def main(argv: list[str] | None = None) -> int:
         if i == n:
             break
         v_ref, drum_speed = vals[0], vals[1]
-        torque = pi(v_ref - drum_speed * R, args.step)
+        torque = pi(v_ref - drum_speed * R, step)
         fmu.setReal([refs["drum_torque_command"]], [torque])
-        fmu.doStep(currentCommunicationPoint=t, communicationStepSize=args.step)
-        t = (i + 1) * args.step
-        if i % 5000 == 0:
+        fmu.doStep(currentCommunicationPoint=t, communicationStepSize=step)
+        t = (i + 1) * step
+        if progress and i % 5000 == 0:
             end = "\r" if sys.stderr.isatty() else "\n"
             sys.stderr.write(f"t = {t:7.1f} s  radius {vals[3]:.3f} m{end}")
     wall = time.perf_counter() - wall0
     fmu.terminate()
     fmu.freeInstance()
     shutil.rmtree(unzip, ignore_errors=True)
-    if sys.stderr.isatty():
+    if progress and sys.stderr.isatty():
         sys.stderr.write("\n")
+    return log, wall
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--t-end", type=float, default=700.0, help="end time [s]")
+    ap.add_argument("--step", type=float, default=0.01, help="communication step [s]")
+    ap.add_argument("--out", type=Path, default=ROOT / "out", help="output folder")
+    ap.add_argument("--pythonfmu", action="store_true",
+                    help="the old pythonfmu FMU (needs winder in the host's Python)")
+    args = ap.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    fmu_file = build(args.out, pythonfmu=args.pythonfmu)
+    log, wall = closed_loop(fmu_file, args.t_end, args.step, progress=True)
+    names, step, t_end = NAMES, args.step, args.t_end
 
     T, tau = log[:, 0], log[:, 1]
     cols = dict(zip(names, log[:, 2:].T, strict=True))
     web = cols["drum_speed"] * R
     err = cols["web_speed_reference"] - web
     settled = T > 2.0
-    print(f"{args.t_end:g} s in {wall:.1f} s wall (real-time factor {args.t_end / wall:.0f}), "
-          f"{args.step * 1e3:g} ms steps; final radius {cols['radius'][-1]:.3f} m; "
+    print(f"{t_end:g} s in {wall:.1f} s wall (real-time factor {t_end / wall:.0f}), "
+          f"{step * 1e3:g} ms steps; final radius {cols['radius'][-1]:.3f} m; "
           f"web-speed error after 2 s: max {np.max(np.abs(err[settled])):.2e} m/s")
 
     import matplotlib

@@ -21,7 +21,7 @@ on until the parent reaches its core (the FMU's step then fails with the reason 
 Writes ``tension_control_fmu.png`` and ``tension_control_fmu.npz`` to ``--out``.
 
     python examples/tension_control_fmu.py [--t-end 60] [--step 0.002] [--out out]
-                                           [--pythonfmu]
+                                           [--pythonfmu | --fmu FILE.fmu]
 """
 
 from __future__ import annotations
@@ -173,6 +173,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="the drum's web-speed rate in J(r)·ω̇_ref: the profile's mean over "
                          "the step, or the measured acceleration at its start")
     ap.add_argument("--out", type=Path, default=ROOT / "out", help="output folder")
+    ap.add_argument("--fmu", type=Path,
+                    help="a native FMU of models/winder_line_fmu.toml already built (winder "
+                         "fmu models/winder_line_fmu.toml -o FILE): run it, build none")
     ap.add_argument("--pythonfmu", action="store_true",
                     help="the pythonfmu FMU (needs winder in the host's Python) instead of "
                          "the native one")
@@ -181,8 +184,13 @@ def main(argv: list[str] | None = None) -> int:
     scene = winder.load_scene(SCENE)
     law = TensionLaw(scene, args.tension, args.bandwidth, args.feedforward)
     wall0 = time.perf_counter()
-    fmu_file = (build_fmu if args.pythonfmu else build_native_fmu)(
-        SCENE, args.out / "winder_line_fmu.fmu")
+    if args.fmu is not None:
+        if args.pythonfmu:
+            ap.error("--fmu runs the FMU given; --pythonfmu builds one: give one of them")
+        fmu_file = args.fmu
+    else:
+        fmu_file = (build_fmu if args.pythonfmu else build_native_fmu)(
+            SCENE, args.out / "winder_line_fmu.fmu")
     wall1 = time.perf_counter()
     log, ended = run(fmu_file, law, args.t_end, args.step)
     wall = time.perf_counter() - wall1
@@ -191,8 +199,9 @@ def main(argv: list[str] | None = None) -> int:
     settled = t >= 1.0
     k1 = int(np.argmax(np.abs(e) * settled))
     print(f"{t[-1]:.4f} s simulated in {wall:.1f} s wall ({t[-1] / wall:.2f}× real time; "
-          f"{'pythonfmu' if args.pythonfmu else 'native'} FMU built in "
-          f"{wall1 - wall0:.1f} s), {args.step * 1e3:g} ms steps, "
+          f"{'pythonfmu' if args.pythonfmu else 'native'} FMU "
+          + (f"{args.fmu}" if args.fmu is not None else f"built in {wall1 - wall0:.1f} s")
+          + f"), {args.step * 1e3:g} ms steps, "
           f"{len(t) - 1} steps, feed-forward: {args.feedforward}")
     print(f"run-out: {ended}" if ended else "the parent did not run out")
     print(f"parent radius {log['parent_radius'][-1]:.6f} m, set radius "

@@ -37,9 +37,10 @@ from winder.fmu.native import build_native_fmu, model_identifier  # noqa: E402
 HOST_C = Path(__file__).with_name("native_host.c")
 
 
-def _cli_native(scene: Path, out: Path) -> Path:
+def _cli_native(scene: Path, out: Path, *options: str) -> Path:
+    """``winder fmu`` (the native FMU is the default)."""
     proc = subprocess.run([sys.executable, "-m", "winder", "fmu", str(scene), "-o", str(out),
-                           "--native"], capture_output=True, text=True, timeout=600)
+                           *options], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert "native" in proc.stdout and "run-checked with FMPy" in proc.stdout, proc.stdout
     return out
@@ -627,3 +628,132 @@ def test_misuse_is_refused_with_a_reason(line_fmu) -> None:
     text = "\n".join(log)
     assert "steps must be contiguous" in text and "fixed parameter" in text
     assert "is not finite" in text and "rk4 is a fixed parameter" in text
+
+
+# ---- the single-drum interface (the pythonfmu FMU's) --------------------------------------
+
+@pytest.fixture(scope="module")
+def free_drum_fmu(tmp_path_factory, models_dir) -> Path:
+    """The paper scene's drum freed on ``drum_torque_command`` (speed_profile = false)."""
+    return build_native_fmu(models_dir / "paper_winding.toml",
+                            tmp_path_factory.mktemp("native4") / "free.fmu",
+                            speed_profile=False)
+
+
+def test_single_drum_interface(free_drum_fmu, paper_fmu) -> None:
+    """The pythonfmu FMU's own variables, declared as it declares them: the Boolean
+    parameter ``speed_profile`` (fixed; its built value; the other is refused with the
+    build option that gives it), the input ``drum_torque_command`` [N.m] (start 0) and
+    the output ``web_speed_reference`` [m/s]; ``drum_torque`` stays an output."""
+    for path, profile in ((free_drum_fmu, False), (paper_fmu, True)):
+        md = fmpy.read_model_description(str(path))
+        by = {v.name: v for v in md.modelVariables}
+        sw = by["speed_profile"]
+        assert (sw.type, sw.causality, sw.variability) == ("Boolean", "parameter", "fixed")
+        assert sw.start == str(profile).lower()
+        ref = by["web_speed_reference"]
+        assert (ref.causality, ref.variability, ref.unit) == ("output", "continuous", "m/s")
+        assert by["drum_torque"].causality == "output"
+        if not profile:
+            cmd = by["drum_torque_command"]
+            assert (cmd.causality, cmd.variability, cmd.unit, float(cmd.start)) == \
+                ("input", "continuous", "N.m", 0.0)
+        else:
+            assert "drum_torque_command" not in by
+        with slave(path) as (fmu, refs, log):
+            vr = refs["speed_profile"]
+            assert fmu.getBoolean([vr]) == [profile]
+            fmu.setBoolean([vr], [profile])  # its own value: accepted
+            with pytest.raises(FMICallException):
+                fmu.setBoolean([vr], [not profile])
+            assert "speed-profile" in log[-1], log
+
+
+def test_free_drum_equals_the_stepper_bit_for_bit(free_drum_fmu, paper_scene) -> None:
+    """speed_profile = false, the drum torque driven by a signal, 200 steps of 10 ms:
+    every output equals the in-process Stepper's of the same scene (the drum freed as
+    the pythonfmu FMU frees it: winder.fmu.build.scene_with_parameters) exactly, and
+    web_speed_reference is min(a_w t, v_w) of the scene's profile."""
+    from winder.fmu.build import scene_with_parameters
+
+    sim = winder.Stepper(scene_with_parameters(paper_scene, {}, speed_profile=False))
+    names = [k for k in _outputs(free_drum_fmu) if k != "web_speed_reference"]
+    d = paper_scene.drum.drive
+    with slave(free_drum_fmu) as (fmu, refs, _):
+        for i in range(200):
+            tau = 30.0 + 20.0 * np.sin(0.1 * i)
+            fmu.setReal([refs["drum_torque_command"]], [tau])
+            sim.set_input("drum_torque", tau)
+            fmu.doStep(i * 0.01, 0.01)
+            sim.step(0.01)
+            got = fmu.getReal([refs[k] for k in names])
+            want = [sim.output(k) for k in names]
+            assert got == want, i
+            ref = fmu.getReal([refs["web_speed_reference"]])[0]
+            assert ref == pytest.approx(min(d.web_acceleration * sim.t, d.web_speed),
+                                        rel=1e-12)
+
+
+_LOOP_SCRIPT = """
+import importlib.util, json, sys
+from pathlib import Path
+import numpy as np
+spec = importlib.util.spec_from_file_location("ex", sys.argv[1])
+ex = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(ex)
+out = Path(sys.argv[2])
+(out / "n").mkdir()
+(out / "p").mkdir()
+native, _ = ex.closed_loop(ex.build(out / "n"), 20.0, 0.01)
+old, _ = ex.closed_loop(ex.build(out / "p", pythonfmu=True), 20.0, 0.01)
+print(json.dumps({k: [float(np.max(np.abs(native[:, j] - old[:, j]))),
+                      float(np.max(np.abs(old[:, j])))]
+                  for j, k in enumerate(["t", "torque", *ex.NAMES])}))
+"""
+
+
+def test_speed_control_example_native_equals_pythonfmu(tmp_path) -> None:
+    """examples/speed_control_fmu.py's PI loop, 20 s at 10 ms, through the native FMU
+    and through the pythonfmu FMU (in a child process: pythonfmu's own exit abort): radius
+    to 1e-6 m, torque, speeds and forces to 1e-5 of their largest magnitude (measured:
+    equal bit for bit, the same generated code and integrator)."""
+    pytest.importorskip("pythonfmu")
+    example = Path(__file__).resolve().parents[2] / "examples" / "speed_control_fmu.py"
+    proc = subprocess.run([sys.executable, "-c", _LOOP_SCRIPT, str(example), str(tmp_path)],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    import json
+
+    diffs = json.loads(proc.stdout.strip().splitlines()[-1])
+    for k, (diff, scale) in diffs.items():
+        assert diff < (1e-6 if k == "radius" else 1e-5 * max(scale, 1e-9)), (k, diff)
+
+
+def test_tension_example_runs_a_built_fmu(line_fmu, tmp_path) -> None:
+    """examples/tension_control_fmu.py --fmu (make demo's way): the native FMU given is
+    run, none built; its figure and log written to --out."""
+    example = Path(__file__).resolve().parents[2] / "examples" / "tension_control_fmu.py"
+    proc = subprocess.run([sys.executable, str(example), "--t-end", "1", "--fmu",
+                           str(line_fmu), "--out", str(tmp_path)],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert f"native FMU {line_fmu})" in proc.stdout, proc.stdout
+    assert not (tmp_path / "winder_line_fmu.fmu").exists()
+    assert len(np.load(tmp_path / "tension_control_fmu.npz")["t"]) == 501
+    assert (tmp_path / "tension_control_fmu.png").stat().st_size > 10_000
+
+
+def test_cli_builds_either_single_drum_machine(tmp_path, models_dir) -> None:
+    """winder fmu --no-speed-profile: the free drum (the native FMU, by default);
+    --speed-profile is refused with --pythonfmu (whose switch is a parameter)."""
+    path = _cli_native(models_dir / "paper_winding.toml", tmp_path / "free.fmu",
+                       "--no-speed-profile")
+    md = fmpy.read_model_description(str(path))
+    by = {v.name: v for v in md.modelVariables}
+    assert by["speed_profile"].start == "false" and "drum_torque_command" in by
+    proc = subprocess.run([sys.executable, "-m", "winder", "fmu",
+                           str(models_dir / "paper_winding.toml"), "-o",
+                           str(tmp_path / "old.fmu"), "--pythonfmu", "--speed-profile"],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode != 0 and "speed_profile" in proc.stderr, proc.stderr
+    assert not (tmp_path / "old.fmu").exists()

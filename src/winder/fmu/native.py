@@ -116,6 +116,11 @@ class NativeInterface:
     derivatives: tuple[Variable, ...]
     ramps: tuple[tuple[int, int, int], ...]  # (a_w, v_w, ramp time) parameter indices
     x0: np.ndarray
+    #: a single-drum scene's own interface (:attr:`Naming.fmu
+    #: <winder.scene.naming.Naming.fmu>`): its profile switch's name and built value, and
+    #: its profile ``min(a_w t, v_w)``: the machine parameter indices of ``a_w``, ``v_w``
+    #: (-1: none, the constants then) and the constants ``a_w``, ``v_w``; else None
+    own: tuple[str, bool, int, int, float, float] | None = None
 
 
 def _unit(unit: str | None) -> str | None:
@@ -154,10 +159,13 @@ def _runtime_parameters(scene: Scene, machine: Machine
     return found, skipped
 
 
-def native_interface(scene: Scene) -> NativeInterface:
+def native_interface(scene: Scene, profile: tuple[float, float] | None = None
+                     ) -> NativeInterface:
     """The variables of ``scene``'s native FMU, with value references in the wrapper's
     layout (``fmu/c/fmi2.c``): outputs, inputs, parameters, solver settings, states,
-    derivatives."""
+    derivatives. ``profile``: a single-drum scene's speed profile ``(a_w, v_w)`` as the
+    scene file gives it (its drum freed, ``scene`` starts it at the initial speed); None:
+    ``scene``'s."""
     system = MachineSystem(scene)
     if system.generated is None:
         raise FmuError("a native FMU needs the generated code: no C compiler")
@@ -175,6 +183,9 @@ def native_interface(scene: Scene) -> NativeInterface:
                        f"{times}: the native FMU cannot move them with the parameters")
     x0 = system.initial_state()
     inputs = {n: names.index(p) for n, p in inputs_of(system).items() if p in names}
+    own = scene.naming.fmu
+    if own is not None:  # the single-drum interface: its own input names
+        inputs = {fmu: inputs[st] for fmu, st in own.inputs.items() if st in inputs}
     outputs = {n: c for n, (c, _) in system.outputs.items() if n not in inputs}
     units = system.channel_units
     ch0 = system.channels(np.array([0.0]), x0[:, None])
@@ -185,6 +196,19 @@ def native_interface(scene: Scene) -> NativeInterface:
                              _unit(units[name]), initial="exact"))
         out_ch.append(m.channel_names.index(channel) if channel in m.channel_names else -1)
         vr += 1
+    own_data = None
+    if own is not None:  # the profile a speed controller follows, min(a_w t, v_w)
+        drive = scene.drum.drive
+        a_w, v_w = profile or (float(drive.web_acceleration), float(drive.web_speed))
+        profile = any(b.prescribed for b in body_elements(scene))
+        ia = names.index("drum.web_acceleration") if profile else -1
+        iv = names.index("drum.web_speed") if profile else -1
+        ref0 = v_w if a_w <= 0 else 0.0
+        outs.append(Variable(own.profile_reference, vr, "output", "continuous", ref0,
+                             _unit(parameter_units(scene)[own.speed]), initial="exact"))
+        out_ch.append(-3)
+        vr += 1
+        own_data = (own.profile_switch, profile, ia, iv, a_w, v_w)
     if m.unwind is not None:
         outs.append(Variable("t", vr, "output", "continuous", 0.0, "s",
                              "time of the outputs [s]: the end of the last step, or where "
@@ -194,7 +218,8 @@ def native_interface(scene: Scene) -> NativeInterface:
     ins = []
     for name, i in inputs.items():
         decl = input_of(names[i])
-        ins.append(Variable(name, vr, "input", "continuous", float(system.params[i]),
+        ins.append(Variable(name, vr, "input", "continuous",
+                            0.0 if own is not None else float(system.params[i]),
                             _unit(decl.unit), f"{decl.doc} [{decl.unit}]"))
         vr += 1
     found, skipped = _runtime_parameters(scene, m)
@@ -222,7 +247,7 @@ def native_interface(scene: Scene) -> NativeInterface:
     return NativeInterface(system, tuple(outs), tuple(out_ch), tuple(ins),
                            tuple(inputs.values()), tuple(pars), tuple(found.values()),
                            tuple(skipped), tuple(solver), tuple(states), tuple(ders),
-                           tuple(ramps), x0)
+                           tuple(ramps), x0, own_data)
 
 
 # ---- files ---------------------------------------------------------------------------------
@@ -265,6 +290,11 @@ def _model_header(iface: NativeInterface, symbol: str, guid: str, balance: Balan
     text += _c_array("int", "W_Z", indicators(sy))
     text += _c_array("int", "W_U", balance.unknowns)
     text += _c_array("double", "W_MB", balance.modes, float.hex)
+    own = iface.own or ("", False, -1, -1, 0.0, 0.0)
+    text += (f"#define W_OWN {int(iface.own is not None)}\n"
+             f"#define W_PROFILE {int(own[1])}\n#define W_REF_AP {own[2]}\n"
+             f"#define W_REF_VP {own[3]}\n#define W_REF_A {float.hex(own[4])}\n"
+             f"#define W_REF_V {float.hex(own[5])}\n")
     text += f"static const char* const W_SLOT_OWNER[] = {{{', '.join(owners)}}};\n"
     return text + "#endif\n"
 
@@ -368,6 +398,18 @@ def _model_description(iface: NativeInterface, model: str, guid: str, scene: Sce
         "description": "true: fixed-step RK4 of step rk4_step (real-time targets); false: "
                        "DOPRI5 to rtol and atol with located events"})
     ET.SubElement(sv, "Boolean", {"start": "false"})
+    if iface.own is not None:  # the single-drum interface's switch (built in one mode)
+        name, profile = iface.own[0], iface.own[1]
+        own = scene.naming.fmu
+        assert own is not None
+        sv = ET.SubElement(mv, "ScalarVariable", {
+            "name": name, "valueReference": "1", "causality": "parameter",
+            "variability": "fixed", "initial": "exact",
+            "description": f"{own.switch_doc} {', '.join(own.inputs)} (this FMU was built "
+                          f"with {name} = {str(profile).lower()}: the other value is "
+                          f"refused; winder fmu --{name.replace('_', '-')}/"
+                          f"--no-{name.replace('_', '-')} builds either)"})
+        ET.SubElement(sv, "Boolean", {"start": str(profile).lower()})
     ms = ET.SubElement(root, "ModelStructure")
     outs = ET.SubElement(ms, "Outputs")
     for v in iface.outputs:
@@ -424,20 +466,34 @@ def model_identifier(scene: Scene) -> str:
 
 
 def build_native_fmu(scene_path: str | Path, out: str | Path, *,
-                     sanitize: bool = False) -> Path:
+                     sanitize: bool = False, speed_profile: bool | None = None) -> Path:
     """Build the native FMU of a scene file at ``out`` (an ``.fmu``), atomically.
     ``sanitize``: compile with AddressSanitizer and UBSan (for tests; the host must then
-    load libasan). Raises :class:`FmuError`."""
+    load libasan). ``speed_profile`` (single-drum scenes only): the drum on its speed
+    profile (true) or freed on the input ``drum_torque_command`` (false), fixed at build
+    time (the two are different machines); None: the scene's drive. Raises
+    :class:`FmuError`."""
     from winder.io.files import atomic_write, scratch_dir
 
     scene_path, out = Path(scene_path), Path(out)
     scene = load_scene(scene_path)
+    profile = None
+    if scene.naming.fmu is not None:
+        profile = (float(scene.drum.drive.web_acceleration),
+                   float(scene.drum.drive.web_speed))
+        if speed_profile is None:
+            speed_profile = any(b.prescribed for b in body_elements(scene))
+        scene = scene_with_parameters(scene, {}, speed_profile=speed_profile)
+    elif speed_profile is not None:
+        raise FmuError("speed_profile is a parameter of single-drum scenes only")
     if out.suffix != ".fmu":
         raise FmuError(f"output file must end in .fmu, got {str(out)!r}")
     if len(scene.webs) > 1:
-        raise FmuError(f"{scene_path}: [[web]]: {len(scene.webs)} webs; the FMU takes a "
-                       "scene with one web (one winding station)")
-    iface = native_interface(scene)
+        raise FmuError(f"{scene_path}: [[web]]: {len(scene.webs)} webs "
+                       f"({', '.join(w.name for w in scene.webs)}); the FMU takes a scene "
+                       "with one web (one winding station); valid: one [web] table (run "
+                       "several stations with winder run)")
+    iface = native_interface(scene, profile)
     model = model_identifier(scene)
     headers = _headers_dir()
     with scratch_dir("winder_native_fmu_") as d:

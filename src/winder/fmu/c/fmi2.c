@@ -128,10 +128,19 @@ static void rates(Comp* s, const double* y, const double* p, double* dy) {
     W_RHS_FN(tb, y, p, s->mw, dy);
 }
 
+/* a single-drum scene's web-speed profile min(a_w t, v_w) (a_w = 0: v_w from t = 0) */
+static double profile_reference(const double* p, double t) {
+    double a = W_REF_AP >= 0 ? p[W_REF_AP] : W_REF_A;
+    double v = W_REF_VP >= 0 ? p[W_REF_VP] : W_REF_V;
+    return a > 0.0 ? fmin(a * t, v) : v;
+}
+
 static double output_of(Comp* s, int i) {
     int ch = W_OUT_CH[i];
     if (ch == -2)
         return s->c.t;
+    if (ch == -3)
+        return profile_reference(s->c.p, s->c.t);
     if (ch < 0)
         return 0.0; /* a channel the machine lacks (an effect off) is zero */
     channels(s);
@@ -389,6 +398,10 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
                           fmi2Boolean value[]) {
     Comp* s = c;
     for (size_t i = 0; i < nvr; i++) {
+        if (W_OWN && vr[i] == 1) { /* the single-drum switch, fixed at build time */
+            value[i] = W_PROFILE ? fmi2True : fmi2False;
+            continue;
+        }
         if (vr[i] != 0)
             return fail(s, "%s", "unknown Boolean value reference");
         value[i] = s->c.rk4 ? fmi2True : fmi2False;
@@ -400,6 +413,15 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
                           const fmi2Boolean value[]) {
     Comp* s = c;
     for (size_t i = 0; i < nvr; i++) {
+        if (W_OWN && vr[i] == 1) { /* the single-drum switch: the machine it was built as */
+            if ((value[i] ? 1 : 0) != W_PROFILE)
+                return fail(s, "%s", W_PROFILE
+                    ? "speed_profile = false needs the free-drum machine: build this FMU "
+                      "with winder fmu --no-speed-profile"
+                    : "speed_profile = true needs the profile-driven machine: build this "
+                      "FMU with winder fmu --speed-profile");
+            continue;
+        }
         if (vr[i] != 0)
             return fail(s, "%s", "unknown Boolean value reference");
         if (s->c.mode == M_STEP)
@@ -496,6 +518,8 @@ static double unknown_at(Comp* s, fmi2ValueReference r, const double* y, const d
         int ch = W_OUT_CH[r];
         if (ch == -2)
             return s->c.t;
+        if (ch == -3)
+            return profile_reference(p, s->c.t);
         if (ch < 0)
             return 0.0;
         winder_modes(s->fns, W_TABLE, W_NSLOTS, W_NSW, s->c.t, y, W_N, p, s->mw, 1);
