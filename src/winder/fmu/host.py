@@ -4,6 +4,7 @@ CLI's run-check, the FMU tests and the real-time benchmark (needs ``winder[fmu]`
 from __future__ import annotations
 
 import shutil
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -11,9 +12,10 @@ from pathlib import Path
 import fmpy
 from fmpy.fmi2 import FMU2Slave
 
+from winder._errors import WinderError
 from winder.fmu.build import FmuError
 
-__all__ = ["loaded_fmu", "start_fmu"]
+__all__ = ["loaded_fmu", "start_fmu", "check_fmu"]
 
 
 @contextmanager
@@ -49,3 +51,24 @@ def start_fmu(fmu: FMU2Slave, refs: dict[str, int], *, logging: bool = True,
         else:
             fmu.setReal([refs[name]], [float(value)])
     fmu.exitInitializationMode()
+
+
+def check_fmu(path: Path) -> str:
+    """Load the FMU in FMPy in this process and run ten 1 ms steps; a one-line report."""
+    with loaded_fmu(path, instance_name="check") as (fmu, refs, _):
+        try:
+            start_fmu(fmu, refs)
+            for i in range(10):
+                fmu.doStep(currentCommunicationPoint=i * 1e-3, communicationStepSize=1e-3)
+            # the roll's radius: ``radius`` (single drum) or the first ``ROLL_radius``
+            name = "radius" if "radius" in refs else next(
+                (k for k in refs if k.endswith("_radius")), None)
+            radius = fmu.getReal([refs[name]])[0] if name is not None else None
+            fmu.terminate()
+        except Exception as exc:  # FMPy raises plain exceptions with the FMI status
+            raise WinderError(f"{path} was built but does not run in this Python "
+                              f"({sys.executable}): {exc}") from exc
+        finally:
+            fmu.freeInstance()
+    where = f", {name} {radius:.6g} m" if name is not None else ""
+    return f"run-checked with FMPy {fmpy.__version__}: 10 steps of 1 ms{where}"
