@@ -154,21 +154,11 @@ int winder_dopri5(const int64_t* fns, const int64_t* table, int64_t nslots,
         int64_t slot = sample_and_switch(cx, rc, t, hh, t1, y, y1, t_out, n_out, Y_out, &k,
                                          &new_mode, &t_end);
         stats[1] += 1;
-        if (slot == GUARD) {
-            t = t_end;
-            status = PENETRATED;
+        int switched;
+        status = end_of_step(cx, slot, new_mode, t_end, y, k1, &t, &nfev, stats, &switched);
+        if (status != DONE)
             break;
-        }
-        if (slot >= 0) {
-            t = t_end;
-            if (new_mode == END) {
-                status = EXHAUSTED;
-                break;
-            }
-            m[slot] = new_mode;
-            evaluate(cx, F_RHS, t, y, k1);
-            nfev += 1;
-            stats[3] += 1;
+        if (switched) {
             h = hh;
             rejected_last = 0;
             continue;

@@ -399,6 +399,31 @@ static inline int64_t sample_and_switch(Ctx* cx, const double* rc, double t, dou
 }
 
 /* Work buffers: g, g0 (switches), yt, ye (n), rl (5 n), then n_extra vectors of n. */
+/* What an accepted step's event (sample_and_switch's slot) does to the run: PENETRATED at
+ * the guard, EXHAUSTED at an unwinding roll's run-out (t moved there), or DONE where the
+ * integration goes on; a mode switch sets the slot's mode, moves t to the event, evaluates
+ * f there (the next step's first stage) and sets *switched. Shared by DOPRI5 and ROS2. */
+static inline int end_of_step(Ctx* cx, int64_t slot, double new_mode, double t_end,
+                              const double* y, double* f, double* t, int64_t* nfev,
+                              int64_t* stats, int* switched) {
+    *switched = 0;
+    if (slot == GUARD) {
+        *t = t_end;
+        return PENETRATED;
+    }
+    if (slot >= 0) {
+        *t = t_end;
+        if (new_mode == END)
+            return EXHAUSTED;
+        cx->m[slot] = new_mode;
+        evaluate(cx, F_RHS, *t, y, f);
+        *nfev += 1;
+        stats[3] += 1;
+        *switched = 1;
+    }
+    return DONE;
+}
+
 static inline int ctx_init(Ctx* cx, const int64_t* fns, const int64_t* table, int64_t nslots,
                     int64_t n_switches, int64_t n, const double* p, double* m, double** extra,
                     int64_t n_extra) {

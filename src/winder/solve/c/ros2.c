@@ -180,23 +180,12 @@ int winder_ros2(const int64_t* fns, const int64_t* table, int64_t nslots,
                                          &new_mode, &t_end);
         stats[1] += 1;
         fresh = 0;
-        if (slot == GUARD) {
-            t = t_end;
-            status = PENETRATED;
+        int switched;
+        status = end_of_step(cx, slot, new_mode, t_end, y, f0, &t, &nfev, stats, &switched);
+        if (status != DONE)
             break;
-        }
-        if (slot >= 0) {
-            t = t_end;
-            if (new_mode == END) {
-                status = EXHAUSTED;
-                break;
-            }
-            m[slot] = new_mode;
-            evaluate(cx, F_RHS, t, y, f0);
-            nfev += 1;
-            stats[3] += 1;
+        if (switched)
             continue;
-        }
         for (int64_t i = 0; i < n; i++) {
             y[i] = y1[i];
             f0[i] = f2[i];
