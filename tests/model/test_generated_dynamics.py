@@ -364,7 +364,10 @@ def test_nip_channels_against_the_spec_formulas(variant: str) -> None:
     assert {(True, True, True), (True, False, True), (False, True, False),
             (False, False, False)} <= seen
     # measured: 0 (two_drum), 3.0e-16 (single drum, Hunt-Crossley)
-    assert worst < 5e-15
+    # the forces scale with k δ, and δ = r_a + r_b − |d| carries the round-off of |d| (one
+    # ulp of about 1 m, 1.1e-16 m, against the scale 1e-4 m): measured 1.7e-12 with
+    # CasADi 3.8.2 and NumPy 2.4.6 (the two compute |d| in another order; 0 before)
+    assert worst < 2e-11
 
 
 def test_web_forces_on_the_roll() -> None:
