@@ -13,7 +13,7 @@ import fmpy
 from fmpy.fmi2 import FMU2Slave
 
 from winder._errors import WinderError
-from winder.fmu.build import FmuError
+from winder.fmu.parameters import FmuError
 
 __all__ = ["loaded_fmu", "start_fmu", "check_fmu"]
 

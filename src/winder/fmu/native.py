@@ -15,7 +15,7 @@ Interface (every name from the machine's and the scene's names):
 - inputs: the :class:`~winder.Stepper`'s (``DRUM_torque`` [N·m] per torque-driven drum
   or unwinding roll, ``ROLL_tension_setpoint`` [N]), units and descriptions from their
   declarations (:func:`winder.model.channels.input_of`);
-- parameters (``fixed``): the scene's FMU parameters (:func:`winder.fmu.build.fmu_parameters`,
+- parameters (``fixed``): the scene's FMU parameters (:func:`winder.fmu.parameters.fmu_parameters`,
   named by part, units and descriptions from the scene schema) that are run-time
   parameters of the machine (found by changing each and comparing the machine's
   parameter vectors: changing one compiles nothing); a drum's ramp time ``v_w / a_w`` is
@@ -52,7 +52,7 @@ import numpy as np
 
 from winder._errors import WinderError
 from winder.fmu.balance import Balance, balance_of, write_balance_source
-from winder.fmu.build import (
+from winder.fmu.parameters import (
     FmuError,
     fmu_parameters,
     parameter_units,
@@ -68,7 +68,7 @@ from winder.scene.load import Scene, load_scene
 from winder.solve.stepper import inputs_of
 from winder.solve.system import MachineSystem
 
-__all__ = ["build_native_fmu", "NativeInterface", "native_interface", "SOLVER_PARAMETERS"]
+__all__ = ["build_fmu", "NativeInterface", "native_interface", "SOLVER_PARAMETERS"]
 
 _C = Path(__file__).resolve().parent / "c"
 _SOLVE_C = Path(__file__).resolve().parents[1] / "solve" / "c"
@@ -465,8 +465,8 @@ def model_identifier(scene: Scene) -> str:
     return "winder_" + (re.sub(r"\W", "_", scene.name or "") or "machine")
 
 
-def build_native_fmu(scene_path: str | Path, out: str | Path, *,
-                     sanitize: bool = False, speed_profile: bool | None = None) -> Path:
+def build_fmu(scene_path: str | Path, out: str | Path, *,
+              sanitize: bool = False, speed_profile: bool | None = None) -> Path:
     """Build the native FMU of a scene file at ``out`` (an ``.fmu``), atomically.
     ``sanitize``: compile with AddressSanitizer and UBSan (for tests; the host must then
     load libasan). ``speed_profile`` (single-drum scenes only): the drum on its speed
