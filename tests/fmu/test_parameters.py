@@ -16,8 +16,9 @@ TORQUE_DRIVE = {"kind": "torque", "torque": 0.0, "web_speed": 0.0}
 
 @pytest.fixture(scope="module")
 def torque_scene(models_dir) -> winder.Scene:
-    """The two-drum winder with both drums torque-driven (from rest)."""
-    data = winder.load_scene(models_dir / "two_drum_winder.toml").to_dict()  # (replace merges into the drive: no change of kind)
+    """The two-drum winder with both drums torque-driven (from rest; through the dict:
+    ``replace`` merges into the drive, with no change of kind)."""
+    data = winder.load_scene(models_dir / "two_drum_winder.toml").to_dict()
     for drum in data["drum"]:
         drum["drive"] = dict(TORQUE_DRIVE)
     return winder.scene_from_dict(data)
