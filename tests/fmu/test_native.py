@@ -434,6 +434,30 @@ def test_model_exchange_matches_simulate(which, file, request, models_dir) -> No
     assert checked >= 5
 
 
+def test_model_exchange_leaves_the_core_at_rest(free_drum_fmu, paper_scene) -> None:
+    """The free drum from rest under a constant 30 N·m: the roll starts at rest on its core,
+    both core switching functions exactly 0, so the core mode starts at the core. Model
+    exchange (FMPy's CVode, rtol 1e-8) must see the roll leave it: radius and speeds
+    against winder.simulate (DOPRI5, rtol 1e-8) over 2 s (measured: radius 1.2e-13 m,
+    speeds 7e-8 relative). Reporting a zero indicator as zero instead, CVode saw no sign
+    change and the radius stayed at the core, 0.0750000 against 0.0750219 m."""
+    from winder.fmu.parameters import scene_with_parameters
+
+    scene = scene_with_parameters(paper_scene, {}, speed_profile=False).replace(
+        drum={"drive": {"torque": 30.0}})
+    ref = winder.simulate(scene, t_end=2.0, output_step=0.01, method="DOPRI5", rtol=1e-8,
+                          atol=1e-10)
+    names = ["radius", "roll_speed", "drum_speed"]
+    res = fmpy.simulate_fmu(str(free_drum_fmu), fmi_type="ModelExchange", solver="CVode",
+                            stop_time=2.0, output_interval=0.01, relative_tolerance=1e-8,
+                            start_values={"drum_torque_command": 30.0}, output=names)
+    assert ref["radius"][-1] - ref["radius"][0] > 2e-5
+    got = {k: np.interp(ref.t, res["time"], res[k]) for k in names}
+    assert np.max(np.abs(got["radius"] - ref["radius"])) < 1e-11
+    for k in names[1:]:
+        assert np.max(np.abs(got[k] - ref[k])) < 1e-6 * np.max(np.abs(ref[k])), k
+
+
 def test_model_structure_from_the_jacobian(two_drum_fmu, models_dir) -> None:
     """numberOfEventIndicators: the switching functions the mode table refers to; each
     derivative's dependencies are the structural nonzeros of the generated Jacobian:

@@ -61,6 +61,7 @@ from winder.fmu.parameters import (
 )
 from winder.model.channels import input_of
 from winder.model.codegen import CFLAGS, SANITIZE_CFLAGS, run_compiler, write_source
+from winder.model.locked_modes import ModeKind
 from winder.model.machine import Machine
 from winder.model.units import BASE_UNITS, DIMENSIONS, dimensions, fmi_name
 from winder.parts import body_elements
@@ -288,6 +289,7 @@ def _model_header(iface: NativeInterface, symbol: str, guid: str, balance: Balan
     text += _c_array("int", "W_PAR_P", iface.parameter_params)
     text += _c_array("int", "W_RAMP", [i for r in iface.ramps for i in r])
     text += _c_array("int", "W_Z", indicators(sy))
+    text += _c_array("int", "W_Z_ZERO", [side for _, side in _indicators(sy)])
     text += _c_array("int", "W_U", balance.unknowns)
     text += _c_array("double", "W_MB", balance.modes, float.hex)
     own = iface.own or ("", False, -1, -1, 0.0, 0.0)
@@ -303,12 +305,23 @@ def indicators(system: MachineSystem) -> list[int]:
     """The event indicators of model exchange: the switching functions (indices into
     ``machine.switch_names``) the mode table switches on, in the table's order: a
     contact's ``g1``, a core's ``g1`` and ``g2``, an unwinding roll's end ``g1``."""
-    out: list[int] = []
+    return [g for g, _ in _indicators(system)]
+
+
+def _indicators(system: MachineSystem) -> list[tuple[int, int]]:
+    """:func:`indicators` with the side (+1 or -1) the mode rule puts an indicator at
+    exactly zero on (``modes_of`` in ``solve/c/events.h``): a core's ``r_c − r`` and an
+    end's at zero are at the core (+1); a contact at zero is open, a roll at rest at its
+    core is not winding (-1). The FMU reports a zero indicator as ±1e-300 on that side:
+    a host that starts on a boundary (a roll at rest on its core) then sees a sign change
+    when the state leaves it."""
+    out: dict[int, int] = {}
     for kind, g1, g2, _, _ in system.table.tolist():
-        for g in (g1, g2) if kind == 1 else (g1,):
-            if g not in out:
-                out.append(int(g))
-    return out
+        pairs = ((g1, 1), (g2, -1)) if kind == ModeKind.CORE else \
+            ((g1, 1 if kind == ModeKind.END else -1),)
+        for g, side in pairs:
+            out.setdefault(int(g), side)
+    return list(out.items())
 
 
 def _dependencies(iface: NativeInterface, pattern: dict[str, np.ndarray]

@@ -866,7 +866,10 @@ fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real dx[], size_t nx) {
     return fmi2OK;
 }
 
-/* the switching functions the mode table refers to, in the machine's locked modes */
+/* the switching functions the mode table refers to, in the machine's locked modes; one
+ * exactly at zero is reported on the side the mode rule puts zero (W_Z_ZERO: ±1e-300), so
+ * that a host which starts on a boundary (a roll at rest on its core) sees a sign change
+ * when the state leaves it */
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real z[], size_t ni) {
     Comp* s = c;
     double g[W_NSW + 1];
@@ -875,7 +878,7 @@ fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real z[], size_t ni) {
         return fail(s, "%s", "fmi2GetEventIndicators: wrong number of event indicators");
     W_SW_FN(tb, s->c.y, s->c.p, s->c.m, g);
     for (int i = 0; i < W_NZ; i++)
-        z[i] = g[W_Z[i]];
+        z[i] = g[W_Z[i]] != 0.0 ? g[W_Z[i]] : W_Z_ZERO[i] * 1e-300;
     return fmi2OK;
 }
 
