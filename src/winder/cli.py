@@ -271,12 +271,13 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
     from winder.io.files import check_output_file
 
     out = check_output_file(args.out, "-o/--out", suffixes=(".fmu",))
-    from winder.fmu.native import build_fmu
+    from winder.fmu.native import FMI_VERSIONS, build_fmu
 
-    out = build_fmu(args.scene, out, speed_profile=args.speed_profile)
-    print(f"FMI 2.0 co-simulation and model-exchange FMU (native: no Python inside) written "
-          f"to {out}\n  binaries/linux64 from the system C compiler; sources/ rebuild it "
-          "elsewhere (fmpy compile)")
+    out = build_fmu(args.scene, out, fmi_version=args.fmi_version,
+                    speed_profile=args.speed_profile)
+    print(f"FMI {args.fmi_version}.0 co-simulation and model-exchange FMU (native: no Python "
+          f"inside) written to {out}\n  binaries/{FMI_VERSIONS[args.fmi_version][2]} from the "
+          "system C compiler; sources/ rebuild it elsewhere (fmpy compile)")
     if args.check:
         print("  " + _check_fmu(out))
     return 0
@@ -469,6 +470,9 @@ def _build_parser() -> argparse.ArgumentParser:
     fmu.add_argument("-o", "--out", default="winder.fmu", help="FMU file (default winder.fmu)")
     fmu.add_argument("--check", action=argparse.BooleanOptionalAction, default=True,
                      help="load the built FMU with FMPy and step it (default on)")
+    fmu.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                     help="FMI 2.0 (default) or FMI 3.0; both with co-simulation and model "
+                          "exchange")
     fmu.add_argument("--native", action="store_true",
                      help="accepted for older scripts: every FMU is native (the compiled "
                           "machine and C integrators, no Python inside)")

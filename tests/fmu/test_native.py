@@ -463,7 +463,7 @@ def test_model_structure_from_the_jacobian(two_drum_fmu, models_dir) -> None:
     derivative's dependencies are the structural nonzeros of the generated Jacobian:
     they contain every numerical nonzero at a state of the run, and an angle's rate
     depends on its speed alone."""
-    from winder.fmu.native import indicators
+    from winder.fmu.interface import indicators
 
     scene = winder.load_scene(models_dir / "two_drum_winder.toml")
     sy = winder.Stepper(scene).system

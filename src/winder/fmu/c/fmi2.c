@@ -43,15 +43,7 @@ enum { S_DONE = 0, S_PAUSED = 1, S_UNDERFLOW = 2, S_NON_FINITE = 3, S_EXHAUSTED 
 #define K_END 2
 #define W_MAGIC 0x77696e6465723032LL /* "winder02" */
 
-/* VR layout */
-#define VR_IN W_NOUT
-#define VR_PAR (VR_IN + W_NIN)
-#define VR_RTOL (VR_PAR + W_NPAR)
-#define VR_ATOL (VR_RTOL + 1)
-#define VR_HRK4 (VR_RTOL + 2)
-#define VR_X (VR_RTOL + 3)
-#define VR_DX (VR_X + W_N)
-#define VR_END (VR_DX + W_N)
+#include "layout.h"
 
 enum { M_INSTANTIATED, M_INIT, M_STEP, M_TERMINATED, M_ERROR };
 
