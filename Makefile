@@ -52,6 +52,7 @@ demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/fmu/paper_winding.fmu
 	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/fmu/two_drum_winder.fmu
 	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/fmu/winder_line_fmu.fmu
+	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/fmu/two_drum_winder_fmi3.fmu --fmi-version 3
 	$(PY) examples/tension_control_fmu.py --fmu $(OUT)/fmu/winder_line_fmu.fmu --out $(OUT)
 	$(PY) examples/speed_control_fmu.py --out $(OUT)
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
