@@ -108,7 +108,7 @@ def measure(repeats: int, quick: bool) -> dict[str, dict[str, float]]:
 def report(rows: dict[str, dict[str, float]]) -> str:
     lines = ["# Real-time factor of the native FMU", "",
              "A plain C host (`tests/fmu/native_host.c`: dlopen, no FMPy, no Python) runs "
-             "each scene's native FMU (`winder fmu SCENE --native`) from t = 0 at 1 ms "
+             "each scene's native FMU (`winder fmu SCENE`) from t = 0 at 1 ms "
              "communication steps and reads every output after each step. Real-time factor "
              "= simulated time / wall time (best of the repeats). DOPRI5: rtol 1e-8, atol "
              "1e-10, events located; RK4: `rk4 = true`, one 1 ms step per communication "
