@@ -49,9 +49,10 @@ demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
 	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
 	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
-	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/fmu/paper_winding.fmu --native
-	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/fmu/two_drum_winder.fmu --native
-	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/fmu/winder_line_fmu.fmu --native
+	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/fmu/paper_winding.fmu
+	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/fmu/two_drum_winder.fmu
+	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/fmu/winder_line_fmu.fmu
+	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/fmu/two_drum_winder_fmi3.fmu --fmi-version 3
 	$(PY) examples/tension_control_fmu.py --fmu $(OUT)/fmu/winder_line_fmu.fmu --out $(OUT)
 	$(PY) examples/speed_control_fmu.py --out $(OUT)
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
@@ -91,7 +92,6 @@ bench: $(STAMP)
 	$(PY) benchmarks/rhs_speed.py
 	$(PY) benchmarks/compiled_machine.py $(if $(BASELINE),--baseline $(BASELINE))
 	$(PY) benchmarks/work_precision.py
-	$(PY) benchmarks/fmu_realtime.py
 	$(PY) benchmarks/fmu_native.py
 	$(PY) benchmarks/cli_speed.py
 	$(PY) benchmarks/sweep_scaling.py
@@ -122,10 +122,9 @@ fmu: $(STAMP)
 	$(PY) examples/speed_control_fmu.py --out $(OUT)
 	$(PY) -m winder fmu models/winder_line.toml -o $(OUT)/winder_line.fmu
 	$(PY) -m winder fmu models/winder_line_small.toml -o $(OUT)/winder_line_small.fmu
-	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/paper_native.fmu --native
-	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/two_drum_native.fmu --native
-	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/winder_line_native.fmu --native
-	$(PY) examples/tension_control_fmu.py --fmu $(OUT)/winder_line_native.fmu --out $(OUT)
+	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/two_drum_winder.fmu
+	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/winder_line_fmu.fmu
+	$(PY) examples/tension_control_fmu.py --fmu $(OUT)/winder_line_fmu.fmu --out $(OUT)
 
 lint: $(STAMP)
 	$(PY) -m ruff check src viewer tests examples benchmarks

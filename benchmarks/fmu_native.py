@@ -26,7 +26,7 @@ from pathlib import Path
 import fmpy
 import numpy as np
 
-from winder.fmu.native import build_native_fmu
+from winder.fmu.native import build_fmu
 from winder.io.files import atomic_write_all
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,7 +82,7 @@ def measure(repeats: int, quick: bool) -> dict[str, dict[str, float]]:
         for label, (file, t_end, goal) in SCENES.items():
             if quick:
                 t_end /= 10
-            fmu = build_native_fmu(ROOT / file, tmp / f"{Path(file).stem}.fmu")
+            fmu = build_fmu(ROOT / file, tmp / f"{Path(file).stem}.fmu")
             md = fmpy.read_model_description(str(fmu))
             unzip = fmpy.extract(str(fmu), unzipdir=str(tmp / Path(file).stem))
             so = Path(unzip) / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
@@ -108,7 +108,7 @@ def measure(repeats: int, quick: bool) -> dict[str, dict[str, float]]:
 def report(rows: dict[str, dict[str, float]]) -> str:
     lines = ["# Real-time factor of the native FMU", "",
              "A plain C host (`tests/fmu/native_host.c`: dlopen, no FMPy, no Python) runs "
-             "each scene's native FMU (`winder fmu SCENE --native`) from t = 0 at 1 ms "
+             "each scene's native FMU (`winder fmu SCENE`) from t = 0 at 1 ms "
              "communication steps and reads every output after each step. Real-time factor "
              "= simulated time / wall time (best of the repeats). DOPRI5: rtol 1e-8, atol "
              "1e-10, events located; RK4: `rk4 = true`, one 1 ms step per communication "

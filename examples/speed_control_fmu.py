@@ -3,10 +3,9 @@
 The native FMU (no Python inside) is exported from ``models/paper_winding.toml`` with
 the drum freed (``speed_profile = false``, a build option: the free drum is another
 machine): the controller reads the web-speed reference and the drum speed, and writes
-``drum_torque_command`` every communication step while the roll grows. ``--pythonfmu``
-runs the same loop through the old pythonfmu FMU (same interface).
+``drum_torque_command`` every communication step while the roll grows.
 
-    python examples/speed_control_fmu.py [--t-end 700] [--step 0.01] [--out out] [--pythonfmu]
+    python examples/speed_control_fmu.py [--t-end 700] [--step 0.01] [--out out]
 """
 
 from __future__ import annotations
@@ -42,15 +41,11 @@ NAMES = ["web_speed_reference", "drum_speed", "roll_speed", "radius", "normal_fo
 R = 0.5  # drum radius [m] (the scene's)
 
 
-def build(out: Path, *, pythonfmu: bool = False) -> Path:
+def build(out: Path) -> Path:
     """The paper scene's FMU with its drum freed, at ``out / winder.fmu``."""
-    fmu_file = out / "winder.fmu"
-    if pythonfmu:
-        from winder.fmu.build import build_fmu
-        return build_fmu(ROOT / "models" / "paper_winding.toml", fmu_file)
-    from winder.fmu.native import build_native_fmu
-    return build_native_fmu(ROOT / "models" / "paper_winding.toml", fmu_file,
-                            speed_profile=False)
+    from winder.fmu.native import build_fmu
+    return build_fmu(ROOT / "models" / "paper_winding.toml", out / "winder.fmu",
+                     speed_profile=False)
 
 
 def closed_loop(fmu_file: Path, t_end: float, step: float, progress: bool = False
@@ -108,11 +103,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--t-end", type=float, default=700.0, help="end time [s]")
     ap.add_argument("--step", type=float, default=0.01, help="communication step [s]")
     ap.add_argument("--out", type=Path, default=ROOT / "out", help="output folder")
-    ap.add_argument("--pythonfmu", action="store_true",
-                    help="the old pythonfmu FMU (needs winder in the host's Python)")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
-    fmu_file = build(args.out, pythonfmu=args.pythonfmu)
+    fmu_file = build(args.out)
     log, wall = closed_loop(fmu_file, args.t_end, args.step, progress=True)
     names, step, t_end = NAMES, args.step, args.t_end
 

@@ -1,8 +1,8 @@
 """Purpose: closed-loop tension control of the winder line through its FMU, a whole parent roll.
 
 The FMU is exported from ``models/winder_line_fmu.toml`` (the small line, its parent roll
-torque-driven: input ``parent_torque``) as a native FMU (``winder fmu --native``: the
-compiled machine, no Python inside; ``--pythonfmu``: the pythonfmu FMU instead). Every
+torque-driven: input ``parent_torque``) as a native FMU (``winder fmu``: the
+compiled machine, no Python inside). Every
 communication step the controller reads the FMU's outputs (span tension, the parent's
 radius and speed, the entry drum's speed and acceleration) and writes the unwind torque
 by the rule of
@@ -21,14 +21,13 @@ on until the parent reaches its core (the FMU's step then fails with the reason 
 Writes ``tension_control_fmu.png`` and ``tension_control_fmu.npz`` to ``--out``.
 
     python examples/tension_control_fmu.py [--t-end 60] [--step 0.002] [--out out]
-                                           [--pythonfmu | --fmu FILE.fmu]
+                                           [--fmu FILE.fmu]
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 import time
 from pathlib import Path
@@ -160,8 +159,7 @@ def plot(log: dict[str, np.ndarray], T_set: float, path: Path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     import winder
-    from winder.fmu.build import build_fmu
-    from winder.fmu.native import build_native_fmu
+    from winder.fmu.native import build_fmu
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=60.0,
@@ -176,21 +174,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--fmu", type=Path,
                     help="a native FMU of models/winder_line_fmu.toml already built (winder "
                          "fmu models/winder_line_fmu.toml -o FILE): run it, build none")
-    ap.add_argument("--pythonfmu", action="store_true",
-                    help="the pythonfmu FMU (needs winder in the host's Python) instead of "
-                         "the native one")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     scene = winder.load_scene(SCENE)
     law = TensionLaw(scene, args.tension, args.bandwidth, args.feedforward)
     wall0 = time.perf_counter()
     if args.fmu is not None:
-        if args.pythonfmu:
-            ap.error("--fmu runs the FMU given; --pythonfmu builds one: give one of them")
         fmu_file = args.fmu
     else:
-        fmu_file = (build_fmu if args.pythonfmu else build_native_fmu)(
-            SCENE, args.out / "winder_line_fmu.fmu")
+        fmu_file = build_fmu(SCENE, args.out / "winder_line_fmu.fmu")
     wall1 = time.perf_counter()
     log, ended = run(fmu_file, law, args.t_end, args.step)
     wall = time.perf_counter() - wall1
@@ -199,7 +191,7 @@ def main(argv: list[str] | None = None) -> int:
     settled = t >= 1.0
     k1 = int(np.argmax(np.abs(e) * settled))
     print(f"{t[-1]:.4f} s simulated in {wall:.1f} s wall ({t[-1] / wall:.2f}× real time; "
-          f"{'pythonfmu' if args.pythonfmu else 'native'} FMU "
+          "native FMU "
           + (f"{args.fmu}" if args.fmu is not None else f"built in {wall1 - wall0:.1f} s")
           + f"), {args.step * 1e3:g} ms steps, "
           f"{len(t) - 1} steps, feed-forward: {args.feedforward}")
@@ -218,9 +210,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    status = main()
-    # pythonfmu's binary now and then corrupts the heap in the interpreter's exit-time
-    # clean-up (after everything above is written): leave without it
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(status)
+    sys.exit(main())

@@ -3,14 +3,13 @@ torque input per drum.
 
 The FMU is exported from ``models/two_drum_winder.toml`` with both drums torque-driven
 (``drive = { kind = "torque" }``) as a native FMU (the compiled machine, no Python
-inside; ``--pythonfmu``: the pythonfmu FMU): its inputs are ``front_torque`` and
+inside): its inputs are ``front_torque`` and
 ``rear_torque``.
 Each controller reads its drum's speed and writes its torque every communication step,
 following the scene's web-speed ramp ``min(a_w t, v_w)``; the set and the rider ride on
 the two drums and share their load through the nips.
 
     python examples/two_drum_speed_control_fmu.py [--t-end 20] [--step 0.01] [--out out]
-                                                  [--pythonfmu]
 """
 
 from __future__ import annotations
@@ -61,23 +60,19 @@ def torque_driven_scene(out: Path) -> tuple[Any, float, float]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from winder.fmu.build import build_fmu
     from winder.fmu.host import loaded_fmu, start_fmu
-    from winder.fmu.native import build_native_fmu
+    from winder.fmu.native import build_fmu
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=20.0, help="end time [s]")
     ap.add_argument("--step", type=float, default=0.01, help="communication step [s]")
     ap.add_argument("--out", type=Path, default=ROOT / "out", help="output folder")
-    ap.add_argument("--pythonfmu", action="store_true",
-                    help="the pythonfmu FMU (needs winder in the host's Python)")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     scene_file = args.out / "two_drum_torque.toml"
     scene, a_w, v_w = torque_driven_scene(scene_file)
     drums = {d.name: (d.radius, d.inertia) for d in scene.drums}  # [m, kg·m²]
-    fmu_file = (build_fmu if args.pythonfmu else build_native_fmu)(
-        scene_file, args.out / "two_drum_torque.fmu")
+    fmu_file = build_fmu(scene_file, args.out / "two_drum_torque.fmu")
 
     bandwidth = 10.0      # speed loop crossover [rad/s]
     pis = {}

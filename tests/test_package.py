@@ -24,7 +24,7 @@ def test_import_winder_loads_no_heavy_dependency() -> None:
     """``import winder`` alone imports neither scipy nor pinocchio: a command pays only for
     what it uses."""
     code = ("import sys, winder; print(sorted({m.split('.')[0] for m in sys.modules} & "
-            "{'scipy', 'pinocchio', 'matplotlib', 'meshcat', 'pythonfmu'}))")
+            "{'scipy', 'pinocchio', 'matplotlib', 'meshcat', 'fmpy'}))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout
     assert out.strip() == "[]"
@@ -261,9 +261,9 @@ def test_imports_point_down_the_layers_and_never_in_a_circle() -> None:
     assert _rank("winder._schema", layers) == _rank("winder._args", layers)
     # the oracle sees what it must: an upward import, a sibling import and a cycle
     planted = {**graph, "winder.io.files": graph["winder.io.files"] | {"winder.solve.simulate"},
-               "winder.viewer._motion": graph["winder.viewer._motion"] | {"winder.fmu.build"}}
+               "winder.viewer._motion": graph["winder.viewer._motion"] | {"winder.fmu.parameters"}}
     assert upward(planted) == ["winder.io.files -> winder.solve.simulate",
-                               "winder.viewer._motion -> winder.fmu.build"]
+                               "winder.viewer._motion -> winder.fmu.parameters"]
     looped = {**graph, "winder.solve.budgets": graph["winder.solve.budgets"]
               | {"winder.solve.simulate"}}
     assert cycle(looped) is not None and "winder.solve.budgets" in cycle(looped)

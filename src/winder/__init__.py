@@ -19,7 +19,7 @@ from winder._errors import (
 # (``winder run`` never imports the FMU, the linearisation or the sweeps; checking a scene
 # imports neither NumPy nor the solver).
 _LAZY = {
-    **dict.fromkeys(("build_fmu",), ".fmu.build"),
+    **dict.fromkeys(("build_fmu",), ".fmu.native"),
     **dict.fromkeys(("jacobian",), ".analysis.linearise"),
     **dict.fromkeys(("FunctionMassLaw", "MassLaw", "MassProperties", "PaperRollLaw"),
                     ".model.mass_law"),
@@ -43,7 +43,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from winder.analysis.modes import Mode, ModeMap, mode_map, modes_at
     from winder.analysis.sweep import sweep
     from winder.analysis.sweep_table import SweepTable
-    from winder.fmu.build import build_fmu
+    from winder.fmu.native import build_fmu
     from winder.forces import FORCES, ForceElement
     from winder.io.files import OutputError
     from winder.io.result import Result, ResultFileError, load_result

@@ -10,7 +10,7 @@ in its module under ``winder/parts/`` (``KEYS``), an effect's settings on its
 - the parser and its error messages (:func:`winder.scene.parse.parse_table`);
 - units and meanings (:func:`winder.scene.key_unit`, :func:`winder.scene.key_doc`);
 - the generated ``docs/scene-reference.md`` (:mod:`winder.scene.reference`);
-- the FMU's parameter units and descriptions (:mod:`winder.fmu.build`).
+- the FMU's parameter units and descriptions (:mod:`winder.fmu.parameters`).
 
 Each result channel is one :class:`Channel` (its name pattern, unit and meaning),
 declared by what writes it: the generic body, nip and web channels in
@@ -90,7 +90,7 @@ class Key:
         The FMU parameter this number is, by its name after its part's (``contact_stiffness``
         of a nip ``front`` is the FMU parameter ``front_contact_stiffness``; a key of a
         single table, ``web_tension``, is named as given); ``""``: not an FMU parameter.
-        :mod:`winder.fmu.build` collects these from every part's keys.
+        :mod:`winder.fmu.parameters` collects these from every part's keys.
     law_units:
         Units of the number that depend on a sibling key ``law``: ``(("hunt_crossley",
         "N/m^p"),)`` is the unit under that law (a Hunt–Crossley stiffness); the unit is

@@ -271,27 +271,13 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
     from winder.io.files import check_output_file
 
     out = check_output_file(args.out, "-o/--out", suffixes=(".fmu",))
-    native = not args.pythonfmu
-    if args.pythonfmu and args.native:
-        raise WinderError("--native and --pythonfmu: give one of them (the native FMU is "
-                          "the default)")
-    if native:
-        from winder.fmu.native import build_native_fmu
+    from winder.fmu.native import FMI_VERSIONS, build_fmu
 
-        out = build_native_fmu(args.scene, out, speed_profile=args.speed_profile)
-    else:
-        if args.speed_profile is not None:
-            raise WinderError("--speed-profile/--no-speed-profile choose the native FMU's "
-                              "machine; the pythonfmu FMU has the Boolean parameter "
-                              "speed_profile instead")
-        from winder.fmu.build import build_fmu
-
-        out = build_fmu(args.scene, out)
-    print(f"FMI 2.0 co-simulation{' and model-exchange' * native} FMU"
-          f"{' (native: no Python inside)' * native} written to {out}\n  "
-          + ("binaries/linux64 from the system C compiler; sources/ rebuild it elsewhere "
-             "(fmpy compile)" if native else "runs inside the host's Python: needs "
-             f"winder installed there (built with {sys.executable})"))
+    out = build_fmu(args.scene, out, fmi_version=args.fmi_version,
+                    speed_profile=args.speed_profile)
+    print(f"FMI {args.fmi_version}.0 co-simulation and model-exchange FMU (native: no Python "
+          f"inside) written to {out}\n  binaries/{FMI_VERSIONS[args.fmi_version][2]} from the "
+          "system C compiler; sources/ rebuild it elsewhere (fmpy compile)")
     if args.check:
         print("  " + _check_fmu(out))
     return 0
@@ -478,22 +464,22 @@ def _build_parser() -> argparse.ArgumentParser:
     view.add_argument("--playback", type=_PLAYBACK, default=30.0,
                       help="playback length of the whole run [s] (0 < x <= 3600, default 30)")
     view.set_defaults(func=_cmd_view)
-    fmu = sub.add_parser("fmu", help="export a scene as an FMI 2.0 co-simulation FMU")
+    fmu = sub.add_parser("fmu", help="export a scene as a native FMI 2.0 FMU (co-simulation "
+                         "and model exchange)")
     fmu.add_argument("scene", help="scene file (TOML)")
     fmu.add_argument("-o", "--out", default="winder.fmu", help="FMU file (default winder.fmu)")
     fmu.add_argument("--check", action=argparse.BooleanOptionalAction, default=True,
                      help="load the built FMU with FMPy and step it (default on)")
+    fmu.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                     help="FMI 2.0 (default) or FMI 3.0; both with co-simulation and model "
+                          "exchange")
     fmu.add_argument("--native", action="store_true",
-                     help="the compiled machine and C integrators behind FMI 2.0, no Python "
-                          "inside (binaries/linux64 and sources/; needs a C compiler): the "
-                          "default")
-    fmu.add_argument("--pythonfmu", action="store_true",
-                     help="the old pythonfmu FMU instead (runs inside the host's Python: "
-                          "needs winder installed there)")
+                     help="accepted for older scripts: every FMU is native (the compiled "
+                          "machine and C integrators, no Python inside)")
     fmu.add_argument("--speed-profile", action=argparse.BooleanOptionalAction, default=None,
                      help="single-drum scenes: the drum on its speed profile, or freed on "
-                          "the input drum_torque_command (native FMU: fixed at build time; "
-                          "default: the scene's drive)")
+                          "the input drum_torque_command (fixed at build time; default: the "
+                          "scene's drive)")
     fmu.set_defaults(func=_cmd_fmu)
     modes = sub.add_parser("modes", help="bounce modes against the wound roll's radius and "
                            "the rotation harmonics (resonance map)")

@@ -8,8 +8,6 @@ import shutil
 import subprocess
 import sys
 import zipfile
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -22,17 +20,14 @@ from ctypes import byref  # noqa: E402
 
 from fmpy.fmi1 import FMICallException  # noqa: E402
 from fmpy.fmi2 import (  # noqa: E402
-    FMU2Slave,
-    fmi2CallbackFunctions,
-    fmi2CallbackLoggerTYPE,
     fmi2Discard,
     fmi2LastSuccessfulTime,
     fmi2Real,
 )
-from fmpy.logging import addLoggerProxy  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
+from fmu_slave import slave  # noqa: E402
 
-from winder.fmu.native import build_native_fmu, model_identifier  # noqa: E402
+from winder.fmu.native import build_fmu, model_identifier  # noqa: E402
 
 HOST_C = Path(__file__).with_name("native_host.c")
 
@@ -54,49 +49,15 @@ def paper_fmu(tmp_path_factory, models_dir) -> Path:
 
 @pytest.fixture(scope="module")
 def two_drum_fmu(tmp_path_factory, models_dir) -> Path:
-    return build_native_fmu(models_dir / "two_drum_winder.toml",
-                            tmp_path_factory.mktemp("native2") / "two_drum.fmu")
+    return build_fmu(models_dir / "two_drum_winder.toml",
+                     tmp_path_factory.mktemp("native2") / "two_drum.fmu")
 
 
 @pytest.fixture(scope="module")
 def line_fmu(tmp_path_factory, models_dir) -> Path:
     """The winder line with its unwind on a torque input."""
-    return build_native_fmu(models_dir / "winder_line_fmu.toml",
-                            tmp_path_factory.mktemp("native3") / "line.fmu")
-
-
-@contextmanager
-def slave(path: Path, *, rk4: bool = False, **params: float
-          ) -> Iterator[tuple[FMU2Slave, dict[str, int], list[str]]]:
-    """An FMPy slave of ``path`` in stepping mode (``params`` set during initialisation),
-    its value references by name, and the messages it logged."""
-    md = fmpy.read_model_description(str(path))
-    unzip = fmpy.extract(str(path))
-    log: list[str] = []
-
-    def logger(env, name, status, category, message) -> None:  # noqa: ANN001
-        log.append(f"[{category.decode()}] {message.decode()}")
-
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip,
-                    modelIdentifier=md.coSimulation.modelIdentifier, instanceName="t")
-    refs = {v.name: v.valueReference for v in md.modelVariables}
-    callbacks = fmi2CallbackFunctions()
-    callbacks.logger = fmi2CallbackLoggerTYPE(logger)
-    addLoggerProxy(byref(callbacks))  # FMPy's C proxy formats the variadic arguments
-    try:
-        fmu.instantiate(callbacks=callbacks)
-        fmu.setupExperiment(startTime=0.0)
-        fmu.enterInitializationMode()
-        if rk4:
-            fmu.setBoolean([refs["rk4"]], [True])
-        for name, value in params.items():
-            fmu.setReal([refs[name]], [value])
-        fmu.exitInitializationMode()
-        yield fmu, refs, log
-    finally:
-        fmu.terminate()
-        fmu.freeInstance()
-        shutil.rmtree(unzip, ignore_errors=True)
+    return build_fmu(models_dir / "winder_line_fmu.toml",
+                     tmp_path_factory.mktemp("native3") / "line.fmu")
 
 
 def _outputs(path: Path) -> list[str]:
@@ -179,7 +140,7 @@ def test_fmpy_compile_rebuilds_it(paper_fmu, tmp_path) -> None:
 def test_interface(two_drum_fmu, line_fmu, models_dir) -> None:
     """Inputs, parameters and outputs are the Stepper's and the scene's, by name, with
     the scene's values and the declared units; the states and derivatives are locals."""
-    from winder.fmu.build import fmu_parameters, parameter_units, parameter_value
+    from winder.fmu.parameters import fmu_parameters, parameter_units, parameter_value
     from winder.model.units import fmi_name
 
     for path, file in ((two_drum_fmu, "two_drum_winder.toml"),
@@ -379,7 +340,7 @@ def test_run_out_discards(tmp_path, models_dir) -> None:
     scene = winder.load_scene(models_dir / "winder_line_fmu.toml")
     scene = scene.replace(roll={"parent": {"initial_radius": 0.4002}})
     (tmp_path / "runout.toml").write_text(tomli_w.dumps(scene.to_dict()))
-    fmu_path = build_native_fmu(tmp_path / "runout.toml", tmp_path / "runout.fmu")
+    fmu_path = build_fmu(tmp_path / "runout.toml", tmp_path / "runout.fmu")
     sim = winder.Stepper(scene)
     with slave(fmu_path) as (fmu, refs, log):
         status = None
@@ -421,8 +382,8 @@ def test_c_host_under_asan(tmp_path, models_dir) -> None:
     cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
         pytest.skip("no C compiler")
-    fmu_path = build_native_fmu(models_dir / "two_drum_winder.toml", tmp_path / "asan.fmu",
-                                sanitize=True)
+    fmu_path = build_fmu(models_dir / "two_drum_winder.toml", tmp_path / "asan.fmu",
+                         sanitize=True)
     with zipfile.ZipFile(fmu_path) as zf:
         zf.extractall(tmp_path / "x")
     md = fmpy.read_model_description(str(fmu_path))
@@ -473,12 +434,36 @@ def test_model_exchange_matches_simulate(which, file, request, models_dir) -> No
     assert checked >= 5
 
 
+def test_model_exchange_leaves_the_core_at_rest(free_drum_fmu, paper_scene) -> None:
+    """The free drum from rest under a constant 30 N·m: the roll starts at rest on its core,
+    both core switching functions exactly 0, so the core mode starts at the core. Model
+    exchange (FMPy's CVode, rtol 1e-8) must see the roll leave it: radius and speeds
+    against winder.simulate (DOPRI5, rtol 1e-8) over 2 s (measured: radius 1.2e-13 m,
+    speeds 7e-8 relative). Reporting a zero indicator as zero instead, CVode saw no sign
+    change and the radius stayed at the core, 0.0750000 against 0.0750219 m."""
+    from winder.fmu.parameters import scene_with_parameters
+
+    scene = scene_with_parameters(paper_scene, {}, speed_profile=False).replace(
+        drum={"drive": {"torque": 30.0}})
+    ref = winder.simulate(scene, t_end=2.0, output_step=0.01, method="DOPRI5", rtol=1e-8,
+                          atol=1e-10)
+    names = ["radius", "roll_speed", "drum_speed"]
+    res = fmpy.simulate_fmu(str(free_drum_fmu), fmi_type="ModelExchange", solver="CVode",
+                            stop_time=2.0, output_interval=0.01, relative_tolerance=1e-8,
+                            start_values={"drum_torque_command": 30.0}, output=names)
+    assert ref["radius"][-1] - ref["radius"][0] > 2e-5
+    got = {k: np.interp(ref.t, res["time"], res[k]) for k in names}
+    assert np.max(np.abs(got["radius"] - ref["radius"])) < 1e-11
+    for k in names[1:]:
+        assert np.max(np.abs(got[k] - ref[k])) < 1e-6 * np.max(np.abs(ref[k])), k
+
+
 def test_model_structure_from_the_jacobian(two_drum_fmu, models_dir) -> None:
     """numberOfEventIndicators: the switching functions the mode table refers to; each
     derivative's dependencies are the structural nonzeros of the generated Jacobian:
     they contain every numerical nonzero at a state of the run, and an angle's rate
     depends on its speed alone."""
-    from winder.fmu.native import indicators
+    from winder.fmu.interface import indicators
 
     scene = winder.load_scene(models_dir / "two_drum_winder.toml")
     sy = winder.Stepper(scene).system
@@ -525,7 +510,7 @@ def test_parameters_act_at_run_time(fmi_type, paper_fmu, paper_scene) -> None:
     40 s to 2.5 s) and twice the caliper, 4 s, equal winder.simulate of the scene with
     those values (whose initial balance is the scene's: none of them enters it) within
     the tolerances above."""
-    from winder.fmu.build import scene_with_parameters
+    from winder.fmu.parameters import scene_with_parameters
 
     values = {"profile_web_speed": 5.0, "web_acceleration": 2.0, "caliper": 3.2e-4}
     scene = scene_with_parameters(paper_scene, values, speed_profile=True)
@@ -591,7 +576,7 @@ def test_static_balance_of_the_hosts_parameters(which, file, values, request,
     on the generated residual), and the states equal winder's balance of the scene with
     those values (scipy's root) to 1e-15 m (measured 7e-17); unchanged parameters keep the
     built state bit for bit."""
-    from winder.fmu.build import scene_with_parameters
+    from winder.fmu.parameters import scene_with_parameters
     from winder.solve.system import MachineSystem
 
     path = request.getfixturevalue(which)
@@ -630,18 +615,17 @@ def test_misuse_is_refused_with_a_reason(line_fmu) -> None:
     assert "is not finite" in text and "rk4 is a fixed parameter" in text
 
 
-# ---- the single-drum interface (the pythonfmu FMU's) --------------------------------------
+# ---- the single-drum interface (the old format's) -----------------------------------------
 
 @pytest.fixture(scope="module")
 def free_drum_fmu(tmp_path_factory, models_dir) -> Path:
     """The paper scene's drum freed on ``drum_torque_command`` (speed_profile = false)."""
-    return build_native_fmu(models_dir / "paper_winding.toml",
-                            tmp_path_factory.mktemp("native4") / "free.fmu",
-                            speed_profile=False)
+    return build_fmu(models_dir / "paper_winding.toml",
+                     tmp_path_factory.mktemp("native4") / "free.fmu", speed_profile=False)
 
 
 def test_single_drum_interface(free_drum_fmu, paper_fmu) -> None:
-    """The pythonfmu FMU's own variables, declared as it declares them: the Boolean
+    """The single-drum format's own variables (Naming.fmu): the Boolean
     parameter ``speed_profile`` (fixed; its built value; the other is refused with the
     build option that gives it), the input ``drum_torque_command`` [N.m] (start 0) and
     the output ``web_speed_reference`` [m/s]; ``drum_torque`` stays an output."""
@@ -672,9 +656,9 @@ def test_single_drum_interface(free_drum_fmu, paper_fmu) -> None:
 def test_free_drum_equals_the_stepper_bit_for_bit(free_drum_fmu, paper_scene) -> None:
     """speed_profile = false, the drum torque driven by a signal, 200 steps of 10 ms:
     every output equals the in-process Stepper's of the same scene (the drum freed as
-    the pythonfmu FMU frees it: winder.fmu.build.scene_with_parameters) exactly, and
+    winder.fmu.parameters.scene_with_parameters frees it) exactly, and
     web_speed_reference is min(a_w t, v_w) of the scene's profile."""
-    from winder.fmu.build import scene_with_parameters
+    from winder.fmu.parameters import scene_with_parameters
 
     sim = winder.Stepper(scene_with_parameters(paper_scene, {}, speed_profile=False))
     names = [k for k in _outputs(free_drum_fmu) if k != "web_speed_reference"]
@@ -694,41 +678,6 @@ def test_free_drum_equals_the_stepper_bit_for_bit(free_drum_fmu, paper_scene) ->
                                         rel=1e-12)
 
 
-_LOOP_SCRIPT = """
-import importlib.util, json, sys
-from pathlib import Path
-import numpy as np
-spec = importlib.util.spec_from_file_location("ex", sys.argv[1])
-ex = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(ex)
-out = Path(sys.argv[2])
-(out / "n").mkdir()
-(out / "p").mkdir()
-native, _ = ex.closed_loop(ex.build(out / "n"), 20.0, 0.01)
-old, _ = ex.closed_loop(ex.build(out / "p", pythonfmu=True), 20.0, 0.01)
-print(json.dumps({k: [float(np.max(np.abs(native[:, j] - old[:, j]))),
-                      float(np.max(np.abs(old[:, j])))]
-                  for j, k in enumerate(["t", "torque", *ex.NAMES])}))
-"""
-
-
-def test_speed_control_example_native_equals_pythonfmu(tmp_path) -> None:
-    """examples/speed_control_fmu.py's PI loop, 20 s at 10 ms, through the native FMU
-    and through the pythonfmu FMU (in a child process: pythonfmu's own exit abort): radius
-    to 1e-6 m, torque, speeds and forces to 1e-5 of their largest magnitude (measured:
-    equal bit for bit, the same generated code and integrator)."""
-    pytest.importorskip("pythonfmu")
-    example = Path(__file__).resolve().parents[2] / "examples" / "speed_control_fmu.py"
-    proc = subprocess.run([sys.executable, "-c", _LOOP_SCRIPT, str(example), str(tmp_path)],
-                          capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    import json
-
-    diffs = json.loads(proc.stdout.strip().splitlines()[-1])
-    for k, (diff, scale) in diffs.items():
-        assert diff < (1e-6 if k == "radius" else 1e-5 * max(scale, 1e-9)), (k, diff)
-
-
 def test_tension_example_runs_a_built_fmu(line_fmu, tmp_path) -> None:
     """examples/tension_control_fmu.py --fmu (make demo's way): the native FMU given is
     run, none built; its figure and log written to --out."""
@@ -745,15 +694,17 @@ def test_tension_example_runs_a_built_fmu(line_fmu, tmp_path) -> None:
 
 def test_cli_builds_either_single_drum_machine(tmp_path, models_dir) -> None:
     """winder fmu --no-speed-profile: the free drum (the native FMU, by default);
-    --speed-profile is refused with --pythonfmu (whose switch is a parameter)."""
+    --speed-profile is refused for a machine from parts (exit 2, naming the option's
+    parameter), with nothing written."""
     path = _cli_native(models_dir / "paper_winding.toml", tmp_path / "free.fmu",
                        "--no-speed-profile")
     md = fmpy.read_model_description(str(path))
     by = {v.name: v for v in md.modelVariables}
     assert by["speed_profile"].start == "false" and "drum_torque_command" in by
     proc = subprocess.run([sys.executable, "-m", "winder", "fmu",
-                           str(models_dir / "paper_winding.toml"), "-o",
-                           str(tmp_path / "old.fmu"), "--pythonfmu", "--speed-profile"],
+                           str(models_dir / "two_drum_winder.toml"), "-o",
+                           str(tmp_path / "parts.fmu"), "--speed-profile"],
                           capture_output=True, text=True, timeout=600)
-    assert proc.returncode != 0 and "speed_profile" in proc.stderr, proc.stderr
-    assert not (tmp_path / "old.fmu").exists()
+    assert proc.returncode == 2 and "speed_profile" in proc.stderr, proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert not (tmp_path / "parts.fmu").exists()

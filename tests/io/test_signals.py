@@ -231,14 +231,8 @@ def test_signal_during_start_up(sig: int, tmp_path: Path) -> None:
     assert not (tmp_path / "r.npz").exists()
 
 
-@pytest.fixture(scope="module")
-def fmu_available() -> None:
-    pytest.importorskip("pythonfmu", reason="pythonfmu is installed with winder[fmu]")
-
-
 @pytest.mark.parametrize(("sig", "phase"), [(signal.SIGTERM, "build")])
-def test_fmu_stopped_leaves_no_build_folder(sig: int, phase: str, tmp_path: Path,
-                                            fmu_available) -> None:
+def test_fmu_stopped_leaves_no_build_folder(sig: int, phase: str, tmp_path: Path) -> None:
     scene = tmp_path / "s.toml"
     scene.write_text(FREE_SPIN)
     out = tmp_path / "out" / "w.fmu"

@@ -15,7 +15,7 @@ import pytest
 import winder
 from winder._schema import NO_DEFAULT, Key, Table
 from winder.cli import main
-from winder.fmu.build import FMU_PARAMETERS, fmu_parameters, parameter_units
+from winder.fmu.parameters import FMU_PARAMETERS, fmu_parameters, parameter_units
 from winder.forces import FORCES
 from winder.parts import drum, flex, nip, rider, roll, web
 from winder.scene import key_doc, key_unit

@@ -93,7 +93,7 @@ class BodyElement(ABC):
     the scene (its tables, parsing, checks, ``to_dict``), the generated reference and the
     viewer's scene graph read it from here. Not yet generic: the figures draw a body by
     :attr:`role` (``drum``: a driven body, else a turning one), and the FMU's tunable
-    parameters are listed per table in :mod:`winder.fmu.build` (a new type has its
+    parameters are listed per table in :mod:`winder.fmu.parameters` (a new type has its
     co-simulation inputs, :attr:`torque_inputs`, but no tunable parameters there).
 
     1. Subclass :class:`BodyElement` (or :class:`RigidDisc` for a body of constant radius,

@@ -43,15 +43,7 @@ enum { S_DONE = 0, S_PAUSED = 1, S_UNDERFLOW = 2, S_NON_FINITE = 3, S_EXHAUSTED 
 #define K_END 2
 #define W_MAGIC 0x77696e6465723032LL /* "winder02" */
 
-/* VR layout */
-#define VR_IN W_NOUT
-#define VR_PAR (VR_IN + W_NIN)
-#define VR_RTOL (VR_PAR + W_NPAR)
-#define VR_ATOL (VR_RTOL + 1)
-#define VR_HRK4 (VR_RTOL + 2)
-#define VR_X (VR_RTOL + 3)
-#define VR_DX (VR_X + W_N)
-#define VR_END (VR_DX + W_N)
+#include "layout.h"
 
 enum { M_INSTANTIATED, M_INIT, M_STEP, M_TERMINATED, M_ERROR };
 
@@ -866,7 +858,10 @@ fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real dx[], size_t nx) {
     return fmi2OK;
 }
 
-/* the switching functions the mode table refers to, in the machine's locked modes */
+/* the switching functions the mode table refers to, in the machine's locked modes; one
+ * exactly at zero is reported on the side the mode rule puts zero (W_Z_ZERO: ±1e-300), so
+ * that a host which starts on a boundary (a roll at rest on its core) sees a sign change
+ * when the state leaves it */
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real z[], size_t ni) {
     Comp* s = c;
     double g[W_NSW + 1];
@@ -875,7 +870,7 @@ fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real z[], size_t ni) {
         return fail(s, "%s", "fmi2GetEventIndicators: wrong number of event indicators");
     W_SW_FN(tb, s->c.y, s->c.p, s->c.m, g);
     for (int i = 0; i < W_NZ; i++)
-        z[i] = g[W_Z[i]];
+        z[i] = g[W_Z[i]] != 0.0 ? g[W_Z[i]] : W_Z_ZERO[i] * 1e-300;
     return fmi2OK;
 }
 

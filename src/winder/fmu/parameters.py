@@ -1,65 +1,36 @@
-"""FMI 2.0 co-simulation export (pythonfmu): the winder as an FMU for controller work.
+"""The parameters of a scene's FMU (:mod:`winder.fmu.native`): which scene keys a host may
+set, under which names and units, and the scene with the host's values applied.
 
-The FMU runs *inside the host's Python*: pythonfmu's binary loads the Python interpreter
-of the importing process and imports :mod:`winder` (with Pinocchio) from it.
-A host that loads the FMU must therefore be a Python process (FMPy, or any tool that
-embeds that Python) whose environment has winder installed; the scene travels inside the
-FMU (``resources/scene.toml``).
-
-Interface of a single-drum scene (the old format)
--------------------------------------------------
-- parameters (:data:`FMU_PARAMETERS`): web speed and acceleration, imbalance, nip
-  stiffness and damping, friction, caliper, density, width, and ``speed_profile``: true
-  drives the drum along the built-in web-speed profile (``drum_torque`` is then an
-  output), false frees the drum, started at the profile's initial speed, and drives it
-  by the input ``drum_torque_command``.
-- input ``drum_torque_command`` [N·m] (named apart from the output channel
-  ``drum_torque``, which reports the torque acting in either mode).
-- outputs: every result channel (the scene's naming's columns but ``t``) and
-  ``web_speed_reference`` = ``min(a_w t, v_w)`` [m/s], the profile a speed controller
-  follows.
-
-Interface of a machine from parts
----------------------------------
-- parameters (:func:`fmu_parameters`): every part's keys declared as FMU parameters
+- A scene with its own FMU interface (:attr:`Naming.fmu <winder.scene.naming.Naming.fmu>`,
+  the single-drum format's): its parameters (:data:`FMU_PARAMETERS`): web speed and
+  acceleration, imbalance, nip stiffness and damping, friction, caliper, density, width.
+- A machine from parts: every part's keys declared as FMU parameters
   (:attr:`Key.fmu <winder._schema.Key.fmu>`, in the part's ``KEYS``; a drive's only for
   the drive kind that takes them), named by part, in the parts' order: per drum
   ``DRUM_web_speed`` (and ``DRUM_web_acceleration`` for a speed profile), per roll
   ``ROLL_width``, ``ROLL_com_offset``, ``ROLL_density``, ``ROLL_caliper`` (and
   ``ROLL_bandwidth`` for a tension-controlled unwinding roll), per nip
   ``NIP_contact_stiffness``, ``NIP_contact_damping``, ``NIP_mu``,
-  ``NIP_slip_reference_velocity``, ``NIP_relaxation_length``, and ``web_tension``; the
-  drives are the scene's.
+  ``NIP_slip_reference_velocity``, ``NIP_relaxation_length``, and ``web_tension``.
   A winder line (``[web.span]``, machines.md §5) has ``span_length``, ``span_EA`` and
   ``span_T_in`` instead of ``web_tension`` (the tension is the span's state).
-- inputs: the :class:`~winder.Stepper`'s, ``DRUM_torque`` [N·m] per torque-driven drum
-  or unwinding roll (``parent_torque``), ``ROLL_tension_setpoint`` [N] of a
-  tension-controlled unwind (none when every drum follows a speed profile); units and
-  descriptions from their declarations (:data:`winder.model.channels.INPUTS`).
-- outputs: the Stepper's outputs (machines.md §9 channels) but the ``DRUM_torque``
-  channel of a torque-driven drum, which is its input (same name, same value); with an
-  unwinding roll also ``t`` [s], the time of the outputs.
-- run-out: when an unwinding roll reaches its core (:attr:`winder.Stepper.ended`),
-  ``fmi2DoStep`` stops there, publishes the outputs at that time, logs why and fails
-  (``do_step`` returns false); every later step fails the same way.
-- ``rtol``: tolerance of the internal DOPRI5 (both kinds).
+
+Descriptions and units are the scene keys' declarations: a key newly declared with
+``fmu=...`` is a parameter at once.
 """
 
 from __future__ import annotations
 
-import shutil
-import tempfile
-from pathlib import Path
 from typing import Any
 
 from winder._errors import WinderError
 from winder._schema import Key
 from winder.scene import naming_of
 from winder.scene.keys import find_key
-from winder.scene.load import Scene, load_scene
+from winder.scene.load import Scene
 from winder.scene.schema import ARRAYS, TABLES
 
-__all__ = ["build_fmu", "FMU_PARAMETERS", "fmu_parameters", "parameter_units",
+__all__ = ["FMU_PARAMETERS", "fmu_parameters", "parameter_units",
            "parameter_value", "scene_with_parameters", "FmuError"]
 
 def _text(table: str, key: str, unit: str | None = None) -> str:
@@ -77,21 +48,8 @@ FMU_PARAMETERS: dict[str, tuple[str, str, str]] = {
     name: (table, key, _text(table, key))
     for name, (table, key) in naming_of(None).fmu.parameters.items()}  # type: ignore[union-attr]
 
-# pythonfmu's binary finds the class by the pattern ``class X(Fmi2Slave):`` in this file,
-# hence the alias.
-_SLAVE_SCRIPT = '''"""winder FMU: the scene in resources/scene.toml (needs a Python with winder)."""
-from winder.fmu.slave import WinderSlave as Fmi2Slave
-
-_pinned_globals = [globals()]  # see winder.fmu.slave.WinderSlave.__init__
-
-
-class Winder(Fmi2Slave):
-    """The winder co-simulation slave."""
-'''
-
-
 class FmuError(WinderError):
-    """The FMU could not be built or does not run in this Python."""
+    """The FMU could not be built, or a parameter value is not one of its parameters."""
 
 
 #: A parameter's place in the scene: the table, the element name for an array of tables
@@ -209,46 +167,3 @@ def scene_with_parameters(scene: Scene, values: dict[str, float], *,
     if own is not None:
         scene.naming.drive_changes(scene, changes, bool(speed_profile))
     return scene.replace(**changes)
-
-
-def build_fmu(scene_path: str | Path, out: str | Path) -> Path:
-    """Build ``out`` (an ``.fmu``) from a scene file, atomically: the complete FMU or
-    nothing at ``out``, and no build folder left in the temporary directory, on an error
-    or a signal. Raises :class:`FmuError` when pythonfmu is missing or the build fails."""
-    # imported here, not at the top: FMU hosts import this module (the slave, FMPy hosts),
-    # and with more modules loaded there pythonfmu 0.7's heap corruption (see
-    # winder.fmu.slave) showed again: 1-3 of the 7 FMU host tests aborted per run
-    from winder.io.files import atomic_write, scratch_dir
-
-    try:
-        from pythonfmu import FmuBuilder
-    except ImportError as exc:
-        raise FmuError("building an FMU needs pythonfmu: pip install 'winder[fmu]'") from exc
-    scene_path = Path(scene_path)
-    scene = load_scene(scene_path)  # validate before packing
-    if len(scene.webs) > 1:
-        raise FmuError(f"{scene_path}: [[web]]: {len(scene.webs)} webs "
-                       f"({', '.join(w.name for w in scene.webs)}); the FMU takes a scene "
-                       "with one web (one winding station); valid: one [web] table (run "
-                       "several stations with winder run)")
-    out = Path(out)
-    if out.suffix != ".fmu":
-        raise FmuError(f"output file must end in .fmu, got {str(out)!r}")
-    with scratch_dir("winder_fmu_") as d:
-        script = d / "winder_fmu.py"
-        script.write_text(_SLAVE_SCRIPT, encoding="utf-8")
-        scene_copy = d / "scene.toml"
-        shutil.copyfile(scene_path, scene_copy)
-        staged = d / "build" / "winder.fmu"
-        # pythonfmu's own scratch folder goes inside ours (removed with it, even on a signal)
-        saved, tempfile.tempdir = tempfile.tempdir, str(d)
-        try:
-            FmuBuilder.build_FMU(script, dest=staged, project_files=[scene_copy],
-                                 needsExecutionTool="true")
-        except Exception as exc:  # pythonfmu raises bare exceptions
-            raise FmuError(f"pythonfmu could not build the FMU from {scene_path}: {exc}") \
-                from exc
-        finally:
-            tempfile.tempdir = saved
-        atomic_write(out, lambda tmp_out: shutil.copyfile(staged, tmp_out))
-    return out
