@@ -112,7 +112,7 @@ peers: $(STAMP)
 scene-reference: $(STAMP)
 	$(PY) -m winder.scene.reference --out docs/scene-reference.md
 
-# The README's quoted numbers of the two-drum winder and the winder line, from the demo's
+# The README's quoted numbers of the two-drum winder, the winder line and the flexible winder, from the demo's
 # results in $(OUT)/ (run where missing): a table to paste.
 readme-numbers: $(STAMP) pin-casadi
 	$(PY) benchmarks/readme_numbers.py --out $(OUT)
