@@ -15,18 +15,22 @@ is linearised with its exact Jacobian (:func:`winder.jacobian`) about its quasi-
   with the translational velocities 0 (the nips' damping sees only the radius growth
   ``δ̇ = ṙ``);
 - angles 0, the imbalance off (``com_offset = 0``: it is the excitation), the other
-  paper rolls at their initial radius.
+  paper rolls at their initial radius; a flexible body (issue #25) turning as a whole in
+  its steady twist: its segments' angles are unknowns too, with ``θ̇_i = Ω`` (a driven
+  drum's speed) or ``θ̇_i = θ̇_0`` (a free roll or rider, segment 0 its reference).
 
 These unknowns (positions, rotation speeds, friction states) solve ``rhs = target`` by
 damped Newton steps on the exact Jacobian from touching positions and no-slip speeds (the
 nips held in contact while solving, checked in contact after). The Jacobian restricted to
 the fast states (positions and velocities of the free coordinates, rotation speeds,
-friction states; angles and radii are slow or absent) gives the modes. Each free
-coordinate names one **bounce mode**: the eigenpair in which that coordinate carries the
+friction states, a flexible body's segment angles; the other angles and radii are slow or
+absent) gives the modes. Each free coordinate (a flexible body's: each order of its shape,
+``front.bend.z1``, :mod:`winder.analysis.shapes`) names one **bounce mode**: the eigenpair
+in which that coordinate carries the
 largest share of the mode's kinetic energy (``½ m |ẋ|²`` per free coordinate, ``½ J |θ̇|²``
 per turning body), an oscillating pair first (share ≥ 1/4), each pair used once
 (``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a single-drum scene); the rest are the
-slip/torsion modes.
+slip modes, and the torsion modes of the flexible bodies (``front.torsion1``).
 """
 
 from __future__ import annotations
