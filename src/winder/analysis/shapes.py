@@ -97,17 +97,20 @@ class Shapes:
                       ) -> tuple[str, float] | None:
         """``(BODY.torsion{n}, share)`` of a mode whose rotation speeds of the turning
         bodies are ``omega`` (complex, in the order of ``speeds``; ``inertia`` [kg·m²]
-        alike) and whose kinetic energy is ``total``: the flexible body whose segments'
-        rotation carries the most of it (at least half) and the dominant order of their
-        shape in :func:`torsion_basis`; ``None`` where no body's twist dominates (a slip
-        mode: a free body turning as a whole)."""
-        best = None
+        alike) and whose kinetic energy is ``total``: where the flexible bodies' segments'
+        rotation carries at least half of it, the body with the most of it and the
+        dominant order of its shape in :func:`torsion_basis`; ``None`` where the twist does
+        not dominate (a slip mode: a free body turning as a whole)."""
+        best, rotation = None, 0.0
         for g in self.torsion:
             live = [r for r in g.rows if r >= 0]
             e = float(np.sum(inertia[live] * np.abs(omega[live]) ** 2))
+            rotation += e
             if best is None or e > best[1]:
                 best = (g, e)
-        if best is None or not best[1] >= 0.5 * total:
+        # the flexible bodies' rotation together (twin drums share a mode through their
+        # nips), the body with the most of it names the mode
+        if best is None or not rotation >= 0.5 * total:
             return None
         g, e = best
         fixed = g.rows[0] < 0
