@@ -61,7 +61,7 @@ demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder view $(OUT)/winder_line.npz --html $(OUT)/winder_line.html --snapshots $(OUT)/snapshots_line --every 100
 # the flexible two-drum winder (issue #25): its first 5 s with the deflection, line-load
 # and twist figures, the animation, and its modes over the whole cycle's radii (0.05-0.6 m;
-# about 1 min here, plus 80 s compiling the machine's code the first time)
+# about 1.5 min here, plus 80 s compiling the machine's code the first time)
 	$(PY) -m winder run models/two_drum_winder_flexible.toml --out $(OUT)/two_drum_winder_flexible.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/two_drum_winder_flexible.npz --html $(OUT)/two_drum_winder_flexible.html --snapshots $(OUT)/snapshots_flexible --every 1
 	$(PY) -m winder modes models/two_drum_winder_flexible.toml --radius-max 0.6 --points 40 --no-simulate --plot $(OUT)/plots/two_drum_flexible_modes.png --csv $(OUT)/two_drum_flexible_modes.csv
