@@ -82,6 +82,12 @@ def _chuck_tables(n: int, length: float) -> tuple[Any, Any, Any, float]:
     return Ks, W, U.T @ W, float(np.linalg.eigvalsh(Ks)[0])
 
 
+def _deviation(values: list[Any]) -> list[Any]:
+    """Each value minus their mean."""
+    mean = sum(values) / len(values)
+    return [v - mean for v in values]
+
+
 class FlexBeam(ForceElement):
     """Bending (condensed beam, bearings, Rayleigh damping) and torsion of flexible
     bodies."""
@@ -177,6 +183,11 @@ class FlexBeam(ForceElement):
             / ev.mathns.sqrt(ei * p(f"{body}.flex.mu1") / states[0].mass)
         free = segs[0].free
         chucks = bool(segs[0].bearing_axes)
+        vx, vz = [bs.vx for bs in states], [bs.vz for bs in states]
+        if not chucks:  # free–free: K₁ holds a common motion of the stations at zero
+            # force, but its row sums carry round-off; taken out here, that round-off
+            # (× EI) does not act on the roll's height or speed
+            ux, uz, vx, vz = (_deviation(u) for u in (ux, uz, vx, vz))
         if chucks:  # (k_b I + EI G)⁻¹, 2 × 2
             kb = p(f"{body}.flex.chuck_stiffness")
             m00 = kb + ei * p(f"{body}.flex.G_0_0")
@@ -188,13 +199,13 @@ class FlexBeam(ForceElement):
         for i, seg in enumerate(segs):
             fx: Any = 0.0
             fz: Any = 0.0
-            for j, bs in enumerate(states):
+            for j in range(len(states)):
                 k = ei * p(f"{body}.flex.K1_{min(i, j)}_{max(i, j)}")
                 if chucks:
                     k = k - ei * ei * sum(w[i][a] * inv[a][b] * w[j][b]
                                           for a in range(2) for b in range(2))
-                fx = fx - k * (ux[j] + beta * bs.vx)
-                fz = fz - k * (uz[j] + beta * bs.vz)
+                fx = fx - k * (ux[j] + beta * vx[j])
+                fz = fz - k * (uz[j] + beta * vz[j])
             ev.add_force(seg.name, fx if "x" in free else 0.0, fz if "z" in free else 0.0)
         kt = p(f"{body}.flex.k_t")
         return kt, beta * kt
