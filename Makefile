@@ -60,6 +60,12 @@ demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder modes models/two_drum_winder.toml --plot $(OUT)/plots/two_drum_modes.png --csv $(OUT)/two_drum_modes.csv
 	$(PY) -m winder run models/winder_line.toml --out $(OUT)/winder_line.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/winder_line.npz --html $(OUT)/winder_line.html --snapshots $(OUT)/snapshots_line --every 100
+# the flexible two-drum winder (issue #25): its first 5 s with the deflection, line-load
+# and twist figures, the animation, and its modes over the whole cycle's radii (0.05-0.6 m;
+# about 1.5 min here, plus 80 s compiling the machine's code the first time)
+	$(PY) -m winder run models/two_drum_winder_flexible.toml --out $(OUT)/two_drum_winder_flexible.npz --plots $(OUT)/plots --progress
+	$(PY) -m winder view $(OUT)/two_drum_winder_flexible.npz --html $(OUT)/two_drum_winder_flexible.html --snapshots $(OUT)/snapshots_flexible --every 1
+	$(PY) -m winder modes models/two_drum_winder_flexible.toml --radius-max 0.6 --points 40 --no-simulate --plot $(OUT)/plots/two_drum_flexible_modes.png --csv $(OUT)/two_drum_flexible_modes.csv
 	@echo "demo outputs in $(OUT)/"
 
 test: $(STAMP) pin-casadi chromium libtbb
@@ -106,7 +112,7 @@ peers: $(STAMP)
 scene-reference: $(STAMP)
 	$(PY) -m winder.scene.reference --out docs/scene-reference.md
 
-# The README's quoted numbers of the two-drum winder and the winder line, from the demo's
+# The README's quoted numbers of the two-drum winder, the winder line and the flexible winder, from the demo's
 # results in $(OUT)/ (run where missing): a table to paste.
 readme-numbers: $(STAMP) pin-casadi
 	$(PY) benchmarks/readme_numbers.py --out $(OUT)

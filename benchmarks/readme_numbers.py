@@ -1,7 +1,9 @@
-"""The README's quoted numbers of the two-drum winder and the winder line, computed from
-the demo's results (``make readme-numbers``): prints a table to paste.
+"""The README's quoted numbers of the two-drum winder, the winder line and the flexible
+two-drum winder, computed from the demo's results (``make readme-numbers``): prints a table
+to paste.
 
-Reads ``out/two_drum_winder.npz`` and ``out/winder_line.npz`` (written by ``make demo``)
+Reads ``out/two_drum_winder.npz``, ``out/winder_line.npz`` and
+``out/two_drum_winder_flexible.npz`` (written by ``make demo``)
 where they exist and were run from the current scene files at the default settings;
 otherwise runs the scene (minutes on a loaded machine) and writes the result there. The
 three rider-load variants the README compares are kept the same way as
@@ -166,6 +168,39 @@ def line_numbers(res: winder.Result, ramp_end: float) -> list[tuple[str, str]]:
     return rows
 
 
+def flex_numbers(res: winder.Result, mm) -> list[tuple[str, str]]:  # noqa: ANN001
+    """The flexible two-drum winder (issue #25): per nip the line load along the width at
+    the run's end (least, largest, mean; the slices' ``F_i N/L``, ``L = ΣF_i / mean``),
+    where it is least uniform, and where a harmonic of the roll's rotation meets an order-1
+    bending mode of the resonance map ``mm`` (:class:`winder.ModeMap`)."""
+    rows: list[tuple[str, str]] = []
+    t_end = float(res.t[-1])
+    spread = {}
+    for nip in ("front_nip", "rear_nip", "rider_nip"):
+        f = []
+        while f"{nip}_s{len(f)}_normal_force" in res:
+            f.append(float(res[f"{nip}_s{len(f)}_normal_force"][-1]))
+        f = np.array(f)
+        mean = float(res[f"{nip}_line_load_mean"][-1])
+        n, length = len(f), float(f.sum()) / mean
+        q = f * n / length
+        y = (np.arange(n) + 0.5) * length / n
+        lo, hi = int(np.argmin(q)), int(np.argmax(q))
+        spread[nip] = (q[hi] - q[lo]) / mean
+        rows.append((f"{nip} line load at t = {t_end:g} s: least, largest, mean [kN/m]",
+                     f"{q[lo] / 1e3:.3f} at y = {y[lo]:.2f} m, {q[hi] / 1e3:.3f} at "
+                     f"y = {y[hi]:.2f} m, {mean / 1e3:.3f}; (max − min)/mean "
+                     f"{100 * spread[nip]:.2f} %"))
+    worst = max(spread, key=spread.get)
+    rows.append(("least uniform line load", f"{worst} ({100 * spread[worst]:.2f} %)"))
+    first = [c for c in mm.shown() if c.endswith(("bend.x1", "bend.z1"))]
+    found = [(c, h, rc) for c, h, rc in mm.crossings(first) if h.endswith("x")]
+    rows.append((f"harmonics meeting an order-1 bending mode at {mm.web_speed:g} m/s [m]",
+                 "; ".join(f"{h} meets {c} at r = {rc:.3f}" for c, h, rc in
+                           sorted(found, key=lambda x: x[2])) or "none"))
+    return rows
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=ROOT / "out",
@@ -184,10 +219,14 @@ def main(argv: list[str] | None = None) -> int:
              f"{r.meta['wall_time']:.1f} s wall, {r.meta['rhs_evaluations'] / 1e6:.1f} M "
              f"evaluations, {r.meta['events']:,} located events")
             for name, r in (("two_drum_winder", two), ("winder_line", line))]
+    flex = result_of("two_drum_winder_flexible", args.out, rerun=args.rerun)
+    flex_map = winder.mode_map(winder.load_scene(MODELS / "two_drum_winder_flexible.toml"),
+                               radius_max=0.6, n=40)  # as make demo: the cycle's radii
     print("| quantity | value |\n|---|---|")
     for title, rows in (("two_drum_winder", two_drum_numbers(two)),
                         ("two_drum_winder, rider load", variants),
                         ("winder_line", line_numbers(line, ramp_end)),
+                        ("two_drum_winder_flexible", flex_numbers(flex, flex_map)),
                         ("integration", runs)):
         for name, value in rows:
             print(f"| {title}: {name} | {value} |")

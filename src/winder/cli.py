@@ -301,19 +301,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
                   radius_max=args.radius_max, _names=("--radius-min", "--radius-max"))
     print(f"{scene.name}: modes at {len(mm.radius)} radii, {mm.radius[0]:.3f}-"
           f"{mm.radius[-1]:.3f} m, web speed {mm.web_speed:g} m/s")
-    one = len(mm.coordinates) == 1
-    for c in mm.coordinates:
-        f, z = mm.frequencies[c], mm.dampings[c]
-        print(f"  bounce mode{'' if one else ' ' + c} {f[0]:.1f} -> {f[-1]:.1f} Hz, "
-              f"damping ratio {z[0]:.3f} -> {z[-1]:.3f}")
-        for lo, hi in mm.overdamped(c):
-            print(f"  bounce mode{'' if one else ' ' + c} is overdamped (real eigenvalue, no "
-                  f"oscillation, no crossing) at r = {lo:.4f}-{hi:.4f} m")
-    for c in mm.coordinates:
-        for h in mm.harmonics():
-            crit = mm.critical_radii(h, c)
-            print(f"  {h} rotation meets the bounce mode{'' if one else ' ' + c} at r = "
-                  + (", ".join(f"{x:.4f} m" for x in crit) if crit else "(no crossing)"))
+    for line in mm.summary():
+        print(f"  {line}")
     if csv is not None:
         atomic_write(csv, csv_writer(mm.as_columns(), fmt="%.10g"))
         print(f"  table written to {csv}")

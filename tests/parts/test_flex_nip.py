@@ -282,10 +282,10 @@ def test_generated_code_matches_the_numeric_path() -> None:
 
 
 def test_the_flexible_two_drum_example_builds() -> None:
-    """examples/two_drum_winder_flexible.toml: every body in 8 segments, every nip sliced."""
+    """models/two_drum_winder_flexible.toml: every body in 8 segments, every nip sliced."""
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[2] / "examples" / "two_drum_winder_flexible.toml"
+    path = Path(__file__).resolve().parents[2] / "models" / "two_drum_winder_flexible.toml"
     m = Machine(winder.load_scene(path))
     assert len(m.bodies) == 32 and len(m.nips) == 24
     for nip in ("front_nip", "rear_nip", "rider_nip"):

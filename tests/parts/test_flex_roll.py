@@ -1,11 +1,13 @@
 """A flexible wound roll (issue #25): N segments sharing one radius state, each with its
 share of ``m(r)``, ``J(r)`` and of the ``−Ẏv`` terms, bending with ``EI(r) = core_EI +
-paper_E·π(r⁴ − r_c⁴)/4`` and no bearings (carried by its nips), twisting with ``GJ``.
+paper_E·π(r⁴ − r_c⁴)/4`` and no bearings (carried by its nips) or on chucks, twisting
+with ``GJ``.
 
 Oracles: world linear and angular momentum of a free-flying growing roll are conserved
 (their rates vanish at any state, to 1e-9, only with ``−Ẏv`` on every segment); its
 free–free bending frequencies follow ``EI(r)`` and ``m(r)``; at rest on a flexible drum
-the slices solve the linear problem by hand; stiff, it is the rigid roll.
+the slices solve the linear problem by hand; stiff, it is the rigid roll; on chucks it
+sags and vibrates as the beam on two bearings of the drum's oracle.
 """
 
 from __future__ import annotations
@@ -260,5 +262,80 @@ def test_generated_code_matches_the_numeric_path() -> None:
     for i in range(3):
         y[gen.index(f"roll_s{i}.z")] += 1e-5 * rng.standard_normal()
         y[gen.index(f"roll_s{i}.theta_dot")] += rng.standard_normal()
+    a, b = gen.rhs(0.1, y), num.rhs(0.1, y)
+    assert np.max(np.abs(a - b) / (np.abs(b) + 1e-6)) < 1e-9
+
+
+# ---- a roll on chucks --------------------------------------------------------------------
+KC = 1e10  # [N/m] each chuck
+
+
+def chucked(n: int, r0: float = 0.3, damping: float = 0.0, speed: float = 0.0
+            ) -> winder.Scene:
+    """The roll of :func:`scene` on chucks 2.2 m above its nip's touching height (the nip
+    stays open: no contact), free in ``x`` and ``z``."""
+    text = scene_text(n, r0=r0, free='["x", "z"]', damping=damping, speed=speed)
+    text = text.replace(f"centre = [0.0, {0.5 + r0}]", f"centre = [0.0, {2.7 + r0}]")
+    text = text.replace(f"damping_ratio = {damping} }}",
+                        f'damping_ratio = {damping}, support = "chucks", '
+                        f"chuck_stiffness = {KC} }}")
+    return winder.scene_from_dict(tomllib.loads(text), source="flexroll.toml")
+
+
+@pytest.mark.parametrize("n", [5, 11])
+def test_roll_on_chucks_sags_as_the_beam_formula(n: int) -> None:
+    """Gravity on, its nip open: the static balance puts a roll on stiff chucks in the sag
+    of the drum's oracle (tests/parts/test_flex_drum.py) with ``EI(r)``, ``q = m(r) g/L``:
+    midspan ``5qL⁴/(384 EI) (1 + 2/(5N²) + 1/(5N⁴)) + qL/(2 k_c)``, every station
+    ``F · (qL/N)`` (measured ≤ 1.4e-12 at N = 11); ``x`` stays on the chucks' line."""
+    r0 = 0.3
+    sys = MachineSystem(chucked(n, r0), backend="pinocchio")
+    y = sys.initial_state()
+    z0 = 2.7 + r0
+    q = mass(r0) * G / W
+    want = 5 * q * W ** 4 / (384 * ei(r0)) * (1 + 2 / (5 * n * n) + 1 / (5 * n ** 4)) \
+        + q * W / (2 * KC)
+    sag = z0 - y[sys.index(f"roll_s{n // 2}.z")]
+    assert abs(sag / want - 1) < 2e-11, (sag, want)
+    F = station_flexibility(n, W, ei(r0), None, KC)
+    stations = z0 - np.array([y[sys.index(f"roll_s{i}.z")] for i in range(n)])
+    assert np.max(np.abs(stations / (F @ np.full(n, q * W / n)) - 1)) < 2e-11
+    assert np.max(np.abs([y[sys.index(f"roll_s{i}.x")] for i in range(n)])) < 1e-12
+    ev = sys.evaluate_numeric(0.0, y)
+    assert float(ev.channels["nip_normal_force"]) == 0.0
+
+
+def test_roll_on_chucks_bends_with_ei_of_the_radius() -> None:
+    """Its bending frequencies at two radii: the chain on chucks ``K(EI) = F⁻¹`` (the
+    Woodbury form of the stiffness is exact: measured 7e-14) with ``m(r)/N``."""
+    n = 6
+    off = "gravity = false\ncontact = false\nslip_relaxation = false\nimbalance = false"
+    for r in (0.2, 0.5):
+        text = scene_text(n, r0=r, effects=off).replace(
+            "damping_ratio = 0.0 }", f'damping_ratio = 0.0, support = "chucks", '
+            f"chuck_stiffness = {KC} }}")
+        sc = winder.scene_from_dict(tomllib.loads(text), source="flexroll.toml")
+        got = frequencies(MachineSystem(sc, backend="pinocchio"), n)
+        F = station_flexibility(n, W, ei(r), None, KC)
+        want = np.sqrt(np.sort(np.linalg.eigvals(np.linalg.inv(F) / (mass(r) / n)).real))
+        assert np.max(np.abs(got / want - 1)) < 1e-12, (r, got, want)
+
+
+def test_chuck_stiffness_needs_chucks() -> None:
+    text = scene_text(3).replace("damping_ratio = 0.0 }", "damping_ratio = 0.0, "
+                                 "chuck_stiffness = 1e9 }")
+    with pytest.raises(SceneError, match=r"chuck_stiffness.*support = 'chucks'"):
+        winder.scene_from_dict(tomllib.loads(text), source="flexroll.toml")
+
+
+def test_generated_code_on_chucks_matches_the_numeric_path() -> None:
+    sc = chucked(3, damping=0.05, speed=20.0)
+    gen, num = MachineSystem(sc), MachineSystem(sc, backend="pinocchio")
+    assert gen.generated is not None
+    y = gen.initial_state()
+    rng = np.random.default_rng(7)
+    for i in range(3):
+        y[gen.index(f"roll_s{i}.z")] += 1e-5 * rng.standard_normal()
+        y[gen.index(f"roll_s{i}.x_dot")] += 1e-3 * rng.standard_normal()
     a, b = gen.rhs(0.1, y), num.rhs(0.1, y)
     assert np.max(np.abs(a - b) / (np.abs(b) + 1e-6)) < 1e-9

@@ -176,6 +176,9 @@ def test_every_channel_of_a_shipped_scene_is_declared_once_with_its_unit(model):
     parts = {p.name: k for k, group in (("drum", scene.drums), ("roll", scene.rolls),
                                         ("rider", scene.riders), ("nip", scene.nips))
              for p in group}
+    # a flexible body's segments NAME_s{i} are bodies of its kind, its nips' slices nips
+    parts |= {b.name: b.table for b in system.machine.bodies if b.segment_of}
+    parts |= {n.name: "nip" for n in system.machine.nips if n.whole is not None}
     machine = {"t": "t", **{out: ch for out, (ch, _) in system.outputs.items()}}
     assert list(machine) == list(units)
     for out, channel in machine.items():

@@ -256,10 +256,16 @@ def test_exhausted_parent(request, short_parent) -> None:
     assert trace[-1][0] == integ.EXHAUSTED and 1.8 < trace[-1][1] < 2.0
 
 
-@pytest.mark.parametrize("name", sorted(p.stem for p in MODELS.glob("*.toml")))
+#: Shipped scenes added after the numba kernels were deleted: no numba trace exists to
+#: compare with (their runs are checked by tests/test_shipped_references.py).
+NO_NUMBA_TRACE = {"two_drum_winder_flexible"}
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in MODELS.glob("*.toml")
+                                        if p.stem not in NO_NUMBA_TRACE))
 def test_every_shipped_scene(request, name) -> None:
-    """The first half second of every shipped scene, DOPRI5 at its tolerances and RK4 at
-    1 ms; 0.2 s with ROS2."""
+    """The first half second of every shipped scene (but :data:`NO_NUMBA_TRACE`), DOPRI5 at
+    its tolerances and RK4 at 1 ms; 0.2 s with ROS2."""
     scene = winder.load_scene(MODELS / f"{name}.toml")
     system, y0 = _system(scene)
     trace = _compare(request, system, y0, 0.5, scene.solver.rtol, scene.solver.atol, 5_000)

@@ -14,11 +14,18 @@ or a drum's rotation frequency crosses an oscillating bounce mode, the imbalance
 drum's runout) drives that mode at resonance (critical radii). For each radius the web
 speed at which the 1× line meets the roll's own vertical bounce mode is
 ``v_crit = 2π r f_bounce``.
+
+A flexible body (issue #25) has bending and torsion modes in place of its segments'
+bounce: labelled by shape, the dominant order ``n`` of the segment displacements' (or
+angles') projection onto ``sin(nπ y/L)`` (:mod:`winder.analysis.shapes`):
+``front.bend.z1``, ``set.bend.x2``, ``front.torsion1``. A harmonic ``k`` meets a bending
+mode of frequency ``f_b`` where ``k v/(2π r) = f_b``, at ``r = k v/(2π f_b)``.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -46,6 +53,8 @@ MAX_POINTS = 10_000
 _JUMP = 0.25
 #: Harmonics of the roll's rotation drawn and searched for crossings.
 ORDERS = (1, 2, 3)
+#: A flexible body's bending orders a chart draws (and the CLI reports).
+SHOWN_ORDERS = 2
 
 
 def modes_at(scene: Scene, radius: float, *, web_speed: float | None = None) -> list[Mode]:
@@ -86,16 +95,40 @@ class ModeMap:
     naming: Naming = BY_PARTS
     #: per bounce mode its natural frequency ``|λ|/2π`` [Hz] (also where it is overdamped)
     natural: dict[str, np.ndarray] = field(default_factory=dict)
+    #: per torsion mode of a flexible body (``BODY.torsion{n}``) its natural frequency
+    #: ``|λ|/2π`` [Hz] (as the slip mode's: the nips' friction overdamps most torsion
+    #: modes) and damping ratio [-]; NaN at a radius where no mode has that label
+    torsion: dict[str, np.ndarray] = field(default_factory=dict)
+    torsion_damping: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def coordinates(self) -> list[str]:
+        """The bounce modes' labels: a rigid body's ``BODY.x``/``BODY.z``, a flexible
+        body's bending orders ``BODY.bend.z1`` … (:mod:`winder.analysis.shapes`)."""
         return list(self.frequencies)
 
     @property
+    def flexible(self) -> bool:
+        """Whether the machine has a flexible body (bending and torsion modes)."""
+        return any(".bend." in c for c in self.frequencies) or bool(self.torsion)
+
+    def shown(self, orders: int = SHOWN_ORDERS) -> list[str]:
+        """The modes a chart draws: every rigid bounce mode, a flexible body's bending
+        orders ``n <= orders`` and its torsion order 1."""
+        def order(c: str) -> int:
+            n = re.search(r"(\d+)$", c)
+            return int(n.group(1)) if n else 0
+        out = [c for c in self.coordinates if ".bend." not in c or order(c) <= orders]
+        return out + [c for c in self.torsion if order(c) == 1]
+
+    @property
     def main(self) -> str:
-        """The wound roll's vertical mode (``ROLL.z``), else the first."""
-        z = f"{self.roll}.z"
-        return z if z in self.frequencies else self.coordinates[0]
+        """The wound roll's vertical mode (``ROLL.z``; flexible: ``ROLL.bend.z1``), else
+        the first."""
+        for z in (f"{self.roll}.z", f"{self.roll}.bend.z1"):
+            if z in self.frequencies:
+                return z
+        return self.coordinates[0]
 
     @property
     def bounce_frequency(self) -> np.ndarray:
@@ -149,7 +182,8 @@ class ModeMap:
         linear interpolation; only where the mode oscillates on both sides and its
         frequency changes by less than 25 % between the two radii."""
         line = self.harmonics()[f"{order}x" if isinstance(order, int) else order]
-        f = self.frequencies[mode or self.main]
+        mode = mode or self.main
+        f = self.frequencies[mode] if mode in self.frequencies else self.torsion[mode]
         d = f - line
         out = []
         # a crossing of an oscillating mode whose frequency moves continuously (less than
@@ -163,10 +197,43 @@ class ModeMap:
             out.append(float(self.radius[i] + s * (self.radius[i + 1] - self.radius[i])))
         return out
 
-    def crossings(self) -> list[tuple[str, str, float]]:
-        """Every crossing ``(mode, harmonic, radius [m])``."""
-        return [(c, h, rc) for c in self.coordinates for h in self.harmonics()
+    def crossings(self, modes: list[str] | None = None) -> list[tuple[str, str, float]]:
+        """Every crossing ``(mode, harmonic, radius [m])`` of the bounce, bending and
+        torsion modes (or of ``modes``, e.g. :meth:`shown`) with the harmonics."""
+        modes = [*self.coordinates, *self.torsion] if modes is None else modes
+        return [(c, h, rc) for c in modes for h in self.harmonics()
                 for rc in self.critical_radii(h, c)]
+
+    def summary(self) -> list[str]:
+        """The lines ``winder modes`` prints: each bounce mode from the first to the last
+        radius (where it is overdamped), then where each harmonic meets it; a flexible
+        machine: the modes :meth:`shown` and only the crossings found."""
+        if self.flexible:
+            out = []
+            for c in self.shown():
+                f = self.frequencies.get(c, self.torsion.get(c))
+                kind = "torsion" if c in self.torsion else \
+                    "bending" if ".bend." in c else "bounce"
+                out.append(f"{kind} mode {c} {f[0]:.1f} -> {f[-1]:.1f} Hz")
+            crossings = self.crossings(self.shown())
+            out += [f"{h} rotation meets {c} at r = {rc:.4f} m" for c, h, rc in crossings]
+            return out or ["no harmonic meets these modes over the map's radii"]
+        one = len(self.coordinates) == 1
+        out = []
+        for c in self.coordinates:
+            f, z = self.frequencies[c], self.dampings[c]
+            name = "" if one else " " + c
+            out.append(f"bounce mode{name} {f[0]:.1f} -> {f[-1]:.1f} Hz, "
+                       f"damping ratio {z[0]:.3f} -> {z[-1]:.3f}")
+            out += [f"bounce mode{name} is overdamped (real eigenvalue, no oscillation, no "
+                    f"crossing) at r = {lo:.4f}-{hi:.4f} m" for lo, hi in self.overdamped(c)]
+        for c in self.coordinates:
+            for h in self.harmonics():
+                crit = self.critical_radii(h, c)
+                out.append(f"{h} rotation meets the bounce mode{'' if one else ' ' + c} at "
+                           "r = " + (", ".join(f"{x:.4f} m" for x in crit) if crit
+                                     else "(no crossing)"))
+        return out
 
     def as_columns(self) -> dict[str, np.ndarray]:
         """The CSV table: the main bounce mode, every bounce mode (``BODY_x_frequency``,
@@ -179,6 +246,10 @@ class ModeMap:
             key = c.replace(".", "_")
             cols[f"{key}_frequency"] = self.frequencies[c]
             cols[f"{key}_damping"] = self.dampings[c]
+        for c, f in self.torsion.items():
+            key = c.replace(".", "_")
+            cols[f"{key}_frequency"] = f
+            cols[f"{key}_damping"] = self.torsion_damping[c]
         cols.update({"slip_frequency": self.slip_frequency, "slip_damping": self.slip_damping,
                      "rotation_1x": self.rotation_1x, "rotation_2x": self.rotation_2x,
                      "rotation_3x": 3 * self.rotation_1x})
@@ -261,7 +332,9 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
         key = _core_key(lin)
         raise ArgumentError(f"{where}: radii[{i}] = {float(radii[i])!r} is out of range; "
                             f"valid: finite radii >= {key} = {rc:g} m")
-    nt = len(lin.coords)
+    nt = len(lin.labels)
+    torsion: dict[str, np.ndarray] = {}
+    tdamp: dict[str, np.ndarray] = {}
     freq = np.full((nt, len(radii)), np.nan)
     damp = np.full((nt, len(radii)), np.nan)
     natural = np.full((nt, len(radii)), np.nan)
@@ -276,15 +349,24 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
         prev = (y, guess if guess is not None else lin.guess(float(r)))
         ms = lin.modes(y)
         for m in ms[:nt]:
-            j = lin.coords.index(m.coordinate)
+            j = lin.labels.index(m.coordinate)
             freq[j, i], damp[j, i] = m.frequency, m.damping_ratio
             natural[j, i] = m.natural_frequency
-        if len(ms) > nt:
-            slip[:, i] = ms[nt].natural_frequency, ms[nt].damping_ratio
-    drums = {b.name: b.operating_speed(v) / (2 * math.pi)
-             for b in lin.machine.bodies if b.prescribed}
+        slips = [m for m in ms[nt:] if m.kind == "slip"]
+        if slips:
+            slip[:, i] = slips[0].natural_frequency, slips[0].damping_ratio
+        for m in ms[nt:]:  # the slowest mode of each torsion label
+            if m.kind == "torsion":
+                f = torsion.setdefault(m.coordinate, np.full(len(radii), np.nan))
+                d = tdamp.setdefault(m.coordinate, np.full(len(radii), np.nan))
+                if np.isnan(f[i]):  # |λ|/2π: the nips' friction damps torsion heavily
+                    f[i], d[i] = m.natural_frequency, m.damping_ratio
+    drums = {b.segment_of or b.name: b.operating_speed(v) / (2 * math.pi)
+             for b in lin.machine.bodies if b.prescribed}  # a flexible drum by its name
     surface = lin.machine.entry.a.surface_speed(v)  # the roll's surface: ratio · v
-    return ModeMap(radii, dict(zip(lin.coords, freq, strict=True)),
-                   dict(zip(lin.coords, damp, strict=True)), slip[0], slip[1],
-                   surface / (2 * math.pi * radii), v, lin.roll.name, drums,
-                   naming_of(scene), dict(zip(lin.coords, natural, strict=True)))
+    order = sorted(torsion, key=lambda c: (c.rsplit(".", 1)[0], int(c.rsplit("n", 1)[1])))
+    return ModeMap(radii, dict(zip(lin.labels, freq, strict=True)),
+                   dict(zip(lin.labels, damp, strict=True)), slip[0], slip[1],
+                   surface / (2 * math.pi * radii), v, lin.roll.segment_of or lin.roll.name, drums,
+                   naming_of(scene), dict(zip(lin.labels, natural, strict=True)),
+                   {c: torsion[c] for c in order}, {c: tdamp[c] for c in order})

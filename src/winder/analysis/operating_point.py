@@ -15,18 +15,22 @@ is linearised with its exact Jacobian (:func:`winder.jacobian`) about its quasi-
   with the translational velocities 0 (the nips' damping sees only the radius growth
   ``δ̇ = ṙ``);
 - angles 0, the imbalance off (``com_offset = 0``: it is the excitation), the other
-  paper rolls at their initial radius.
+  paper rolls at their initial radius; a flexible body (issue #25) turning as a whole in
+  its steady twist: its segments' angles are unknowns too, with ``θ̇_i = Ω`` (a driven
+  drum's speed) or ``θ̇_i = θ̇_0`` (a free roll or rider, segment 0 its reference).
 
 These unknowns (positions, rotation speeds, friction states) solve ``rhs = target`` by
 damped Newton steps on the exact Jacobian from touching positions and no-slip speeds (the
 nips held in contact while solving, checked in contact after). The Jacobian restricted to
 the fast states (positions and velocities of the free coordinates, rotation speeds,
-friction states; angles and radii are slow or absent) gives the modes. Each free
-coordinate names one **bounce mode**: the eigenpair in which that coordinate carries the
+friction states, a flexible body's segment angles; the other angles and radii are slow or
+absent) gives the modes. Each free coordinate (a flexible body's: each order of its shape,
+``front.bend.z1``, :mod:`winder.analysis.shapes`) names one **bounce mode**: the eigenpair
+in which that coordinate carries the
 largest share of the mode's kinetic energy (``½ m |ẋ|²`` per free coordinate, ``½ J |θ̇|²``
 per turning body), an oscillating pair first (share ≥ 1/4), each pair used once
 (``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a single-drum scene); the rest are the
-slip/torsion modes.
+slip modes, and the torsion modes of the flexible bodies (``front.torsion1``).
 """
 
 from __future__ import annotations
@@ -39,6 +43,7 @@ import numpy as np
 from winder._args import number, show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.linearise import jacobian
+from winder.analysis.shapes import Shapes
 from winder.model.locked_modes import AUTO, IN_CONTACT, ModeKind
 from winder.parts import BodyElement, body_elements
 from winder.parts.drum import DRIVE_KEYS
@@ -62,9 +67,11 @@ _RATE_UNIT = {"x_dot": " m/s²", "z_dot": " m/s²", "theta_dot": " rad/s²", "fr
 @dataclass(frozen=True)
 class Mode:
     """One eigenvalue (of a pair): ``frequency`` [Hz] (damped, 0 for a real eigenvalue),
-    ``natural_frequency`` ``|λ|/2π`` [Hz], ``damping_ratio`` [-], ``kind`` (``bounce`` or
-    ``slip``) and ``coordinate``: the free coordinate that dominates a bounce mode
-    (``BODY.x``/``BODY.z``), or the state that dominates a slip mode."""
+    ``natural_frequency`` ``|λ|/2π`` [Hz], ``damping_ratio`` [-], ``kind`` (``bounce``,
+    ``bending``, ``slip`` or ``torsion``) and ``coordinate``: the free coordinate that
+    dominates a bounce mode (``BODY.x``/``BODY.z``), a flexible body's bending order
+    (``BODY.bend.z1``, :mod:`winder.analysis.shapes`) or torsion order
+    (``BODY.torsion1``), or the state that dominates a slip mode."""
 
     eigenvalue: complex
     kind: str
@@ -171,14 +178,31 @@ class _Linearisation:
         self.coords = [f"{b.name}.{c}" for b in m.bodies for c in b.free]
         self.velocities = [m.index(f"{n}_dot") for n in self.coords]
         self.speeds = [m.index(f"{b.name}.theta_dot") for b in m.bodies if not b.prescribed]
+        #: the modes' generalised coordinates: a flexible body's bending orders in place
+        #: of its segments' x/z (:mod:`winder.analysis.shapes`)
+        self.shapes = Shapes(m.bodies, self.coords,
+                             [b.name for b in m.bodies if not b.prescribed])
+        self.labels = self.shapes.labels
+        # a flexible body's segment angles are elastic (its twist): fast, and in the
+        # balance the twist that carries the torques, turning with the body: θ̇_i = Ω (the
+        # drive's speed) on a driven body, θ̇_i = θ̇_0 on a free one (θ_0 its reference)
+        self.angles: list[int] = []
+        self.twists: dict[int, tuple[int | None, float]] = {}  # θ_i -> (θ_0, or None: Ω)
+        for whole in dict.fromkeys(b.segment_of for b in m.bodies if b.segment_of):
+            segs = [b for b in m.bodies if b.segment_of == whole]
+            drive = next((b for b in segs if b.prescribed), None)
+            turning = [m.index(f"{b.name}.theta") for b in segs if not b.prescribed]
+            self.angles += turning
+            for i in turning if drive is not None else turning[1:]:
+                self.twists[i] = (None, drive.sense * drive.operating_speed(v)) \
+                    if drive is not None else (turning[0], 0.0)
         slow = {m.index(f"{b.name}.theta") for b in m.bodies if not b.prescribed}
+        slow -= set(self.angles)
         slow |= {m.index(_radius_state(b)) for b in m.bodies if b.radius_state}
         taken = set(self.positions) | set(self.velocities) | set(self.speeds) | slow
+        taken |= set(self.angles)
         self.others = [i for i in range(len(names)) if i not in taken]  # friction, ...
-        # unknowns of the balance and their equations (rates)
-        self.unknowns = self.positions + self.speeds + self.others
-        self.equations = self.velocities + self.speeds + self.others
-        self.fast = self.positions + self.velocities + self.speeds + self.others
+        self._sets()
         self.paper = {m.index(f"{b.name}.theta_dot"): m.index(_radius_state(b))
                       for b in m.bodies if b.radius_state}
         self._speed_slots = np.arange(len(self.positions),
@@ -208,9 +232,14 @@ class _Linearisation:
             return
         self.idle = [self.machine.state_names[i] for i in sorted(drop)]
         self.others = [i for i in self.others if i not in drop]
-        self.unknowns = self.positions + self.speeds + self.others
-        self.equations = self.velocities + self.speeds + self.others
-        self.fast = self.positions + self.velocities + self.speeds + self.others
+        self._sets()
+
+    def _sets(self) -> None:
+        """The balance's unknowns and their equations (rates), the modes' fast states."""
+        twists = list(self.twists)
+        self.unknowns = self.positions + self.speeds + self.others + twists
+        self.equations = self.velocities + self.speeds + self.others + twists
+        self.fast = self.positions + self.velocities + self.speeds + self.others + self.angles
 
     # ---- the operating point ------------------------------------------------------------
     def _radius_of(self, y: np.ndarray, name: str) -> float:
@@ -233,6 +262,11 @@ class _Linearisation:
         # no slip, θ̇_b = −θ̇_a r_a / r_b across each nip, from the drums
         omega = {b.name: b.sense * b.operating_speed(self.v)
                  for b in m.bodies if b.prescribed}
+        for b in m.bodies:  # a flexible drum's segments turn with its driven one
+            whole = next((omega[o.name] for o in m.bodies if o.name in omega
+                          and b.segment_of is not None and o.segment_of == b.segment_of), None)
+            if whole is not None:
+                omega.setdefault(b.name, whole)
         for _ in m.nips:
             for n in m.nips:
                 a, b = n.a.name, n.b.name
@@ -274,6 +308,12 @@ class _Linearisation:
         for i_w, i_r in self.paper.items():  # constant surface speed: ω̇ = −ω ṙ / r
             f[i_w] += y[i_w] * f[i_r] / y[i_r]
             J[i_w, i_w] += (f[i_r] + y[i_w] * J[i_r, i_w]) / y[i_r]
+        for i, (ref, omega) in self.twists.items():  # a steady twist: θ̇_i = θ̇_0 or Ω
+            if ref is None:
+                f[i] -= omega
+            else:
+                f[i] -= f[ref]
+                J[i] -= J[ref]
         return f[self.equations], J[np.ix_(self.equations, self.unknowns)]
 
     def _scales(self, y: np.ndarray) -> np.ndarray:
@@ -446,8 +486,10 @@ class _Linearisation:
 
     # ---- the modes ----------------------------------------------------------------------
     def modes(self, y: np.ndarray) -> list[Mode]:
-        """Bounce modes (in the order of the free coordinates), then slip modes (slowest
-        first), at the operating point ``y``."""
+        """Bounce modes (in the order of the generalised coordinates :attr:`labels`: a
+        flexible body's bending orders ``BODY.bend.z1`` …), then slip modes (slowest
+        first), then torsion modes ``BODY.torsion{n}`` (slowest first), at the operating
+        point ``y``."""
         from scipy.optimize import linear_sum_assignment
 
         A = jacobian(self.system, self.t, y)[np.ix_(self.fast, self.fast)]
@@ -461,7 +503,8 @@ class _Linearisation:
         inertia = np.array([float(ev.bodies[b.name].inertia)
                             for b in self.machine.bodies if not b.prescribed])
         V = vec[:, keep]
-        kin = np.vstack([mass[:, None] * np.abs(V[nt:2 * nt]) ** 2,
+        Q = self.shapes.Q  # onto the generalised coordinates (a flexible body's orders)
+        kin = np.vstack([((Q * Q) @ mass)[:, None] * np.abs(Q @ V[nt:2 * nt]) ** 2,
                          inertia[:, None] * np.abs(V[2 * nt:2 * nt + ns]) ** 2])
         share = kin[:nt] / np.maximum(kin.sum(axis=0), 1e-300)
         # each coordinate takes the eigenpair in which it has the largest share, an
@@ -471,11 +514,20 @@ class _Linearisation:
         rows, cols = linear_sum_assignment(-score)
         bounce = {int(r): keep[int(c)] for r, c in zip(rows, cols, strict=True)}
         names = [self.machine.state_names[i] for i in self.fast]
-        out = [Mode(complex(lam[bounce[c]]), "bounce", self.coords[c]) for c in range(nt)]
-        slips = sorted((i for i in keep if i not in bounce.values()), key=lambda i: abs(lam[i]))
-        return out + [Mode(complex(lam[i]), "slip",
-                           names[2 * nt + int(np.argmax(np.abs(vec[2 * nt:, i])))])
-                      for i in slips]
+        out = [Mode(complex(lam[bounce[c]]), "bending" if ".bend." in self.labels[c]
+                    else "bounce", self.labels[c]) for c in range(nt)]
+        slips, torsions = [], []
+        for k in sorted((k for k in range(len(keep)) if keep[k] not in bounce.values()),
+                        key=lambda k: abs(lam[keep[k]])):
+            i = keep[k]
+            label = self.shapes.torsion_label(V[2 * nt:2 * nt + ns, k], inertia,
+                                              float(kin[:, k].sum()))
+            if label is not None:
+                torsions.append(Mode(complex(lam[i]), "torsion", label[0]))
+            else:
+                slips.append(Mode(complex(lam[i]), "slip",
+                                  names[2 * nt + int(np.argmax(np.abs(vec[2 * nt:, i])))]))
+        return out + slips + torsions
 
 
 def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: bool

@@ -13,8 +13,10 @@ machine without flexible bodies never builds it. Per flexible body ``NAME`` with
 with the run-time parameters ``NAME.flex.Kx_i_j`` [N/m], ``NAME.flex.Cx_i_j`` [N·s/m]
 (``i ≤ j``, symmetric; ``Kz``, ``Cz`` likewise), ``NAME.flex.k_t`` [N·m/rad] and
 ``NAME.flex.c_t`` [N·m·s/rad]. The bearings hold the axes a segment lists in
-``bearing_axes`` (a drum: ``x`` and ``z``; a rider: ``x``); along the others the beam is
-free–free (it rests on its nip). The
+``bearing_axes`` (a drum: ``x`` and ``z``; a rider: ``x``; a roll on chucks: its free
+axes); along the others the beam is free–free (it rests on its nip). A paper roll's
+``EI(r)`` changes at run time: its stiffness is ``EI(r)`` times the unit beam's, on chucks
+the Woodbury form of :func:`_chuck_tables`. The
 torsion torques go in as spatial forces (they are not part of a segment's ``NAME_s{i}_torque``
 channel, which keeps machines.md §9's meaning). Channel ``NAME_twist`` [rad]: the drive
 end's angle minus the far end's, operation sense.
@@ -59,6 +61,33 @@ LINE_LOAD = (
 )
 
 
+def _chuck_tables(n: int, length: float) -> tuple[Any, Any, Any, float]:
+    """A roll on chucks (``k_b`` per end): the stations' flexibility is ``A/EI + U Uᵀ/k_b``
+    (``A`` the beam's on rigid supports at unit ``EI``, ``U = [1 − y/L, y/L]`` the chucks'
+    rigid-body shapes, :func:`~winder.model.beam.station_flexibility`), so by Woodbury
+    ``K(EI) = EI K_s − EI² W (k_b I + EI G)⁻¹ Wᵀ`` with ``K_s = A⁻¹`` [N/m per N·m²],
+    ``W = K_s U`` and ``G = Uᵀ K_s U``: exact for the ``EI(r)`` of a growing roll at run
+    time with a 2 × 2 inverse. Returns ``(K_s, W, G, μ₁)``, ``μ₁`` the least eigenvalue
+    of ``K_s`` (the first mode on rigid chucks at unit ``EI`` and segment mass: the
+    Rayleigh damping's ``ω₁² = EI μ₁/(m/N)``)."""
+    import numpy as np  # not for checking a scene
+
+    from winder.model.beam import station_flexibility
+
+    y = (np.arange(n) + 0.5) * length / n
+    Ks = np.linalg.inv(station_flexibility(n, length, 1.0, None, math.inf))
+    Ks = 0.5 * (Ks + Ks.T)
+    U = np.column_stack([1.0 - y / length, y / length])
+    W = Ks @ U
+    return Ks, W, U.T @ W, float(np.linalg.eigvalsh(Ks)[0])
+
+
+def _deviation(values: list[Any]) -> list[Any]:
+    """Each value minus their mean."""
+    mean = sum(values) / len(values)
+    return [v - mean for v in values]
+
+
 class FlexBeam(ForceElement):
     """Bending (condensed beam, bearings, Rayleigh damping) and torsion of flexible
     bodies."""
@@ -86,13 +115,22 @@ class FlexBeam(ForceElement):
             segs.sort(key=lambda s: s.index)
             first = segs[0]
             flex, part, n = first.flex, first.part, len(segs)
-            if hasattr(flex, "core_EI"):  # a paper roll: EI(r), no bearings
+            if hasattr(flex, "core_EI"):  # a paper roll: EI(r), no bearings or chucks
                 unit = beam_matrices(n, first.length, float(n), 1.0, None, 0.0, 0.0, 0.0,
                                      flex.GJ)
+                K1, mu1 = unit.K, unit.omega1 ** 2
+                if first.bearing_axes:  # on chucks: K(EI) by Woodbury, module text
+                    K1, W, G, mu1 = _chuck_tables(n, first.length)
+                    for i in range(n):
+                        for e in range(2):
+                            machine.parameter(f"{body}.flex.W{e}_{i}", W[i, e])
+                    for a, b in ((0, 0), (0, 1), (1, 1)):
+                        machine.parameter(f"{body}.flex.G_{a}_{b}", G[a, b])
+                    machine.parameter(f"{body}.flex.chuck_stiffness", flex.chuck_stiffness)
                 for i in range(n):
                     for j in range(i, n):
-                        machine.parameter(f"{body}.flex.K1_{i}_{j}", unit.K[i, j])
-                machine.parameter(f"{body}.flex.mu1", unit.omega1 ** 2)
+                        machine.parameter(f"{body}.flex.K1_{i}_{j}", K1[i, j])
+                machine.parameter(f"{body}.flex.mu1", mu1)
                 machine.parameter(f"{body}.flex.damping_ratio", flex.damping_ratio)
                 machine.parameter(f"{body}.flex.core_EI", flex.core_EI)
                 machine.parameter(f"{body}.flex.paper_E", flex.paper_E)
@@ -144,13 +182,30 @@ class FlexBeam(ForceElement):
         beta = 2.0 * p(f"{body}.flex.damping_ratio") \
             / ev.mathns.sqrt(ei * p(f"{body}.flex.mu1") / states[0].mass)
         free = segs[0].free
+        chucks = bool(segs[0].bearing_axes)
+        vx, vz = [bs.vx for bs in states], [bs.vz for bs in states]
+        if not chucks:  # free–free: K₁ holds a common motion of the stations at zero
+            # force, but its row sums carry round-off; taken out here, that round-off
+            # (× EI) does not act on the roll's height or speed
+            ux, uz, vx, vz = (_deviation(u) for u in (ux, uz, vx, vz))
+        if chucks:  # (k_b I + EI G)⁻¹, 2 × 2
+            kb = p(f"{body}.flex.chuck_stiffness")
+            m00 = kb + ei * p(f"{body}.flex.G_0_0")
+            m11 = kb + ei * p(f"{body}.flex.G_1_1")
+            m01 = ei * p(f"{body}.flex.G_0_1")
+            det = m00 * m11 - m01 * m01
+            inv = ((m11 / det, -m01 / det), (-m01 / det, m00 / det))
+            w = [[p(f"{body}.flex.W{e}_{i}") for e in range(2)] for i in range(len(segs))]
         for i, seg in enumerate(segs):
             fx: Any = 0.0
             fz: Any = 0.0
-            for j, bs in enumerate(states):
+            for j in range(len(states)):
                 k = ei * p(f"{body}.flex.K1_{min(i, j)}_{max(i, j)}")
-                fx = fx - k * (ux[j] + beta * bs.vx)
-                fz = fz - k * (uz[j] + beta * bs.vz)
+                if chucks:
+                    k = k - ei * ei * sum(w[i][a] * inv[a][b] * w[j][b]
+                                          for a in range(2) for b in range(2))
+                fx = fx - k * (ux[j] + beta * vx[j])
+                fz = fz - k * (uz[j] + beta * vz[j])
             ev.add_force(seg.name, fx if "x" in free else 0.0, fz if "z" in free else 0.0)
         kt = p(f"{body}.flex.k_t")
         return kt, beta * kt

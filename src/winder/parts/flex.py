@@ -4,8 +4,9 @@ Euler–Bernoulli, condensed onto the segment centres: :mod:`winder.model.beam`)
 torsion spring between neighbours, held at its two ends by bearings.
 
 ``flex = { segments = N, EI = ..., kGA = ..., GJ = ... }`` on a ``[[drum]]`` or a
-``[[rider]]`` (which then needs its ``length``); without it the body is rigid, exactly as
-before."""
+``[[rider]]`` (which then needs its ``length``), ``flex = { segments = N, core_EI = ...,
+paper_E = ..., GJ = ... }`` on a wound ``[[roll]]`` (carried by its drums, or on chucks:
+``support = "chucks"``); without it the body is rigid, exactly as before."""
 
 from __future__ import annotations
 
@@ -17,8 +18,9 @@ from winder._schema import Key, Table
 __all__ = ["FlexPart", "FLEX_KEYS", "parse_flex", "MAX_SEGMENTS", "RollFlexPart",
            "ROLL_FLEX_KEYS", "parse_roll_flex", "ROLL_SUPPORTS"]
 
-#: How a flexible wound roll is carried: ``drums`` (by its nips, no bearings).
-ROLL_SUPPORTS = ("drums",)
+#: How a flexible wound roll is carried: ``drums`` (by its nips, no bearings) or ``chucks``
+#: (bearings at its core's ends, on its ``centre``).
+ROLL_SUPPORTS = ("drums", "chucks")
 
 #: The most segments a flexible body may have.
 MAX_SEGMENTS = 64
@@ -95,8 +97,11 @@ ROLL_FLEX_KEYS = Table((
     Key(name="GJ", required=True, unit="N·m²", lo=0.0, lo_open=True, hi=1e18,
         doc="torsional stiffness G·J; neighbouring segments are joined by GJ/(L/N)"),
     Key(name="support", kind="str", choices=ROLL_SUPPORTS,
-        doc="drums: carried by its nips, no bearings (free–free); chucks: not yet "
-            "(issue #25)"),
+        doc="drums: carried by its nips, no bearings (free–free); chucks: held at its "
+            "core's two ends by bearings on its centre, along its free axes"),
+    Key(name="chuck_stiffness", unit="N/m", lo=0.0, lo_open=True, hi=1e18,
+        default_text="1e9 with support = chucks",
+        doc="stiffness of each of the two chucks, per free axis (support = chucks only)"),
     FLEX_KEYS["damping_ratio"],
 ))
 
@@ -112,6 +117,7 @@ class RollFlexPart:
     paper_E: float
     GJ: float
     support: str = "drums"
+    chuck_stiffness: float = 1e9
     damping_ratio: float = 0.01
 
 
@@ -125,4 +131,9 @@ def parse_roll_flex(reader: Any, label: str, raw: Any) -> RollFlexPart:
         raise reader.fail(flabel, "segments", f"{n!r} is not an integer; valid: an integer, "
                                               f"2–{MAX_SEGMENTS}")
     kw["segments"] = int(n)
+    if "chuck_stiffness" in kw and kw.get("support", "drums") != "chucks":
+        raise reader.fail(flabel, "chuck_stiffness", "given, but support is not 'chucks' "
+                                                     "(a roll on its drums has no chucks); "
+                                                     "valid: support = 'chucks', or no "
+                                                     "chuck_stiffness")
     return RollFlexPart(**kw)

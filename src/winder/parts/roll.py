@@ -377,10 +377,14 @@ class RollSegment(RollBody):
     radius state ``NAME.radius`` and the parameters ``NAME.core_radius``, ``NAME.width``,
     ... (declared by segment 0); the radius grows with their mean speed,
     ``ṙ = h · mean(speed_i) / 2π``, and segment 0 holds the core mode ``NAME.core``.
-    Bending (``EI(r)``, no bearings) and torsion: the force element ``flex_beam``."""
+    Bending (``EI(r)``; no bearings, or chucks at the core's ends) and torsion: the force
+    element ``flex_beam``."""
 
-    #: no bearings: carried by its nips
-    bearing_axes: tuple[str, ...] = ()
+    @property
+    def bearing_axes(self) -> tuple[str, ...]:
+        """The axes its chucks hold (``support = "chucks"``: its free axes), else none:
+        carried by its nips."""
+        return tuple(self.free) if self.flex.support == "chucks" else ()
 
     def __init__(self, part: Any, index: int, placed: Any = None) -> None:
         super().__init__(part, placed)

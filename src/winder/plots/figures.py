@@ -499,7 +499,8 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
                     title: str = "", envelopes: dict[str, tuple[str, str]] | None = None,
                     colours: dict[str, str] | None = None) -> Path:
     """Resonance map (:class:`winder.ModeMap`): the bounce modes (one line per free
-    coordinate) and the slowest slip/torsion mode against the radius, the 1×/2×/3× roll
+    coordinate; a flexible machine: :meth:`~winder.ModeMap.shown`, its bending orders 1–2
+    and torsion order 1 too) and the slowest slip mode against the radius, the 1×/2×/3× roll
     rotation lines and the drums' rotation, every crossing of a harmonic with a bounce mode
     marked; with ``result``, the simulated normal-force envelopes below on the same radius
     axis (``envelopes``: label → (force channel, radius channel); default the single-drum
@@ -507,15 +508,20 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     when the labels are nip names, so that a nip has its colour of the run figures)."""
     mm = mode_map
     rows = 2 if result is not None else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(8, 4.2 * rows), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(rows, 1, figsize=(12, 6.5 * rows) if mm.flexible else (8, 4.2 * rows),
+                             sharex=True, squeeze=False)
     ax = axes[0, 0]
     r = mm.radius
     one = len(mm.coordinates) == 1
-    for i, c in enumerate(mm.coordinates):
-        f = mm.frequencies[c]
+    drawn = mm.shown() if mm.flexible else mm.coordinates  # flexible: orders 1-2, torsion 1
+    for i, c in enumerate(drawn):
+        f = mm.frequencies[c] if c in mm.frequencies else mm.torsion[c]
         colour = MODE_COLOURS[i % len(MODE_COLOURS)]
-        ax.plot(r, np.where(f > 0, f, np.nan), color=colour, lw=2,
-                label="bounce mode (damped)" if one else f"bounce mode {c} (damped)")
+        kind = "torsion" if c in mm.torsion else "bending" if ".bend." in c else "bounce"
+        ax.plot(r, np.where(f > 0, f, np.nan), color=colour, lw=2 if kind == "bounce" else 1.5,
+                ls="-" if kind != "torsion" else (0, (5, 1)),
+                label="bounce mode (damped)" if one else f"{kind} mode {c} "
+                + ("|λ|/2π" if kind == "torsion" else "(damped)"))
         if np.any(f == 0):  # overdamped (real eigenvalue): a bar along the bottom
             ax.plot(r, np.where(f == 0, 0.02 + 0.025 * i, np.nan), color=colour, lw=4,
                     solid_capstyle="butt", transform=ax.get_xaxis_transform(),
@@ -530,17 +536,19 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
                     label=f"{name[:-1]}× roll rotation at {mm.web_speed:g} m/s")
         else:
             ax.plot(r, line, "-.", color="0.45", lw=1, label=f"{name} rotation")
+    shown = [mm.frequencies[c] if c in mm.frequencies else mm.torsion[c] for c in drawn]
     values = np.concatenate([f[np.isfinite(f) & (f > 0)]
-                             for f in (*mm.frequencies.values(), *harmonics.values())])
+                             for f in (*shown, *harmonics.values())])
     log = values.size > 0 and values.max() / values.min() > 30
     if log:
         ax.set_yscale("log")
         ax.set_ylim(max(values.min() * 0.7, 0.1), values.max() * 1.5)
     else:
         ax.set_ylim(0, float(np.nanmax(mm.bounce_frequency)) * 1.1)
-    crossings = mm.crossings()
+    crossings = mm.crossings(drawn)
     for c, h, rc in crossings:
-        f = float(np.interp(rc, r, mm.frequencies[c]))
+        f = float(np.interp(rc, r, mm.frequencies[c] if c in mm.frequencies
+                            else mm.torsion[c]))
         ax.plot([rc], [f], "o", color="C3", ms=5, mfc="none", mew=1.2)
         if one:
             ax.axvline(rc, color="C3", lw=0.8, alpha=0.7)
@@ -552,7 +560,10 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     if crossings and not one:
         ax.plot([], [], "o", color="C3", mfc="none", label="crossing (critical radius)")
     ax.set_ylabel("frequency [Hz]")
-    ax.legend(fontsize=8 if one else 7, loc="upper right")
+    if mm.flexible:  # many modes: the legend beside the chart
+        ax.legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    else:
+        ax.legend(fontsize=8 if one else 7, loc="upper right")
     ax.grid(alpha=0.3, which="both" if log else "major")
     ax.set_title(_label(title, 120) or "Resonance map (Campbell chart)")
     if result is not None:

@@ -134,7 +134,10 @@ def resting_state(machine: Machine, x: np.ndarray, p: np.ndarray, movable: set[s
     """
     be = be or NumericBackend(machine.model)
     x = np.array(x, dtype=float)
-    order = [b for b in machine.bodies if b.name in movable and b.free]
+    # a body held along all its free axes by bearings (a roll on chucks) is not placed on
+    # the bodies below it: it starts on its bearings' line, the balance finds its sag
+    order = [b for b in machine.bodies if b.name in movable and b.free
+             and not set(b.free) <= set(getattr(b, "bearing_axes", ()))]
     rank = {b.name: i for i, b in enumerate(machine.bodies)}
     placed0 = {b.name for b in machine.bodies if b.name not in movable or not b.free}
     supports = {b.name: [n for n in machine.nips if n.b is b and _whole(machine, n) and
