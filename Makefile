@@ -102,6 +102,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/cli_speed.py
 	$(PY) benchmarks/sweep_scaling.py
 	$(PY) benchmarks/flex_speed.py
+	$(PY) benchmarks/flex_cycle.py
 
 # Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
 peers: $(STAMP)

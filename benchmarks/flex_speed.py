@@ -4,7 +4,7 @@ docs/flex_speed.md and .json).
 The single-drum winder with a flexible drum of N segments (the roll rigid on it, the nip
 sliced): N = 1 is the rigid drum. For each N: the time to generate and compile its code
 into an empty cache, the generated right-hand side and exact Jacobian called the way the
-compiled integrators call them (numba, through the function address), and the numeric
+compiled integrators call them (the C loop of the machine's library), and the numeric
 Pinocchio path (``MachineSystem(scene, backend="pinocchio").rhs``). Best of repeats (the
 machine may be loaded).
 
@@ -126,7 +126,7 @@ def main() -> None:
     lines = ["# Flexible drum: cost per evaluation and compile time", "",
              "`python benchmarks/flex_speed.py`: the single-drum winder with a flexible "
              "drum of N segments (N = 1: rigid), its nip sliced; generated code called "
-             "through its address (numba), the numeric Pinocchio path from Python; best "
+             "in the C loop of its library, the numeric Pinocchio path from Python; best "
              "of repeats on a shared 2-core machine.", "",
              "| N | states | compile [s] | rhs [µs] | Jacobian [µs] | numeric rhs [µs] |",
              "|---|---|---|---|---|---|"]
