@@ -453,8 +453,8 @@ def _build_parser() -> argparse.ArgumentParser:
     view.add_argument("--playback", type=_PLAYBACK, default=30.0,
                       help="playback length of the whole run [s] (0 < x <= 3600, default 30)")
     view.set_defaults(func=_cmd_view)
-    fmu = sub.add_parser("fmu", help="export a scene as a native FMI 2.0 FMU (co-simulation "
-                         "and model exchange)")
+    fmu = sub.add_parser("fmu", help="export a scene as a native FMU, FMI 2.0 or 3.0 "
+                         "(co-simulation and model exchange)")
     fmu.add_argument("scene", help="scene file (TOML)")
     fmu.add_argument("-o", "--out", default="winder.fmu", help="FMU file (default winder.fmu)")
     fmu.add_argument("--check", action=argparse.BooleanOptionalAction, default=True,

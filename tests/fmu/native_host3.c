@@ -1,8 +1,11 @@
 /* A plain C FMI 3.0 co-simulation host for the native FMU's tests (no FMPy, no Python):
- *   native_host3 MODEL.so TOKEN CYCLES VR
+ *   native_host3 MODEL.so TOKEN CYCLES VR VR_TIME
  * dlopens the binary once, then CYCLES times instantiates, initialises, does 10 steps of
- * 10 ms, takes, serialises and frees an FMU state, reads the Float64 VR, terminates and
- * frees; prints the cycles and whether VR was the same every time. Built with
+ * 10 ms, takes, serialises and frees an FMU state, reads the Float64 VR, misuses it twice
+ * (a step that does not start where the last ended: refused in the FMI 2.0 core and logged
+ * through the wrapper's relay; a Float64 that cannot be set: refused by the wrapper),
+ * terminates and frees; prints the cycles, whether VR was the same every time and the
+ * messages logged. Built with
  * -fsanitize=address,undefined by tests/fmu/test_fmi3.py. */
 
 #include <dlfcn.h>
@@ -11,10 +14,14 @@
 
 #include "fmi3Functions.h"
 
+static int logged = 0;
+
+/* counts the messages (each cycle's deliberate misuse logs two), prints the first ones */
 static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category,
                    fmi3String message) {
     (void)env;
-    fprintf(stderr, "[%d|%s] %s\n", (int)status, category, message);
+    if (logged++ < 2)
+        fprintf(stderr, "[%d|%s] %s\n", (int)status, category, message);
 }
 
 #define LOAD(name)                                                     \
@@ -25,8 +32,8 @@ static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String ca
     }
 
 int main(int argc, char** argv) {
-    if (argc < 5) {
-        fprintf(stderr, "usage: %s MODEL.so TOKEN CYCLES VR\n", argv[0]);
+    if (argc < 6) {
+        fprintf(stderr, "usage: %s MODEL.so TOKEN CYCLES VR VR_TIME\n", argv[0]);
         return 2;
     }
     int cycles = atoi(argv[3]);
@@ -41,6 +48,7 @@ int main(int argc, char** argv) {
     LOAD(fmi3ExitInitializationMode)
     LOAD(fmi3DoStep)
     LOAD(fmi3GetFloat64)
+    LOAD(fmi3SetFloat64)
     LOAD(fmi3GetFMUState)
     LOAD(fmi3SerializedFMUStateSize)
     LOAD(fmi3SerializeFMUState)
@@ -83,10 +91,17 @@ int main(int argc, char** argv) {
         if (c == 0)
             first = v;
         same = same && v == first;
+        fmi3Boolean event, terminate, early;
+        fmi3Float64 last;
+        fmi3ValueReference bad = (fmi3ValueReference)atoi(argv[5]);
+        if (fmi3DoStep(s, 99.0, 0.01, fmi3True, &event, &terminate, &early, &last) != fmi3Error
+            || fmi3SetFloat64(s, &bad, 1, &v, 1) != fmi3Error)
+            return 1;
         fmi3Terminate(s);
         fmi3FreeInstance(s);
     }
     dlclose(lib);
-    printf("%d cycles, %s radius %.17g\n", cycles, same ? "same" : "different", first);
+    printf("%d cycles, %s radius %.17g, %d messages\n", cycles, same ? "same" : "different",
+           first, logged);
     return 0;
 }

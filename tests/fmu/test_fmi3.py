@@ -9,6 +9,7 @@ import shutil
 import subprocess
 import sys
 import zipfile
+from ctypes import POINTER, byref, c_bool, c_double, c_void_p
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -244,8 +245,9 @@ def test_directional_derivatives_equal_fmi2(fmus) -> None:
 
 def test_run_out_terminates(fmus, tmp_path, models_dir) -> None:
     """The winder line with 0.2 mm of paper on its parent: fmi3DoStep returns fmi3Discard
-    with terminateSimulation and lastSuccessfulTime at the run-out, which equals the FMI 2.0
-    FMU's (the core's) and the in-process Stepper's, with the reason logged."""
+    at the run-out, with the outputs and ``time`` there, equal to the in-process Stepper's,
+    and the reason logged; a further step returns fmi3Discard with terminateSimulation
+    and lastSuccessfulTime at the run-out."""
     import tomli_w
     from fmpy.fmi1 import FMICallException
 
@@ -268,6 +270,15 @@ def test_run_out_terminates(fmus, tmp_path, models_dir) -> None:
         assert t == sim.t and 2.6 < t < 2.75
         assert s.get(["time"])[0] == t
         assert s.get(["parent_radius"])[0] == pytest.approx(0.4, abs=1e-9)
+        # the next step, called directly (FMPy raises on fmi3Discard): its outputs say so
+        step = s.fmu.dll.fmi3DoStep
+        step.argtypes = [c_void_p, c_double, c_double, c_bool, *[POINTER(c_bool)] * 3,
+                         POINTER(c_double)]
+        event, terminate, early, last = c_bool(True), c_bool(False), c_bool(True), c_double()
+        status = step(s.fmu.component, t, 0.01, True, byref(event), byref(terminate),
+                      byref(early), byref(last))
+        assert (status, terminate.value, event.value, early.value, last.value) == \
+            (2, True, False, False, t)
     finally:
         s.close()
     assert any("'parent' ran out of web" in line for line in s.log), s.log
@@ -276,8 +287,9 @@ def test_run_out_terminates(fmus, tmp_path, models_dir) -> None:
 def test_c_host_under_asan(tmp_path, models_dir) -> None:
     """A C host of the FMI 3.0 interface (tests/fmu/native_host3.c: dlopen, no FMPy)
     compiled with -fsanitize=address,undefined instantiates, steps, takes and serialises an
-    FMU state, and frees a sanitized build of the two-drum FMU 300 times: exit 0, no
-    sanitizer report, the same radius every time."""
+    FMU state, misuses it twice (each refusal logged: through the wrapper's relay and by
+    the wrapper) and frees a sanitized build of the two-drum FMU 300 times: exit 0, no
+    sanitizer report, the same radius every time, 600 messages."""
     cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
         pytest.skip("no C compiler")
@@ -290,13 +302,15 @@ def test_c_host_under_asan(tmp_path, models_dir) -> None:
                     "-g", "-I", str(Path(fmpy.__file__).parent / "c-code"),
                     str(Path(__file__).with_name("native_host3.c")), "-o", str(host), "-ldl"],
                    check=True, capture_output=True)
-    radius = {v.name: v.valueReference for v in md.modelVariables}["set_radius"]
-    proc = subprocess.run([str(host), str(so), md.guid, "300", str(radius)],
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    proc = subprocess.run([str(host), str(so), md.guid, "300", str(refs["set_radius"]),
+                           str(refs["time"])],
                           capture_output=True, text=True, timeout=600,
                           env={"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0"})
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "Sanitizer" not in proc.stderr and "runtime error" not in proc.stderr
-    assert "300 cycles, same radius" in proc.stdout, proc.stdout
+    assert "300 cycles, same radius" in proc.stdout and "600 messages" in proc.stdout, \
+        proc.stdout
 
 
 def test_fmpy_compile_rebuilds_it(fmus, tmp_path) -> None:

@@ -332,7 +332,7 @@ def test_directional_derivatives(two_drum_fmu, models_dir) -> None:
 # ---- the run-out of an unwinding roll -----------------------------------------------------
 
 def test_run_out_discards(tmp_path, models_dir) -> None:
-    """A parent with 0.2 mm of paper runs out near 2.686 s (test_fmu.py's case): the
+    """A parent with 0.2 mm of paper runs out near 2.686 s: the
     step returns fmi2Discard with the reason logged, the outputs at the run-out time,
     fmi2LastSuccessfulTime there, and every later step discards too."""
     import tomli_w

@@ -31,9 +31,9 @@ def model_description(iface: NativeInterface, model: str, guid: str, scene: Scen
 
 
 def build_description(model: str, sources: list[str]) -> bytes:
-    """FMI 3.0 ``sources/buildDescription.xml``: the C files to compile (C99; the
-    integrators with ``-ffp-contract=off`` where the compiler takes it, for the same
-    numbers as winder's own build) and libm."""
+    """FMI 3.0 ``sources/buildDescription.xml``: the C files to compile (C99) and libm.
+    It carries no compiler options: a rebuild (``fmpy compile``) uses its tool's flags, so
+    its numbers may differ from winder's build (``-ffp-contract=off``) by round-off."""
     root = ET.Element("fmiBuildDescription", {"fmiVersion": "3.0"})
     conf = ET.SubElement(root, "BuildConfiguration", {"modelIdentifier": model})
     files = ET.SubElement(conf, "SourceFileSet", {"language": "C99"})

@@ -246,5 +246,7 @@ def _indicators(system: MachineSystem) -> list[tuple[int, int]]:
         pairs = ((g1, 1), (g2, -1)) if kind == ModeKind.CORE else \
             ((g1, 1 if kind == ModeKind.END else -1),)
         for g, side in pairs:
-            out.setdefault(int(g), side)
+            if out.setdefault(int(g), side) != side:
+                raise FmuError(f"switching function {system.machine.switch_names[g]!r} "
+                               "is a contact's and a core's: its zero has no one side")
     return list(out.items())

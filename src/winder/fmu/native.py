@@ -119,7 +119,10 @@ def _compile(sources: Path, model: str, out: Path, symbol: str, wrappers: tuple[
         run_compiler([*flags, "-I", str(sources), "-c", str(sources / src), "-o", str(obj)],
                      src)
         objs.append(str(obj))
-    link = ["-shared", *(SANITIZE_CFLAGS if sanitize else ["-Wl,--no-undefined"])]
+    # -Bsymbolic: the wrappers' calls into fmi2.c (FMI 3.0 calls the fmi2 functions) bind
+    # inside this library, never to another FMU's fmi2Instantiate loaded before it
+    link = ["-shared", "-Wl,-Bsymbolic",
+            *(SANITIZE_CFLAGS if sanitize else ["-Wl,--no-undefined"])]
     run_compiler([*link, *objs, "-o", str(out), "-lm"], f"{model}.so")
 
 

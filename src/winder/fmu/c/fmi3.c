@@ -167,6 +167,8 @@ fmi3Status fmi3Reset(fmi3Instance instance) { return st3(fmi2Reset(((Inst*)insta
 
 /* ---- variables ----------------------------------------------------------------------- */
 
+/* the Reals of FMI 2.0 in one fmi2GetReal call per contiguous run (its derivatives are
+ * evaluated once per call), then the time and the event indicators */
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                           fmi3Float64 values[], size_t nValues) {
     Inst* in = instance;
@@ -174,18 +176,23 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
     int have_z = 0;
     if (nValues != nvr)
         return refuse(in, "fmi3GetFloat64: one value per value reference");
-    for (size_t i = 0; i < nvr; i++) {
+    for (size_t i = 0; i < nvr;) {
         fmi2Status s = fmi2OK;
-        if (vr[i] < VR_END) {
-            s = fmi2GetReal(in->c2, &vr[i], 1, &values[i]);
+        size_t run = 0;
+        while (i + run < nvr && vr[i + run] < VR_END)
+            run++;
+        if (run) {
+            s = fmi2GetReal(in->c2, &vr[i], run, &values[i]);
+            i += run;
         } else if (vr[i] == VR_TIME) {
-            s = fmi2GetRealStatus(in->c2, fmi2LastSuccessfulTime, &values[i]);
+            s = fmi2GetRealStatus(in->c2, fmi2LastSuccessfulTime, &values[i++]);
         } else if (vr[i] < VR_Z + W_NZ) {
             if (!have_z) {
                 s = fmi2GetEventIndicators(in->c2, z, W_NZ);
                 have_z = 1;
             }
             values[i] = z[vr[i] - VR_Z];
+            i++;
         } else {
             return refuse(in, "fmi3GetFloat64: not a Float64 value reference");
         }
