@@ -122,14 +122,15 @@ def save_plant(plant: Any, path: str | os.PathLike) -> Path:
     from winder.io.files import atomic_write
 
     path = Path(path)
-    if path.suffix not in PLANT_SUFFIXES:
+    suffix = path.suffix.lower()
+    if suffix not in PLANT_SUFFIXES:
         raise ArgumentError(f"save_plant: {str(path)!r} must end in "
                             f"{' or '.join(PLANT_SUFFIXES)}")
     op = plant.operating_point
     units = plant.units
 
     def names(labels: Sequence[str]) -> np.ndarray:
-        return np.array(list(labels), dtype=object if path.suffix == ".mat" else str)
+        return np.array(list(labels), dtype=object if suffix == ".mat" else str)
 
     data = {"A": np.asarray(plant.A), "B": np.asarray(plant.B), "C": np.asarray(plant.C),
             "D": np.asarray(plant.D),
@@ -145,7 +146,7 @@ def save_plant(plant: Any, path: str | os.PathLike) -> Path:
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as fh:
-            if path.suffix == ".mat":
+            if suffix == ".mat":
                 from scipy.io import savemat
 
                 savemat(fh, data)
