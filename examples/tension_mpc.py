@@ -6,7 +6,7 @@ The plant is the full nonlinear small winder line with its parent torque-driven
 2 m/s². Every ``--dt`` the MPC reads the state and solves, with CasADi's own SQP method
 and QP solver (``sqpmethod``, ``qrqp``), over a horizon of ``--horizon`` steps::
 
-    min  Σ_k ((T_k − T*) / 1 N)² + ((τ_k − τ_{k−1}) / 10 N·m)²
+    min  Σ_k ((T_k − T*) / 1 N)² + ((τ_k − τ_{k−1}) / s_τ)²     (s_τ = --move-scale, 300 N·m)
     s.t. (ω_k+1, T_k+1) = RK4 of f(x, τ_k, p) + d on (parent.theta_dot, span.tension)
 
 where ``f`` is :func:`winder.casadi_model`'s right-hand side of the same machine: the two
@@ -25,8 +25,8 @@ both over the ramp are printed and drawn.
 
 Writes ``tension_mpc.png`` to ``--out``.
 
-    python examples/tension_mpc.py [--t-end 21] [--dt 0.01] [--horizon 20] [--out out]
-                                   [--quick]
+    python examples/tension_mpc.py [--t-end 21] [--dt 0.01] [--horizon 20]
+                                   [--move-scale 300] [--out out] [--quick]
 """
 
 from __future__ import annotations
@@ -45,9 +45,11 @@ PREDICTED = ("parent.theta_dot", "span.tension")
 
 class TensionMPC:
     """The MPC of the module text on ``model`` (:func:`winder.casadi_model` with the input
-    ``parent_torque``), set-point ``tension`` [N], step ``dt`` [s], ``horizon`` steps."""
+    ``parent_torque``), set-point ``tension`` [N], step ``dt`` [s], ``horizon`` steps,
+    torque moves weighed against ``move_scale`` [N·m] per 1 N of tension error."""
 
-    def __init__(self, model, tension: float, dt: float, horizon: int) -> None:
+    def __init__(self, model, tension: float, dt: float, horizon: int,
+                 move_scale: float = 300.0) -> None:
         import casadi as ca
 
         self.model, self.dt, self.N = model, dt, horizon
@@ -86,7 +88,7 @@ class TensionMPC:
             k4 = F(zk + dt * k3, uk, xm_, xr_, (k + 1) * dt, p1) + self.bias
             opti.subject_to(Z[:, k + 1] == zk + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4))
             before = self.u_prev if k == 0 else U[:, k - 1]
-            cost += (Z[1, k + 1] - tension) ** 2 + ((uk - before) / 10.0) ** 2
+            cost += (Z[1, k + 1] - tension) ** 2 + ((uk - before) / move_scale) ** 2
         opti.minimize(cost)
         opti.solver("sqpmethod", {"qpsol": "qrqp", "print_header": False,
                                   "print_iteration": False, "print_time": False,
@@ -131,6 +133,10 @@ def main() -> None:
                     help="end time [s] (default 21: the drums' ramp to 41.7 m/s, 20.85 s)")
     ap.add_argument("--dt", type=float, default=0.01, help="MPC step [s] (default 0.01)")
     ap.add_argument("--horizon", type=int, default=20, help="steps (default 20)")
+    ap.add_argument("--move-scale", type=float, default=300.0,
+                    help="torque move [N·m] that costs as much as 1 N of tension error "
+                    "(default 300; smaller: a smoother torque, a larger error where the "
+                    "ramp ends)")
     ap.add_argument("--out", default="out", help="output directory (default out)")
     ap.add_argument("--quick", action="store_true", help="the first 2 s (for the tests)")
     args = ap.parse_args()
@@ -146,7 +152,7 @@ def main() -> None:
     t0 = time.perf_counter()
     model = winder.casadi_model(PLANT, inputs=["parent_torque"], outputs=["span_tension"])
     t_model = time.perf_counter() - t0
-    mpc = TensionMPC(model, tension, args.dt, args.horizon)
+    mpc = TensionMPC(model, tension, args.dt, args.horizon, args.move_scale)
     t_build = time.perf_counter() - t0 - t_model
     sim = winder.Stepper(PLANT)
     u = 0.0
