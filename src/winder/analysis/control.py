@@ -94,7 +94,7 @@ def _names(where: str, what: str, given: Any, valid: Sequence[str]) -> list[str]
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CasadiModel:
     """A machine's dynamics as CasADi Functions, in the contact-closed mode.
 
