@@ -55,6 +55,8 @@ demo: $(STAMP) pin-casadi chromium
 	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/fmu/two_drum_winder_fmi3.fmu --fmi-version 3
 	$(PY) examples/tension_control_fmu.py --fmu $(OUT)/fmu/winder_line_fmu.fmu --out $(OUT)
 	$(PY) examples/speed_control_fmu.py --out $(OUT)
+	$(PY) examples/tension_loop_design.py --out $(OUT)
+	$(PY) examples/tension_mpc.py --out $(OUT)
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/two_drum_winder.npz --html $(OUT)/two_drum_winder.html --snapshots $(OUT)/snapshots_two_drum --every 100
 	$(PY) -m winder modes models/two_drum_winder.toml --plot $(OUT)/plots/two_drum_modes.png --csv $(OUT)/two_drum_modes.csv

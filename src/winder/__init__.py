@@ -21,6 +21,8 @@ from winder._errors import (
 _LAZY = {
     **dict.fromkeys(("build_fmu",), ".fmu.native"),
     **dict.fromkeys(("jacobian",), ".analysis.linearise"),
+    **dict.fromkeys(("casadi_model", "CasadiModel"), ".analysis.control"),
+    **dict.fromkeys(("linearise",), ".analysis.plant"),
     **dict.fromkeys(("FunctionMassLaw", "MassLaw", "MassProperties", "PaperRollLaw"),
                     ".model.mass_law"),
     **dict.fromkeys(("Mode", "ModeMap", "mode_map", "modes_at"), ".analysis.modes"),
@@ -39,8 +41,10 @@ _LAZY = {
 }
 
 if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
+    from winder.analysis.control import CasadiModel, casadi_model
     from winder.analysis.linearise import jacobian
     from winder.analysis.modes import Mode, ModeMap, mode_map, modes_at
+    from winder.analysis.plant import linearise
     from winder.analysis.sweep import sweep
     from winder.analysis.sweep_table import SweepTable
     from winder.fmu.native import build_fmu
@@ -88,7 +92,10 @@ __all__ = [
     "Scene",
     "Stepper",
     "build_fmu",
+    "CasadiModel",
+    "casadi_model",
     "jacobian",
+    "linearise",
     "load_result",
     "load_scene",
     "mode_map",
