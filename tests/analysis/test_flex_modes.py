@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import tomllib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -210,3 +211,35 @@ def test_twin_flexible_drums_each_have_their_torsion1() -> None:
         assert m.kind == "torsion" and 0.0 < m.damping_ratio < 0.2
         assert abs(m.natural_frequency / want - 1) < 9e-2, (drum, m.natural_frequency, want)
     assert ms["front.bend.z1"].kind == "bending" and ms["set.bend.z1"].kind == "bending"
+
+
+def test_free_flexible_bodies_add_no_zero_root() -> None:
+    """The shipped flexible two-drum winder: a free flexible body's first segment angle
+    (the set's, the rider's) is its reference, slow like a rigid body's angle, its other
+    segments' angles the twists ``θ_i − θ_0`` (``fast_jacobian``), so no eigenvalue of the
+    fast states is an exact zero (with ``θ_0`` among them: two roots of 1e-12–1e-11 1/s,
+    1e-17 of the largest, labelled as slip or torsion modes; measured smallest |λ| /
+    largest now: 5.4e-5 at r = 0.05 m, 4.3e-3 at 0.3 m). Identity: the eigenvalues are
+    those of all the angles absolute, ``θ_0`` fast, but its zero roots (measured 2.6e-14
+    of the largest); without the twist rows (``θ_0`` merely dropped) the rider's torsion
+    falls from 235 to 16 Hz and this fails."""
+    from winder.analysis.operating_point import _linearisation
+
+    scene = winder.load_scene(Path(__file__).resolve().parents[2] / "models"
+                              / "two_drum_winder_flexible.toml")
+    for r in (0.05, 0.3):
+        lam = np.abs([m.eigenvalue for m in winder.modes_at(scene, r)])
+        assert lam.min() > 1e-6 * lam.max(), (r, np.sort(lam)[:3])
+    lin = _linearisation(scene, "test", None, lo_open=False)
+    y = lin.solve(0.3, "test")
+    refs = sorted({ref for ref, _ in lin.twists.values() if ref is not None})
+    assert len(refs) == 2  # the set's and the rider's θ_0
+    fast = lin.fast + refs
+    everything = np.linalg.eigvals(winder.jacobian(lin.system, lin.t, y)[np.ix_(fast, fast)])
+    top = np.max(np.abs(everything))
+    nonzero = everything[np.abs(everything) > 1e-9 * top]
+    assert len(everything) - len(nonzero) == len(refs)
+    got = np.linalg.eigvals(lin.fast_jacobian(y))
+    key = lambda z: (round(z.real, 3), round(z.imag, 3))  # noqa: E731
+    assert np.max(np.abs(np.array(sorted(got, key=key)) - np.array(sorted(nonzero, key=key)))
+                  ) < 3e-13 * top

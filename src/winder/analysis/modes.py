@@ -183,7 +183,10 @@ class ModeMap:
         frequency changes by less than 25 % between the two radii."""
         line = self.harmonics()[f"{order}x" if isinstance(order, int) else order]
         mode = mode or self.main
-        f = self.frequencies[mode] if mode in self.frequencies else self.torsion[mode]
+        if mode in self.frequencies:
+            f = self.frequencies[mode]
+        else:  # a torsion mode's |λ|/2π: not where it is overdamped (a real root)
+            f = np.where(self.torsion_damping[mode] < 1.0, self.torsion[mode], np.nan)
         d = f - line
         out = []
         # a crossing of an oscillating mode whose frequency moves continuously (less than

@@ -185,14 +185,17 @@ class _Linearisation:
         self.labels = self.shapes.labels
         # a flexible body's segment angles are elastic (its twist): fast, and in the
         # balance the twist that carries the torques, turning with the body: θ̇_i = Ω (the
-        # drive's speed) on a driven body, θ̇_i = θ̇_0 on a free one (θ_0 its reference)
+        # drive's speed) on a driven body, θ̇_i = θ̇_0 on a free one (θ_0 its reference:
+        # slow, as a rigid body's angle, its segments' θ_i, i ≥ 1, standing for the twists
+        # θ_i − θ_0 in the fast states: see fast_jacobian; the forces see only the
+        # differences, so θ_0 among the fast states would add an exact zero eigenvalue)
         self.angles: list[int] = []
         self.twists: dict[int, tuple[int | None, float]] = {}  # θ_i -> (θ_0, or None: Ω)
         for whole in dict.fromkeys(b.segment_of for b in m.bodies if b.segment_of):
             segs = [b for b in m.bodies if b.segment_of == whole]
             drive = next((b for b in segs if b.prescribed), None)
             turning = [m.index(f"{b.name}.theta") for b in segs if not b.prescribed]
-            self.angles += turning
+            self.angles += turning if drive is not None else turning[1:]
             for i in turning if drive is not None else turning[1:]:
                 self.twists[i] = (None, drive.sense * drive.operating_speed(v)) \
                     if drive is not None else (turning[0], 0.0)
@@ -484,6 +487,20 @@ class _Linearisation:
                            f"saturated at mu F_n = {n.part.friction.mu * fn:.4g} N")
         return "".join(out)
 
+    def fast_jacobian(self, y: np.ndarray) -> np.ndarray:
+        """The exact Jacobian on the fast states (:attr:`fast`) at ``y``. A free flexible
+        body's segment angle ``θ_i`` (i ≥ 1) stands for its twist ``θ_i − θ_0`` (``θ_0``
+        slow): its row is ``d(θ_i − θ_0)/dt``, the rows of ``θ_i`` and ``θ_0`` subtracted
+        (the columns are already the twist's: the forces depend on angle differences
+        only)."""
+        J = jacobian(self.system, self.t, y)
+        rows = J[self.fast]
+        at = {i: k for k, i in enumerate(self.fast)}
+        for i, (ref, _) in self.twists.items():
+            if ref is not None:
+                rows[at[i]] -= J[ref]
+        return rows[:, self.fast]
+
     # ---- the modes ----------------------------------------------------------------------
     def modes(self, y: np.ndarray) -> list[Mode]:
         """Bounce modes (in the order of the generalised coordinates :attr:`labels`: a
@@ -492,7 +509,7 @@ class _Linearisation:
         point ``y``."""
         from scipy.optimize import linear_sum_assignment
 
-        A = jacobian(self.system, self.t, y)[np.ix_(self.fast, self.fast)]
+        A = self.fast_jacobian(y)
         lam, vec = np.linalg.eig(A)
         nt, ns = len(self.positions), len(self.speeds)
         keep = [i for i in range(len(lam)) if lam[i].imag >= 0.0]  # one of each pair

@@ -16,7 +16,9 @@ contact-closed); no finite differences.
 positions and velocities, the rotation speeds of the free bodies, the friction, span
 tension and controller states. The angles (pure integrals of the speeds, which nothing
 else sees with the imbalance off) and the rolls' radii (growing over minutes, a caliper
-per turn) are frozen at the operating point: the model is the plant at one diameter,
+per turn) are frozen at the operating point (a flexible body's segment angles are its
+twists, fast; a free one's first segment angle is its reference, frozen, and its other
+segments' angles stand for their twists from it): the model is the plant at one diameter,
 and a map over the radius is the gain-scheduling family. So its poles are exactly the
 eigenvalues ``winder modes`` reports (:func:`winder.modes_at`), and a state with no
 dynamics there (a friction state without relaxation) is left out, as there.
@@ -34,7 +36,6 @@ import numpy as np
 
 from winder._errors import ArgumentError
 from winder.analysis.control import _as_scene, model_of
-from winder.analysis.linearise import jacobian
 from winder.analysis.operating_point import _linearisation, _radius
 from winder.scene.load import Scene
 
@@ -51,7 +52,7 @@ def linearise(scene: Scene | str | os.PathLike, radius: float, *,
     wound roll and ``web_speed`` [m/s] (default the scene's), about the operating point of
     ``winder modes`` (module docstring: the fast states, exact derivatives).
 
-    ``inputs``: names among the scene's plant inputs (default all): ``DRUM_torque`` [N·m]
+    ``inputs``: names among the scene's plant inputs (default all): ``ROLL_torque`` [N·m]
     per torque-driven unwinding roll, ``ROLL_tension_setpoint`` [N], ``DRUM_web_speed``
     [m/s] per speed-profile drum (a perturbation of its speed). ``outputs``: result
     channels as the scene names them (default all).
@@ -78,7 +79,7 @@ def linearise(scene: Scene | str | os.PathLike, radius: float, *,
     system, t = lin.system, lin.t
     model = model_of(system, inputs=inputs, outputs=outputs, where=where, x0=y)
     fast = list(lin.fast)
-    A = jacobian(system, t, y)[np.ix_(fast, fast)]
+    A = lin.fast_jacobian(y)  # a free flexible body's angles: its twists
     x, u, p = (ca.SX.sym(n, k) for n, k in (("x", model.n_states),
                                             ("u", len(model.input_names)),
                                             ("p", len(model.param_names))))
@@ -98,13 +99,15 @@ def linearise(scene: Scene | str | os.PathLike, radius: float, *,
                    **dict(zip(model.output_names, model.output_units, strict=True))}
     plant.operating_point = {"radius": r, "web_speed": lin.v, "t": t, "x": y.copy(),
                              "state_names": model.state_names, "u": model.u0.copy(),
-                             "y": y0.ravel().copy()}
+                             "y": y0.ravel().copy(), "p": np.asarray(p0, dtype=float).copy(),
+                             "param_names": model.param_names}
     return plant
 
 
 def poles_with_damping(plant: Any) -> list[tuple[complex, float, float]]:
     """``(pole, natural frequency [Hz], damping ratio)`` of each pole of ``plant`` (one of
-    each complex pair, its positive imaginary part), slowest first."""
+    each complex pair, its positive imaginary part), slowest first. A pole in the right
+    half-plane has a negative damping ratio (−1 for a positive real pole)."""
     lam = np.linalg.eigvals(np.asarray(plant.A)) if plant.nstates else np.empty(0)
     out = []
     for v in sorted((complex(v) for v in lam if v.imag >= 0.0), key=lambda v: (abs(v), v.real)):
@@ -118,7 +121,8 @@ def save_plant(plant: Any, path: str | os.PathLike) -> Path:
     or ``.mat`` (MATLAB, scipy's ``savemat``): ``A``, ``B``, ``C``, ``D``, the names of
     the ``states``, ``inputs`` and ``outputs`` with their units (``state_units``, ...),
     the ``poles``, and the operating point (``radius`` [m], ``web_speed`` [m/s], ``x_op``
-    over ``x_op_names``, ``u_op``, ``y_op``)."""
+    over ``x_op_names``, ``u_op``, ``y_op``, and ``p_op`` over ``p_op_names``: the
+    parameters ``casadi_model``'s ``f`` and ``h`` take there, drums at full speed)."""
     from winder.io.files import atomic_write
 
     path = Path(path)
@@ -142,7 +146,7 @@ def save_plant(plant: Any, path: str | os.PathLike) -> Path:
             "poles": np.linalg.eigvals(np.asarray(plant.A)),
             "radius": float(op["radius"]), "web_speed": float(op["web_speed"]),
             "x_op": op["x"], "x_op_names": names(op["state_names"]), "u_op": op["u"],
-            "y_op": op["y"]}
+            "y_op": op["y"], "p_op": op["p"], "p_op_names": names(op["param_names"])}
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as fh:

@@ -29,8 +29,8 @@ def add_parser(sub: Any, positive: Callable[[str], Any]) -> None:
     p.add_argument("--web-speed", type=positive, metavar="V",
                    help="operating web speed [m/s] (default: the scene's)")
     p.add_argument("--input", action="append", metavar="NAME",
-                   help="an input (repeat; default all): DRUM_torque, ROLL_tension_setpoint, "
-                   "DRUM_web_speed")
+                   help="an input (repeat; default all): ROLL_torque (an unwind's), "
+                   "ROLL_tension_setpoint, DRUM_web_speed")
     p.add_argument("--output", action="append", metavar="NAME",
                    help="an output: a result channel (repeat; default all)")
     p.add_argument("--out", metavar="FILE", help="write the plant (.mat: MATLAB, scipy's "
