@@ -106,6 +106,10 @@ ROLL_FLEX_KEYS = Table((
 ))
 
 
+#: [N/m] each chuck's stiffness where a roll on chucks does not give it
+CHUCK_STIFFNESS = 1e9
+
+
 @dataclass(frozen=True)
 class RollFlexPart:
     """``flex = { ... }`` of a wound roll: ``segments`` lumped segments of its width, each
@@ -117,7 +121,8 @@ class RollFlexPart:
     paper_E: float
     GJ: float
     support: str = "drums"
-    chuck_stiffness: float = 1e9
+    #: [N/m] on chucks (1e9 unless given); None on the drums (so a scene's dict omits it)
+    chuck_stiffness: float | None = None
     damping_ratio: float = 0.01
 
 
@@ -136,4 +141,6 @@ def parse_roll_flex(reader: Any, label: str, raw: Any) -> RollFlexPart:
                                                      "(a roll on its drums has no chucks); "
                                                      "valid: support = 'chucks', or no "
                                                      "chuck_stiffness")
+    if kw.get("support") == "chucks":
+        kw.setdefault("chuck_stiffness", CHUCK_STIFFNESS)
     return RollFlexPart(**kw)
