@@ -26,6 +26,7 @@ from winder._args import show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.model.locked_modes import IN_CONTACT, WINDING, ModeKind
 from winder.scene.load import Scene
+from winder.solve.simulate import _as_scene
 from winder.solve.stepper import inputs_of
 from winder.solve.system import MachineSystem
 
@@ -193,17 +194,6 @@ def _symbolic(system: MachineSystem, input_params: Sequence[str],
     return x, u, p, xdot, y, [*rest, TIME_PARAMETER]
 
 
-def _as_scene(where: str, scene: Any) -> Scene:
-    if isinstance(scene, Scene):
-        return scene
-    if isinstance(scene, str | os.PathLike):
-        from winder.scene import load_scene
-
-        return load_scene(scene)
-    raise ArgumentTypeError(f"{where}: scene must be a winder.Scene or the path of a scene "
-                            f"file, got {show(scene)} ({type(scene).__name__})")
-
-
 def model_of(system: MachineSystem, *, inputs: Sequence[str] | None = None,
              outputs: Sequence[str] | None = None, where: str = "casadi_model",
              x0: np.ndarray | None = None) -> CasadiModel:
@@ -251,5 +241,5 @@ def casadi_model(scene: Scene | str | os.PathLike, *, inputs: Sequence[str] | No
     ------
     ArgumentError: an input or output that the scene does not have.
     """
-    scene = _as_scene("casadi_model", scene)
+    scene = _as_scene(scene, "casadi_model")
     return model_of(MachineSystem(scene), inputs=inputs, outputs=outputs)

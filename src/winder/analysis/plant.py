@@ -35,9 +35,10 @@ from typing import Any
 import numpy as np
 
 from winder._errors import ArgumentError
-from winder.analysis.control import _as_scene, model_of
+from winder.analysis.control import model_of
 from winder.analysis.operating_point import _linearisation, _radius
 from winder.scene.load import Scene
+from winder.solve.simulate import _as_scene
 
 __all__ = ["linearise", "save_plant", "PLANT_SUFFIXES", "poles_with_damping"]
 
@@ -72,7 +73,7 @@ def linearise(scene: Scene | str | os.PathLike, radius: float, *,
     import control
 
     where = "linearise"
-    scene = _as_scene(where, scene)
+    scene = _as_scene(scene, where)
     lin = _linearisation(scene, where, web_speed, lo_open=False)
     r = _radius(where, lin, radius)
     y = lin.solve(r, where)

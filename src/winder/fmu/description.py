@@ -96,22 +96,32 @@ def _dependencies(iface: NativeInterface, pattern: dict[str, np.ndarray], offset
     return [" ".join(map(str, sorted(d))) for d in deps]
 
 
-def _scalar(parent: ET.Element, v: Variable) -> None:
-    attrs = {"name": v.name, "valueReference": str(v.vr), "causality": v.causality,
-             "variability": v.variability}
+def _attributes(v: Variable, offset: int) -> tuple[dict[str, str], dict[str, str]]:
+    """A Real variable's attributes: the variable's own (name, value reference,
+    causality, variability, description, initial) and its type's (start, unit,
+    derivative: ``vr + offset`` of its state, FMI 2.0's 1-based ModelVariables index with
+    ``offset`` 1, FMI 3.0's value reference with 0)."""
+    own = {"name": v.name, "valueReference": str(v.vr), "causality": v.causality,
+           "variability": v.variability}
     if v.description:
-        attrs["description"] = v.description
+        own["description"] = v.description
     if v.initial is not None:
-        attrs["initial"] = v.initial
-    sv = ET.SubElement(parent, "ScalarVariable", attrs)
-    real: dict[str, str] = {}
+        own["initial"] = v.initial
+    typed: dict[str, str] = {}
     if v.start is not None:
-        real["start"] = repr(float(v.start))
+        typed["start"] = repr(float(v.start))
     if v.unit is not None:
-        real["unit"] = v.unit
+        typed["unit"] = v.unit
     if v.derivative is not None:
-        real["derivative"] = str(v.derivative + 1)  # an index into ModelVariables (1-based)
-    ET.SubElement(sv, "Real", real)
+        typed["derivative"] = str(v.derivative + offset)
+    return own, typed
+
+
+def _scalar(parent: ET.Element, v: Variable) -> None:
+    """FMI 2.0: a ScalarVariable with its Real (Reals are in value-reference order, so a
+    state's index in ModelVariables is its value reference + 1)."""
+    own, typed = _attributes(v, 1)
+    ET.SubElement(ET.SubElement(parent, "ScalarVariable", own), "Real", typed)
 
 
 def _description2(iface: NativeInterface, model: str, guid: str, scene: Scene,
@@ -195,19 +205,8 @@ def _description3(iface: NativeInterface, model: str, token: str, scene: Scene,
                                   "causality": "independent", "variability": "continuous",
                                   "unit": "s", "description": "simulation time [s]"})
     for v in real_vars:
-        attrs = {"name": v.name, "valueReference": str(v.vr), "causality": v.causality,
-                 "variability": v.variability}
-        if v.description:
-            attrs["description"] = v.description
-        if v.initial is not None:
-            attrs["initial"] = v.initial
-        if v.unit is not None:
-            attrs["unit"] = v.unit
-        if v.start is not None:
-            attrs["start"] = repr(float(v.start))
-        if v.derivative is not None:
-            attrs["derivative"] = str(v.derivative)  # FMI 3.0: the state's value reference
-        ET.SubElement(mv, "Float64", attrs)
+        own, typed = _attributes(v, 0)
+        ET.SubElement(mv, "Float64", {**own, **typed})
     names = iface.system.machine.switch_names
     zs = indicators(iface.system)
     for k, g in enumerate(zs):

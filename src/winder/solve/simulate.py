@@ -53,13 +53,16 @@ def _check_bool(name: str, value: Any) -> bool:
     return bool(value)
 
 
-def _as_scene(scene: Any) -> Scene:
+def _as_scene(scene: Any, where: str = "") -> Scene:
+    """``scene``, or the scene file at that path; ``where`` (a function's name) prefixes
+    the error."""
     if isinstance(scene, Scene):
         return scene
     if isinstance(scene, str | os.PathLike):
         return load_scene(scene)
-    raise ArgumentTypeError(f"scene must be a winder.Scene or the path of a scene file (str "
-                            f"or pathlib.Path), got {type(scene).__name__}: {scene!r:.80}")
+    raise ArgumentTypeError(f"{where + ': ' if where else ''}scene must be a winder.Scene or "
+                            f"the path of a scene file (str or pathlib.Path), got "
+                            f"{type(scene).__name__}: {scene!r:.80}")
 
 
 def resolve_backend(backend: str | None, scene: Scene) -> str:
