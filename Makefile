@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.winder-installed
 OUT    ?= out
 
 .PHONY: demo test test-slow bench peers fmu docs-figures lint chromium libtbb clean venv pin-casadi \
-	scene-reference readme-numbers
+	scene-reference readme-numbers docs
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -23,6 +23,23 @@ pin-casadi: $(STAMP)
 	$(PY) -m winder.model.pin_casadi
 
 venv: $(STAMP) pin-casadi
+
+# The documentation site (mkdocs.yml; docs/ into site/, warnings as errors): its own venv
+# with the `docs` extra of pyproject.toml alone, not winder's dependencies nor the C++
+# generator (griffe reads src/ without importing it): about 30 s to create, then the
+# build alone (a few seconds). Open site/index.html.
+DOCS_VENV  ?= .venv-docs
+DOCS_STAMP := $(DOCS_VENV)/.winder-docs-installed
+
+$(DOCS_STAMP): pyproject.toml
+	$(PYTHON) -m venv $(DOCS_VENV)
+	$(PYTHON) -c "import tomllib; print('\\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['docs']))" > $(DOCS_VENV)/requirements-docs.txt
+	$(DOCS_VENV)/bin/python -m pip install --quiet --disable-pip-version-check -r $(DOCS_VENV)/requirements-docs.txt
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	NO_MKDOCS_2_WARNING=1 $(DOCS_VENV)/bin/python -m mkdocs build --strict --quiet --site-dir site
+	@echo "documentation site in site/ (open site/index.html)"
 
 # Headless Chromium for the browser test and the snapshots (Debian package; root only).
 chromium:
@@ -120,9 +137,14 @@ scene-reference: $(STAMP)
 readme-numbers: $(STAMP) pin-casadi
 	$(PY) benchmarks/readme_numbers.py --out $(OUT)
 
-# The README's resonance map (committed under docs/).
+# The README's resonance map and the examples' figures of the site's gallery (committed
+# under docs/; about 2 min).
 docs-figures: $(STAMP)
 	$(PY) -m winder modes models/paper_winding.toml --plot docs/resonance_map.png --csv docs/modes.csv
+	$(PY) examples/tension_loop_design.py --out docs/examples
+	$(PY) examples/tension_mpc.py --out docs/examples
+	$(PY) examples/speed_control_fmu.py --out $(OUT) && cp $(OUT)/speed_control_fmu.png docs/examples/
+	$(PY) examples/tension_control_fmu.py --out $(OUT) && cp $(OUT)/tension_control_fmu.png docs/examples/
 
 # The FMUs and the closed-loop examples (FMPy host): the drum-speed PI loop, and the winder
 # line's tension control through its FMU over a whole parent roll.
@@ -139,4 +161,4 @@ lint: $(STAMP)
 	$(PY) -m ruff check src viewer tests examples benchmarks
 
 clean:
-	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info
+	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info $(DOCS_VENV) site
