@@ -88,7 +88,7 @@ demo: $(STAMP) pin-casadi chromium
 	@echo "demo outputs in $(OUT)/"
 
 test: $(STAMP) pin-casadi chromium libtbb
-	$(PY) -m ruff check src viewer tests examples benchmarks
+	$(PY) -m ruff check src viewer tests examples benchmarks tools
 	$(VENV)/bin/lint-imports
 	$(PY) -m pytest -q
 
@@ -158,7 +158,7 @@ fmu: $(STAMP)
 	$(PY) examples/tension_control_fmu.py --fmu $(OUT)/winder_line_fmu.fmu --out $(OUT)
 
 lint: $(STAMP)
-	$(PY) -m ruff check src viewer tests examples benchmarks
+	$(PY) -m ruff check src viewer tests examples benchmarks tools
 
 clean:
 	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info $(DOCS_VENV) site
