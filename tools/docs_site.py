@@ -35,6 +35,7 @@ API_SECTIONS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("Results and files", (".io",)),
     ("Resonance map", (".analysis.modes",)),
     ("Sweeps", (".analysis.sweep",)),
+    ("Calibration", (".analysis.fit",)),
     ("Control design", (".analysis.control", ".analysis.plant", ".analysis.linearise")),
     ("FMU", (".fmu",)),
     ("Variable-mass core and the machine", (".model",)),
@@ -153,6 +154,17 @@ _NAME = r"\*{0,2}[A-Za-z_][\w.]*(?: \[[^\]]*\])?"   # a name, its unit: 't_end [
 _ITEM = re.compile(rf"^(?P<names>{_NAME}(?:\s*,\s*{_NAME})*):(?:\s+(?P<text>.*))?$")
 _BARE = re.compile(r"^(?P<names>\*{0,2}[A-Za-z_][\w.]*(?:\s*,\s*\*{0,2}[A-Za-z_][\w.]*)*)"
                    r"(?:\s+:\s+(?P<type>.+))?$")
+
+
+def comment_doc(lines: list[str], lineno: int) -> str | None:
+    """The ``#:`` comment lines right above line ``lineno`` (1-based) of ``lines``: the
+    Sphinx convention for documenting an assignment, which griffe does not read."""
+    found: list[str] = []
+    i = lineno - 2
+    while i >= 0 and lines[i].lstrip().startswith("#:"):
+        found.append(lines[i].lstrip()[2:].strip())
+        i -= 1
+    return "\n".join(reversed(found)) or None
 
 
 def _role(match: re.Match[str]) -> str:
