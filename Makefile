@@ -26,8 +26,8 @@ venv: $(STAMP) pin-casadi
 
 # The documentation site (mkdocs.yml; docs/ into site/, warnings as errors): its own venv
 # with the `docs` extra of pyproject.toml alone, not winder's dependencies nor the C++
-# generator (griffe reads src/ without importing it): about 30 s to create, then the
-# build alone (a few seconds). Open site/index.html.
+# generator (griffe reads src/ without importing it): 50 s the first time on the loaded
+# 2-core machine, then about 10 s for the build alone. Open site/index.html.
 DOCS_VENV  ?= .venv-docs
 DOCS_STAMP := $(DOCS_VENV)/.winder-docs-installed
 
