@@ -174,3 +174,55 @@ def test_comment_doc_reads_the_sphinx_attribute_comment():
     assert site.comment_doc(lines, 4) == "first line\nsecond line"
     assert site.comment_doc(lines, 6) is None
     assert site.comment_doc(lines, 1) is None
+
+
+def _blocks(lang: str | None = None):
+    """(page, info string, body) of every fenced block under docs/ (``lang``: that one)."""
+    for page in sorted(DOCS.rglob("*.md")):
+        text = page.read_text(encoding="utf-8")
+        for info, body in re.findall(r"(?ms)^```(\w*)[^\n]*\n(.*?)^```", text):
+            if lang is None or info == lang:
+                yield page.relative_to(DOCS), info, body
+
+
+def test_code_blocks_are_valid_python_and_toml():
+    import tomllib
+
+    from winder.scene import scene_from_dict
+
+    pythons = tomls = 0
+    for page, _, body in _blocks("python"):
+        compile(body, f"{page} (python block)", "exec")
+        pythons += 1
+    for page, _, body in _blocks("toml"):
+        data = tomllib.loads(body)
+        if "scene" in data:  # a whole scene: it must load
+            scene_from_dict(data, source=str(page))
+        tomls += 1
+    assert pythons >= 8 and tomls >= 3
+
+
+def test_command_lines_in_the_docs_parse_with_the_real_cli():
+    """Every ``winder ...`` line of a code block (not a synopsis with ``[options]``)
+    parses with winder's own argument parser, and every ``models/*.toml`` it names
+    exists."""
+    import shlex
+
+    from winder.cli import _build_parser
+
+    parser = _build_parser()
+    checked = 0
+    for page, _, body in _blocks():
+        for line in re.sub(r"\\\n\s*", " ", body).splitlines():
+            if not re.match(r"\s*(\S*/)?winder\s", line) or " [" in line:
+                continue
+            words = shlex.split(line, comments=True)
+            try:
+                parser.parse_args(words[1:])
+            except SystemExit as exc:
+                raise AssertionError(f"{page}: {line.strip()!r} does not parse") from exc
+            for word in words:
+                if word.startswith("models/"):
+                    assert (ROOT / word).is_file(), f"{page}: {word}"
+            checked += 1
+    assert checked >= 20
