@@ -18,7 +18,9 @@ $(STAMP): pyproject.toml
 # built under ~/.cache/winder/pin-casadi/<pin, casadi, eigen versions>/ (shared by every clone
 # and venv; $(VENV)/winder-pin-casadi where the home cache is not writable) when missing
 # (about 160 s of g++ and 4 GB, once per version); a no-op otherwise; a warning only where
-# g++ is missing.
+# g++ is missing. Only the generated code's route "cpp" needs it (WINDER_ROUTE=cpp): the
+# default route "py" gives the same expressions without it, so `make demo` never waits for
+# it; `make test` builds it for the routes' cross-check (tests/model/test_routes.py).
 pin-casadi: $(STAMP)
 	$(PY) -m winder.model.pin_casadi
 
@@ -42,7 +44,7 @@ libtbb:
 	    || echo "warning: could not install libtbb12; the ecospy host test will be skipped"; \
 	else echo "warning: libtbb12 not found and not root; the ecospy host test will be skipped"; fi
 
-demo: $(STAMP) pin-casadi chromium
+demo: $(STAMP) chromium
 	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
@@ -84,7 +86,7 @@ test-slow: $(STAMP) chromium
 # core and the exhausted parent. libstdc++ is preloaded too: without it ASan's __cxa_throw
 # interceptor aborts in matplotlib's ft2font. A report aborts the run (exit status != 0).
 .PHONY: test-asan
-test-asan: $(STAMP) pin-casadi
+test-asan: $(STAMP)
 	WINDER_SANITIZE=1 ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LD_PRELOAD="$$($${CC:-cc} -print-file-name=libasan.so) $$($${CC:-cc} -print-file-name=libstdc++.so.6)" \
@@ -117,7 +119,7 @@ scene-reference: $(STAMP)
 
 # The README's quoted numbers of the two-drum winder, the winder line and the flexible winder, from the demo's
 # results in $(OUT)/ (run where missing): a table to paste.
-readme-numbers: $(STAMP) pin-casadi
+readme-numbers: $(STAMP)
 	$(PY) benchmarks/readme_numbers.py --out $(OUT)
 
 # The README's resonance map (committed under docs/).

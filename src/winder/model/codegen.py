@@ -272,7 +272,8 @@ def generate(machine: Machine, *, directory: Path | None = None,
              route: str | None = None, link: Link | None = None) -> Generated:
     """The compiled functions of ``machine``: from the cache, or generated and compiled
     (and cached). ``route``: how Pinocchio's algorithms reach the symbols (one of
-    :data:`~winder.model.backends.ROUTES`; default ``cpp`` where its generator is built).
+    :data:`~winder.model.backends.ROUTES`; default:
+    :func:`~winder.model.backends.default_route`).
     ``link``: objects linked into the machine's library with the generated code (the
     integrators). Raises :class:`CompilerMissing` without a C compiler. A cached machine
     loads without importing CasADi (its version comes from the package metadata)."""
