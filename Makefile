@@ -9,6 +9,7 @@ OUT    ?= out
 	scene-reference readme-numbers
 
 $(STAMP): pyproject.toml
+	@echo "creating $(VENV) and installing winder with its dependencies (pip; about 2 min the first time)"
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[test,fmu,peers]'
@@ -30,7 +31,7 @@ venv: $(STAMP) pin-casadi
 chromium:
 	@if command -v chromium >/dev/null 2>&1; then :; \
 	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
-	  echo "installing chromium (apt-get)"; \
+	  echo "installing chromium for the snapshots (apt-get; about 1 min, once)"; \
 	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
 	    || echo "warning: could not install chromium; browser tests will be skipped"; \
 	else echo "warning: chromium not found and not root; browser tests will be skipped"; fi
@@ -44,10 +45,12 @@ libtbb:
 	    || echo "warning: could not install libtbb12; the ecospy host test will be skipped"; \
 	else echo "warning: libtbb12 not found and not root; the ecospy host test will be skipped"; fi
 
-demo: $(STAMP) chromium
+# The first result comes first; Chromium (for the snapshots) is installed before the first view.
+demo: $(STAMP)
 	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
+	@$(MAKE) --no-print-directory chromium
 	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
 	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
 	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
