@@ -9,6 +9,7 @@ OUT    ?= out
 	scene-reference readme-numbers docs
 
 $(STAMP): pyproject.toml
+	@echo "creating $(VENV) and installing winder with its dependencies (pip; about 2 min the first time)"
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[test,fmu,peers]'
@@ -18,7 +19,9 @@ $(STAMP): pyproject.toml
 # built under ~/.cache/winder/pin-casadi/<pin, casadi, eigen versions>/ (shared by every clone
 # and venv; $(VENV)/winder-pin-casadi where the home cache is not writable) when missing
 # (about 160 s of g++ and 4 GB, once per version); a no-op otherwise; a warning only where
-# g++ is missing.
+# g++ is missing. Only the generated code's route "cpp" needs it (WINDER_ROUTE=cpp): the
+# default route "py" gives the same expressions without it, so `make demo` never waits for
+# it; `make test` builds it for the routes' cross-check (tests/model/test_routes.py).
 pin-casadi: $(STAMP)
 	$(PY) -m winder.model.pin_casadi
 
@@ -45,7 +48,7 @@ docs: $(DOCS_STAMP)
 chromium:
 	@if command -v chromium >/dev/null 2>&1; then :; \
 	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
-	  echo "installing chromium (apt-get)"; \
+	  echo "installing chromium for the snapshots (apt-get; about 1 min, once)"; \
 	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
 	    || echo "warning: could not install chromium; browser tests will be skipped"; \
 	else echo "warning: chromium not found and not root; browser tests will be skipped"; fi
@@ -59,10 +62,12 @@ libtbb:
 	    || echo "warning: could not install libtbb12; the ecospy host test will be skipped"; \
 	else echo "warning: libtbb12 not found and not root; the ecospy host test will be skipped"; fi
 
-demo: $(STAMP) pin-casadi chromium
+# The first result comes first; Chromium (for the snapshots) is installed before the first view.
+demo: $(STAMP)
 	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
+	@$(MAKE) --no-print-directory chromium
 	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
 	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
 	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
@@ -101,7 +106,7 @@ test-slow: $(STAMP) chromium
 # core and the exhausted parent. libstdc++ is preloaded too: without it ASan's __cxa_throw
 # interceptor aborts in matplotlib's ft2font. A report aborts the run (exit status != 0).
 .PHONY: test-asan
-test-asan: $(STAMP) pin-casadi
+test-asan: $(STAMP)
 	WINDER_SANITIZE=1 ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LD_PRELOAD="$$($${CC:-cc} -print-file-name=libasan.so) $$($${CC:-cc} -print-file-name=libstdc++.so.6)" \
@@ -134,7 +139,7 @@ scene-reference: $(STAMP)
 
 # The README's quoted numbers of the two-drum winder, the winder line and the flexible winder, from the demo's
 # results in $(OUT)/ (run where missing): a table to paste.
-readme-numbers: $(STAMP) pin-casadi
+readme-numbers: $(STAMP)
 	$(PY) benchmarks/readme_numbers.py --out $(OUT)
 
 # The README's resonance map and the examples' figures of the site's gallery (committed

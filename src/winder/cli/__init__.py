@@ -338,6 +338,18 @@ def _add_linearise(sub: Any) -> None:
     add_parser(sub, _POSITIVE)
 
 
+def _version() -> str:
+    """The installed package's version (``winder.__version__`` where it is not installed)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("winder")
+    except metadata.PackageNotFoundError:
+        from winder import __version__
+
+        return __version__
+
+
 def _build_parser() -> argparse.ArgumentParser:
     from winder.scene.schema import BACKENDS, METHODS  # the scene's [solver] choices: one list
 
@@ -345,6 +357,7 @@ def _build_parser() -> argparse.ArgumentParser:
                      epilog="Exit status: 0 done; 2 bad input or failed run (a message names "
                      "the file, option or key); 128+N stopped by signal N (130 Ctrl-C, 143 "
                      "SIGTERM, 129 SIGHUP; no partial file left); 1 internal error.")
+    parser.add_argument("--version", action="version", version=f"winder {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     run = sub.add_parser("run", help="simulate a scene file and write its result channels")
     run.add_argument("scene", help="scene file (TOML)")
@@ -402,7 +415,7 @@ def _build_parser() -> argparse.ArgumentParser:
                            "the rotation harmonics (resonance map)")
     modes.add_argument("scene", help="scene file (TOML)")
     modes.add_argument("--plot", nargs="?", const="campbell.png",
-                       help="write the Campbell chart (PNG; default name campbell.png)")
+                       help="write the resonance map (PNG; default name campbell.png)")
     modes.add_argument("--csv", help="write frequencies, damping and critical speeds (CSV)")
     modes.add_argument("--web-speed", type=_POSITIVE,
                        help="operating web speed [m/s] (default: the scene's)")
@@ -441,7 +454,8 @@ def _build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--trajectories", action="store_true",
                        help="also store each run's full result (OUT/trajectories/*.npz)")
     sweep.add_argument("--t-end", type=_POSITIVE, help="end time of each run [s]")
-    sweep.add_argument("--rtol", type=_RTOL)
+    sweep.add_argument("--rtol", type=_RTOL, help=f"relative tolerance of each run (0 < "
+                       f"rtol <= {RTOL_MAX:g}; default: the scene's [solver] rtol)")
     sweep.add_argument("--output-step", type=_POSITIVE, help="sampling of the runs [s]")
     sweep.add_argument("--max-wall", type=_POSITIVE, help="wall-clock budget per run [s]")
     sweep.add_argument("--bands", type=_COUNT, default=24, help="radius bands (default 24)")

@@ -27,6 +27,7 @@ import hashlib
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -238,6 +239,11 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str
     return path, pattern
 
 
+def _say(line: str) -> None:
+    """One line on stderr about a build (a build is never silent: it can take a minute)."""
+    print(line, file=sys.stderr, flush=True)
+
+
 def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
     """The cache key of a machine's generated code (:func:`generate`)."""
     return hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(),
@@ -272,7 +278,8 @@ def generate(machine: Machine, *, directory: Path | None = None,
              route: str | None = None, link: Link | None = None) -> Generated:
     """The compiled functions of ``machine``: from the cache, or generated and compiled
     (and cached). ``route``: how Pinocchio's algorithms reach the symbols (one of
-    :data:`~winder.model.backends.ROUTES`; default ``cpp`` where its generator is built).
+    :data:`~winder.model.backends.ROUTES`; default:
+    :func:`~winder.model.backends.default_route`).
     ``link``: objects linked into the machine's library with the generated code (the
     integrators). Raises :class:`CompilerMissing` without a C compiler. A cached machine
     loads without importing CasADi (its version comes from the package metadata)."""
@@ -292,11 +299,16 @@ def generate(machine: Machine, *, directory: Path | None = None,
         compiled = not obj.exists()
         with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
             if compiled:
+                name = getattr(getattr(machine, "scene", None), "name", "the machine")
+                _say(f"winder: building {name}'s code once ({machine.n_states} states, "
+                     f"{machine.model.nbodies - 1} bodies; cached in {root})")
                 src = _c_source(machine, symbol, Path(tmp), route)[0]
                 tmp_obj = Path(tmp) / obj.name
                 run_compiler([*cflags, "-c", str(src), "-o", str(tmp_obj)],
                              "the generated model")
                 os.replace(tmp_obj, obj)
+                _say(f"winder: {name}'s code built in {time.perf_counter() - t0:.1f} s "
+                     f"({src.stat().st_size / 1024:.0f} kB of C)")
             tmp_lib = Path(tmp) / lib.name
             extra = [str(o) for o in link.objects] if link is not None else []
             run_compiler([*link_flags(), str(obj), *extra, "-o", str(tmp_lib), "-lm"],

@@ -291,9 +291,10 @@ def parse_tables(source: str, data: Mapping[str, Any]) -> dict[str, dict[str, An
     out = {}
     for name in ("drum", "roll", "paper", "contact", "friction"):
         raw = data.get(name, {})
-        if name == "drum" and isinstance(raw, dict):
-            raw = {k: v for k, v in raw.items() if k != "drive"}
-        out[name] = parse_table(source, name, raw, LEGACY_TABLES[name])
+        sub = ("drive",) if name == "drum" else ()
+        if sub and isinstance(raw, dict):
+            raw = {k: v for k, v in raw.items() if k not in sub}
+        out[name] = parse_table(source, name, raw, LEGACY_TABLES[name], sub_tables=sub)
     return out
 
 

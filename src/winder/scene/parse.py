@@ -131,17 +131,20 @@ def parse_value(source: str, table: str, key: str, value: Any, spec: Key) -> Any
     return _number(source, table, key, value, spec)
 
 
-def parse_table(source: str, table: str, raw: Any, keys: Table) -> dict[str, Any]:
+def parse_table(source: str, table: str, raw: Any, keys: Table, *,
+                sub_tables: tuple[str, ...] = ()) -> dict[str, Any]:
     """The keys of one table, each checked against its declaration in ``keys`` (type,
     finiteness, bounds, choices); ``table`` names it in messages (``drum 'front'``).
-    Sub-tables (kind ``table``) are left out: the caller parses them with their own."""
+    Sub-tables (kind ``table``) are left out: the caller parses them with their own;
+    ``sub_tables`` names those the caller took out of ``raw`` (listed as valid keys)."""
     if not isinstance(raw, dict):
         raise SceneError(f"{source}: [{table}] must be a table of keys, got {show(raw)} "
                          f"({type(raw).__name__})")
     out: dict[str, Any] = {}
     for key, value in raw.items():
         if key not in keys:
-            raise fail(source, table, key, f"unknown key; valid keys: {', '.join(keys.names())}")
+            raise fail(source, table, key, "unknown key; valid keys: "
+                       + ", ".join((*keys.names(), *sub_tables)))
         spec = keys[key]
         if spec.kind != "table":
             out[key] = parse_value(source, table, key, value, spec)

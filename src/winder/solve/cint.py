@@ -24,6 +24,7 @@ import ctypes
 import hashlib
 import math
 import os
+import sys
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -61,6 +62,8 @@ def link() -> Link:
     objects = tuple(root / f"{Path(s).stem}.o" for s in SOURCES)
     if not all(o.exists() for o in objects):
         root.parent.mkdir(parents=True, exist_ok=True)
+        print(f"winder: building the C integrators once ({', '.join(SOURCES)}; cached in "
+              f"{root.parent})", file=sys.stderr, flush=True)
         with tempfile.TemporaryDirectory(dir=root.parent, prefix=".build-") as tmp:
             for src, obj in zip(SOURCES, objects, strict=True):
                 run_compiler([*flags, "-c", str(_DIR / src), "-o", str(Path(tmp) / obj.name)],
