@@ -177,12 +177,13 @@ def test_comment_doc_reads_the_sphinx_attribute_comment():
 
 
 def _blocks(lang: str | None = None):
-    """(page, info string, body) of every fenced block under docs/ (``lang``: that one)."""
-    for page in sorted(DOCS.rglob("*.md")):
+    """(page, info string, body) of every fenced block under docs/ and of the README
+    (``lang``: that one)."""
+    for page in [ROOT / "README.md", *sorted(DOCS.rglob("*.md"))]:
         text = page.read_text(encoding="utf-8")
         for info, body in re.findall(r"(?ms)^```(\w*)[^\n]*\n(.*?)^```", text):
             if lang is None or info == lang:
-                yield page.relative_to(DOCS), info, body
+                yield page.relative_to(ROOT), info, body
 
 
 def test_code_blocks_are_valid_python_and_toml():
@@ -226,3 +227,17 @@ def test_command_lines_in_the_docs_parse_with_the_real_cli():
                     assert (ROOT / word).is_file(), f"{page}: {word}"
             checked += 1
     assert checked >= 20
+
+
+def test_readme_starts_and_stays_short():
+    """The README: at most 300 lines, the two commands first, a quick start for one's own
+    machine (a whole scene, ``winder run``, ``winder view``) within its first 60 lines,
+    and every shipped scene in its table."""
+    lines = (ROOT / "README.md").read_text(encoding="utf-8").splitlines()
+    assert len(lines) <= 300, len(lines)
+    commands = [i for i, line in enumerate(lines) if line.strip().startswith("make ")]
+    assert [lines[i].split()[1] for i in commands[:2]] == ["demo", "test"]
+    head = "\n".join(lines[:60])
+    assert "```toml" in head and "winder run " in head and "winder view " in head
+    tables = {m for m in re.findall(r"^\| `([\w.]+\.toml)` \|", "\n".join(lines), re.M)}
+    assert tables == {p.name for p in (ROOT / "models").glob("*.toml")}
