@@ -19,6 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from winder.analysis.modes import FREE_BELOW  # noqa: E402
 from winder.io.files import atomic_write, safe_stem  # noqa: E402
 from winder.io.result import Result  # noqa: E402
 from winder.parts import BodyElement, WebPart, body_elements  # noqa: E402
@@ -512,28 +513,47 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
                              sharex=True, squeeze=False)
     ax = axes[0, 0]
     r = mm.radius
+    single = len(r) == 1  # the initial state (or a map of one radius): markers, no lines
+    if single and not np.isfinite(r[0]):  # no wound roll: no radius axis
+        r = np.zeros(1)
     one = len(mm.coordinates) == 1
     drawn = mm.shown() if mm.flexible else mm.coordinates  # flexible: orders 1-2, torsion 1
     for i, c in enumerate(drawn):
         f = mm.frequencies[c] if c in mm.frequencies else mm.torsion[c]
         colour = MODE_COLOURS[i % len(MODE_COLOURS)]
         kind = "torsion" if c in mm.torsion else "bending" if ".bend." in c else "bounce"
-        ax.plot(r, np.where(f > 0, f, np.nan), color=colour, lw=2 if kind == "bounce" else 1.5,
-                ls="-" if kind != "torsion" else (0, (5, 1)),
+        style = {"marker": "D" if kind == "torsion" else "o", "ls": "none", "ms": 7} \
+            if single else {"lw": 2 if kind == "bounce" else 1.5,
+                            "ls": "-" if kind != "torsion" else (0, (5, 1))}
+        if single and ".bend.x" in c:  # beside its z order of the same frequency: hollow
+            style.update(mfc="none", ms=11, mew=1.5)
+        free = single and c in mm.natural and mm.natural[c][0] < FREE_BELOW
+        if free:  # a zero eigenvalue: nothing holds it, a mark along the bottom
+            ax.plot(r, [0.03 + 0.04 * i], marker="v", ms=8, ls="none", color=colour,
+                    transform=ax.get_xaxis_transform(), label=f"{c} free: 0 Hz (nothing "
+                    "holds it)")
+            continue
+        ax.plot(r, np.where(f > 0, f, np.nan), color=colour, **style,
                 label="bounce mode (damped)" if one else f"{kind} mode {c} "
                 + ("|λ|/2π" if kind == "torsion" else "(damped)"))
-        if np.any(f == 0):  # overdamped (real eigenvalue): a bar along the bottom
+        if np.any(f == 0) and not single:  # overdamped (real eigenvalue): a bar at the bottom
             ax.plot(r, np.where(f == 0, 0.02 + 0.025 * i, np.nan), color=colour, lw=4,
                     solid_capstyle="butt", transform=ax.get_xaxis_transform(),
                     label=("bounce mode" if one else c) + " overdamped here (real "
                     "eigenvalue: no oscillation)")
-    ax.plot(r, mm.slip_frequency, "C2" if one else "C7", lw=1.0,
-            label="slip/torsion mode |λ|/2π (slowest)")
+    if not single or np.all(mm.slip_frequency > 0):  # (a NaN: no slip mode)
+        ax.plot(r, mm.slip_frequency, "C2" if one else "C7", lw=1.0,
+                **({"marker": "s", "ls": "none"} if single else {}),
+                label="slip/torsion mode |λ|/2π (slowest)")
     harmonics = mm.harmonics()
     for name, line in harmonics.items():
         if name in _HARMONIC_STYLE:
-            ax.plot(r, line, _HARMONIC_STYLE[name], color="k", lw=1,
-                    label=f"{name[:-1]}× roll rotation at {mm.web_speed:g} m/s")
+            if single and not np.all(np.isfinite(line)):
+                continue  # no wound roll: no roll rotation
+            ax.plot(r, line, *(("x",) if single else (_HARMONIC_STYLE[name],)), color="k",
+                    lw=1, label=f"{name[:-1]}× roll rotation at {mm.web_speed:g} m/s")
+        elif single:  # a drum's rotation: the same at every radius
+            ax.axhline(float(line[0]), ls="-.", color="0.45", lw=1, label=f"{name} rotation")
         else:
             ax.plot(r, line, "-.", color="0.45", lw=1, label=f"{name} rotation")
     shown = [mm.frequencies[c] if c in mm.frequencies else mm.torsion[c] for c in drawn]
@@ -543,6 +563,10 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     if log:
         ax.set_yscale("log")
         ax.set_ylim(max(values.min() * 0.7, 0.1), values.max() * 1.5)
+    elif single or not np.any(np.isfinite(mm.bounce_frequency)):
+        top = max(float(values.max()) if values.size else 0.0,
+                  float(np.nanmax(mm.slip_frequency, initial=0.0)))
+        ax.set_ylim(0, top * 1.15 if top > 0 else 1.0)
     else:
         ax.set_ylim(0, float(np.nanmax(mm.bounce_frequency)) * 1.1)
     crossings = mm.crossings(drawn)
@@ -586,5 +610,12 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     if len(r) > 1:  # the map's radii (--radius-min/max), the envelope too where it is longer
         span = float(r.max() - r.min())
         ax.set_xlim(float(r.min()) - 0.02 * span, float(r.max()) + 0.02 * span)
-    axes[-1, 0].set_xlabel("roll radius r [m]")
+    if mm.initial_state and not np.isfinite(mm.radius[0]):
+        ax.set_xlim(-1.0, 1.0)
+        ax.set_xticks([])
+        axes[-1, 0].set_xlabel(f"the initial state ({mm.initial_reason})")
+    elif mm.initial_state:
+        axes[-1, 0].set_xlabel(f"roll radius r [m]: the initial state ({mm.initial_reason})")
+    else:
+        axes[-1, 0].set_xlabel("roll radius r [m]")
     return _save(fig, Path(path))
