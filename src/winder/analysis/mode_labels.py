@@ -18,8 +18,9 @@ label:
 
 - each free coordinate takes the eigenpair in which it carries the largest share of the
   kinetic energy, such an oscillating one first (its share ≥ 1/4), every pair at most once.
-  A flexible body's bending order (``front.bend.z1``) takes only such an oscillating one:
-  none at a radius where no oscillating mode has that shape. A rigid body's coordinate
+  A flexible body's bending order (``front.bend.z1``) takes only such an oscillating one
+  with at least :data:`SHAPE_SHARE` of its energy in that order: none at a radius where no
+  oscillating mode has that shape. A rigid body's coordinate
   (``set.x``) always names one: where none oscillates the real eigenvalue with the largest
   share (the coordinate is overdamped there: frequency 0, damping ratio 1), or a zero
   eigenvalue (free: nothing holds it);
@@ -40,13 +41,17 @@ import numpy as np
 
 from winder.analysis.shapes import Shapes
 
-__all__ = ["Mode", "label_modes", "MECHANICAL_SHARE"]
+__all__ = ["Mode", "label_modes", "MECHANICAL_SHARE", "SHAPE_SHARE"]
 
 #: The least mechanical share (participation of the bodies' states) of a labelled
 #: oscillating mode.
 MECHANICAL_SHARE = 0.5
-#: The least kinetic-energy share of a coordinate in the oscillating mode it names.
+#: The kinetic-energy share of a coordinate in an oscillating mode it names first.
 _BOUNCE_SHARE = 0.25
+#: The least kinetic-energy share of a bending order in the oscillating mode it names (the
+#: twin drums of a two-drum winder share their order-2 modes through the set: each drum's
+#: x2 and z2 12-24 % of them).
+SHAPE_SHARE = 0.1
 
 
 @dataclass(frozen=True)
@@ -56,8 +61,8 @@ class Mode:
     ``bending``, ``slip`` or ``torsion``) and ``coordinate``: the free coordinate that
     dominates a bounce mode (``BODY.x``/``BODY.z``), a flexible body's bending order
     (``BODY.bend.z1``, :mod:`winder.analysis.shapes`) or torsion order
-    (``BODY.torsion1``), or the state that dominates a slip mode (:mod:`winder.analysis.
-    mode_labels`: a bending or torsion label only on an oscillating mode of that shape)."""
+    (``BODY.torsion1``), or the state that dominates a slip mode (a bending or torsion
+    label only on an oscillating mode of that shape: module text)."""
 
     eigenvalue: complex
     kind: str
@@ -123,7 +128,8 @@ def label_modes(A: np.ndarray, *, shapes: Shapes, n_positions: int, n_speeds: in
     good = oscillating & (mech >= MECHANICAL_SHARE)
     first = good[None, :] & (share >= _BOUNCE_SHARE)
     shaped = np.array([".bend." in c for c in shapes.labels], dtype=bool)[:, None]
-    score = np.where(shaped, np.where(first, 1.0 + share, -1.0), share + first)
+    shape_ok = good[None, :] & (share >= SHAPE_SHARE)
+    score = np.where(shaped, np.where(shape_ok, share + first, -1.0), share + first)
     rows, cols = linear_sum_assignment(-score)
     bounce = {int(r): keep[int(c)] for r, c in zip(rows, cols, strict=True)
               if score[r, c] >= 0.0}

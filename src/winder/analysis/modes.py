@@ -283,7 +283,7 @@ class ModeMap:
                 ok = np.nonzero(np.isfinite(f))[0]
                 out.append(f"{kind} mode {c} {f[ok[0]]:.1f} -> {f[ok[-1]]:.1f} Hz"
                            + ("" if len(ok) == len(f) else
-                              f" (oscillating at {len(ok)} of {len(f)} radii)")
+                              f" (found at {len(ok)} of {len(f)} radii)")
                            if len(ok) else f"{kind} mode {c}: no oscillating mode of this "
                            "shape over the map")
             crossings = self.crossings(self.shown())

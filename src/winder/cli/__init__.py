@@ -315,7 +315,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         atomic_write(csv, csv_writer(mm.as_columns(), fmt="%.10g"))
         print(f"  table written to {csv}")
     if plot is not None:
-        from winder.plots.figures import campbell_figure, nip_colours
+        from winder.plots.campbell import campbell_figure
+        from winder.plots.figures import nip_colours
         from winder.solve.simulate import simulate
 
         result = None
