@@ -120,7 +120,8 @@ def _at_rest(scene: Scene, where: str, web_speed: float | None) -> _Linearisatio
 
 @dataclass(frozen=True)
 class ModeMap:
-    """Modes against the wound roll's radius. Arrays over ``radius`` [m]; frequencies
+    """Modes against the wound roll's radius (or, :attr:`initial_state`, one row: the
+    modes at the initial state). Arrays over ``radius`` [m]; frequencies
     [Hz]; speeds [m/s].
 
     ``frequencies``/``dampings``: per bounce mode (``coordinates``, e.g. ``set.x``) its
@@ -404,11 +405,16 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     one caliper per revolution at no slip: ``r² = r₀² + h L/π`` with ``L`` the paper brought
     in by the drive's ramp and full speed)) at ``web_speed`` [m/s] (``> 0``; default the
     scene's). Each radius starts from the operating point of the one before (continuation).
+    A scene without a winding operating point (no wound roll, or ``[effects] contact =
+    false``) gives one row, the modes of its initial state (:attr:`ModeMap.initial_state`;
+    ``n`` checked and unused, ``web_speed`` [m/s] ``>= 0`` only for the drums' rotation,
+    default each drum's own).
 
     Raises
     ------
-    ArgumentError: ``n``, ``radii`` or ``web_speed`` out of range, or a scene without a
-        winding operating point (see :func:`operating_point`).
+    ArgumentError: ``n``, ``radii`` or ``web_speed`` out of range, a scene whose winding
+        operating point cannot be found (see :func:`operating_point`), or radii given for
+        a scene without one.
     """
     where = "mode_map"
     _check_type(scene, where)
