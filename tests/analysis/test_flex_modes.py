@@ -16,14 +16,17 @@ part projects mostly onto ``sin(πy/L)``.
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 import tomllib
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
 import winder
-from winder.analysis.modes import mode_map
+from winder.analysis.modes import mode_map, modes_at
 from winder.analysis.shapes import Shapes, orders, sine_basis, torsion_basis
 from winder.model.beam import station_flexibility
 from winder.model.machine import Machine
@@ -35,7 +38,18 @@ V = 41.7  # [m/s]
 N = 8
 
 
-def scene(n: int = N) -> winder.Scene:
+def scene(n: int = N, **kw) -> winder.Scene:
+    """:func:`scene_text` read."""
+    return winder.scene_from_dict(tomllib.loads(scene_text(n, **kw)), source="flexmodes.toml")
+
+
+def scene_text(n: int = N, *, length: float = L, mass: float = MD, gj: float = GJ,
+               v: float = V, sigma: float = 0.01, roll: bool = True, contact: bool = True
+               ) -> str:
+    """The TOML of the flexible drum (``n`` segments, ``length`` [m], ``mass`` [kg], ``gj``
+    [N·m²]) under the light roll on the soft nip at web speed ``v`` [m/s], relaxation length
+    ``sigma`` [m]; without ``roll`` the drum alone on its bearings (no roll, nip or web); without
+    ``contact`` the scene with ``[effects] contact = false``."""
     text = f"""
 [scene]
 name = "flexmodes"
@@ -44,6 +58,8 @@ output_step = 0.01
 
 [effects]
 imbalance = false
+contact = {str(contact).lower()}
+slip_relaxation = {str(contact).lower()}
 
 [paper]
 density = {RHO}
@@ -53,13 +69,15 @@ caliper = 70e-6
 name = "drum"
 radius = {R}
 inertia = 1400.0
-mass = {MD}
+mass = {mass}
 centre = [0.0, 0.0]
-length = {L}
-drive = {{ kind = "speed_profile", web_acceleration = 0.7, web_speed = {V} }}
-flex = {{ segments = {n}, EI = {EI}, shear = false, GJ = {GJ}, bearing_stiffness = {KB}, \
+length = {length}
+drive = {{ kind = "speed_profile", web_acceleration = 0.7, web_speed = {v} }}
+flex = {{ segments = {n}, EI = {EI}, shear = false, GJ = {gj}, bearing_stiffness = {KB}, \
 damping_ratio = 0.0 }}
-
+"""
+    if roll:
+        text += f"""
 [[roll]]
 name = "roll"
 centre = [0.0, 0.6]
@@ -67,7 +85,7 @@ free = ["z"]
 core_radius = {RC}
 core_mass = {MC}
 core_inertia = 0.1
-width = {L}
+width = {length}
 initial_radius = {RC}
 
 [[nip]]
@@ -75,12 +93,12 @@ name = "nip"
 a = "drum"
 b = "roll"
 contact = {{ law = "linear", stiffness = {K_NIP}, damping = 0.0 }}
-friction = {{ mu = 0.35, slip_velocity = 0.05, relaxation_length = 0.01, min_speed = 0.1 }}
+friction = {{ mu = 0.35, slip_velocity = 0.05, relaxation_length = {sigma}, min_speed = 0.1 }}
 
 [web]
 entry_nip = "nip"
 """
-    return winder.scene_from_dict(tomllib.loads(text), source="flexmodes.toml")
+    return text
 
 
 def roll_mass(r: float) -> float:
@@ -197,7 +215,7 @@ def test_twin_flexible_drums_each_have_their_torsion1() -> None:
     first torsion modes through the set (each drum about 38 % of the energy); each is still
     labelled, ``front.torsion1`` and ``rear.torsion1``, near the chain held at its drive
     end, ``2 √(k_t/I_d) sin(π/(2(2N − 1)))`` = 200.37 Hz (the nips and the x bending at
-    197 Hz pull them: measured 2.3e-4 and 8.6e-3)."""
+    197 Hz pull them: measured 2.3e-4 and 8.6e-3). Their order-2 bending: see below."""
     from pathlib import Path
 
     from winder.analysis.modes import modes_at
@@ -211,6 +229,19 @@ def test_twin_flexible_drums_each_have_their_torsion1() -> None:
         assert m.kind == "torsion" and 0.0 < m.damping_ratio < 0.2
         assert abs(m.natural_frequency / want - 1) < 9e-2, (drum, m.natural_frequency, want)
     assert ms["front.bend.z1"].kind == "bending" and ms["set.bend.z1"].kind == "bending"
+    # issue #32: each drum's order-2 bending, shared by the twins through the set (12-24 %
+    # of each mode per drum and direction), is labelled, oscillating, near the drum's own
+    # on its bearings (the chain: 196.50 Hz; measured 7.3e-3 off); no shape label on a real
+    # eigenvalue (the set's torsion is overdamped here: before, a relaxation at ~9 Hz
+    # with damping ratio 1 carried set.torsion1)
+    chain = station_flexibility(n, 5.0, 2.26e9, 3.7e9, 1e9)
+    second = math.sqrt(np.sort(np.linalg.eigvals(np.linalg.inv(chain) / (3000.0 / n)).real)[1])
+    for c in ("front.bend.x2", "front.bend.z2", "rear.bend.x2", "rear.bend.z2"):
+        assert ms[c].kind == "bending" and 0.0 < ms[c].damping_ratio < 0.2, ms.get(c)
+        assert abs(2 * math.pi * ms[c].natural_frequency / second - 1) < 7e-2, ms[c]
+    labelled = [m for m in ms.values() if m.kind in ("bending", "torsion")]
+    assert all(m.eigenvalue.imag > 0 for m in labelled)
+    assert "set.torsion1" not in ms
 
 
 def test_free_flexible_bodies_add_no_zero_root() -> None:
@@ -243,3 +274,186 @@ def test_free_flexible_bodies_add_no_zero_root() -> None:
     key = lambda z: (round(z.real, 3), round(z.imag, 3))  # noqa: E731
     assert np.max(np.abs(np.array(sorted(got, key=key)) - np.array(sorted(nonzero, key=key)))
                   ) < 3e-13 * top
+
+
+# ---- issue #32 item 6: a label from the mode's shape, never from a relaxation ------------------
+def held_torsion1(n: int = N, length: float = L, gj: float = GJ, inertia: float = 1400.0
+                  ) -> float:
+    """The first mode [Hz] of the torsion chain held at its driven segment: ``N − 1`` disks
+    ``J/N`` on springs ``GJ N/L``, ``ω₁ = 2 √(k_t/I_d) sin(π/(2(2N − 1)))``."""
+    kt, Id = gj * n / length, inertia / n
+    return 2 * math.sqrt(kt / Id) * math.sin(math.pi / (2 * (2 * n - 1))) / (2 * math.pi)
+
+
+def lone_bend1(n: int = N, length: float = L, mass: float = MD) -> float:
+    """The first bending frequency [Hz] of the drum alone on its bearings: the chain of
+    ``N`` masses ``m/N`` on the inverse of the closed-form flexibility at the stations."""
+    F = station_flexibility(n, length, EI, None, KB)
+    return float(np.sqrt(np.min(np.linalg.eigvals(np.linalg.inv(F) / (mass / n)).real))
+                 / (2 * np.pi))
+
+
+#: The reproduction of issue #32 item 6: a 6 m drum (4.3 t, GJ = 2.26e9 N·m²) whose held
+#: chain's first torsion mode is 138.07 Hz, under the light roll on the soft nip; the
+#: nip's friction relaxes at (v + v_min)/σ, slower than that torsion mode in every case.
+RELAX = {"length": 6.0, "mass": 4300.0, "gj": 2.26e9}
+RELAX_CASES = [(10.9, 0.1), (41.7, 0.1), (41.7, 0.055)]  # 17.5, 66.5, 121 Hz
+
+
+@pytest.mark.parametrize("v, sigma", RELAX_CASES)
+def test_torsion_label_is_the_held_chains_mode_not_a_relaxation(v: float, sigma: float
+                                                                ) -> None:
+    """Issue #32 item 6: with the nip's friction relaxing at ``(v + v_min)/σ`` (17.5, 66.5
+    and 121 Hz here) below the drum's first torsion mode (the held chain: 138.07 Hz),
+    ``drum.torsion1`` is the oscillating mode of the held chain's frequency, once (measured
+    1.2e-4, 3.5e-4, 4.3e-4 at r = 0.1 m: the light roll's inertia through the nip); the
+    slices' relaxation modes (real, ``−(v + v_min)/σ``: seven of the eight within 6.5e-4,
+    the eighth coupled to the roll's slip) carry no shape label; every mode with a shape
+    label (bending or torsion) is an oscillating pair. Before the fix 3-4 modes were
+    ``drum.torsion1``, the relaxations among them with damping ratio 1, and the map kept
+    the slowest: 17.5 Hz."""
+    s = scene(v=v, sigma=sigma, **RELAX)
+    ms = modes_at(s, 0.1)
+    rate = (v + 0.1) / sigma
+    want = held_torsion1(length=6.0, gj=2.26e9)
+    assert rate < 2 * math.pi * want  # the relaxations are slower than the torsion mode
+    t1 = [m for m in ms if m.coordinate == "drum.torsion1"]
+    assert len(t1) == 1, t1
+    assert t1[0].kind == "torsion" and t1[0].eigenvalue.imag > 0
+    assert abs(t1[0].natural_frequency / want - 1) < 4e-3, (t1[0], want)
+    for m in ms:  # a shape label only on an oscillating pair
+        if m.kind in ("bending", "torsion"):
+            assert m.eigenvalue.imag > 0 and m.damping_ratio < 1, m
+    relax = [m for m in ms if m.eigenvalue.imag == 0 and abs(-m.eigenvalue.real / rate - 1)
+             < 5e-3]
+    assert len(relax) >= N - 1, [m.eigenvalue for m in ms if m.eigenvalue.imag == 0]
+    assert all(m.kind == "slip" and ".torsion" not in m.coordinate
+               and ".bend." not in m.coordinate for m in relax)
+
+
+def test_map_torsion1_is_the_held_chain_at_every_radius() -> None:
+    """The map of the reproduction (relaxation at 17.5 Hz): ``drum.torsion1`` at every
+    radius is the held chain's 138.07 Hz (measured 4.8e-5 at r = 0.06 m to 1.0e-3 at 0.3 m,
+    the roll's inertia growing; before the fix 17.506 Hz, the relaxation, with damping
+    ratio 1: 0.87 off), with damping ratio < 1, and no torsion label of the map carries a
+    damping ratio of 1."""
+    mm = mode_map(scene(v=10.9, sigma=0.1, **RELAX), np.linspace(0.06, 0.3, 5))
+    want = held_torsion1(length=6.0, gj=2.26e9)
+    got = mm.torsion["drum.torsion1"]
+    assert np.max(np.abs(got / want - 1)) < 1e-2, (got, want)
+    for c, z in mm.torsion_damping.items():
+        assert np.all(np.isnan(z) | (z < 1.0)), (c, z)
+
+
+# ---- issue #32 item 5: a machine without a wound roll, or with contact off -------------------
+def test_lone_flexible_drum_modes_at_its_initial_state(tmp_path) -> None:
+    """Issue #32 item 5: the flexible drum alone on its bearings (no roll, nip or web): one
+    row at its initial state; ``drum.bend.z1`` and ``drum.bend.x1`` are the closed-form
+    chain of the drum on its bearings (43.18 Hz; 0.88 % below the continuous beam's: the
+    lumping), ``drum.torsion1`` the held chain (103.70 Hz): measured 6e-14, 2e-15;
+    undamped. ``winder modes`` exits 0 and its CSV is that one row with the map's columns;
+    the figure draws it (markers)."""
+    s = scene(roll=False)
+    mm = mode_map(s)
+    assert len(mm.radius) == 1 and np.isnan(mm.radius[0]) and mm.initial_state
+    bend = lone_bend1()
+    for c in ("drum.bend.z1", "drum.bend.x1"):
+        assert abs(mm.natural[c][0] / bend - 1) < 1e-12, (c, mm.natural[c][0], bend)
+        assert abs(mm.dampings[c][0]) < 1e-12
+    assert abs(mm.torsion["drum.torsion1"][0] / held_torsion1() - 1) < 1e-12
+    assert {m.coordinate for m in modes_at(s)} >= {"drum.bend.z1", "drum.torsion1"}
+    with pytest.raises(winder.ArgumentError, match=r"radius = 0.3 .*no wound roll"):
+        modes_at(s, 0.3)
+    with pytest.raises(winder.ArgumentError, match=r"radius_min = 0.1 .*no wound roll"):
+        mode_map(s, radius_min=0.1)
+    path = tmp_path / "lone.toml"
+    path.write_text(scene_text(roll=False))
+    csv, png = tmp_path / "m.csv", tmp_path / "m.png"
+    proc = subprocess.run([sys.executable, "-m", "winder", "modes", str(path), "--csv",
+                           str(csv), "--plot", str(png)], capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert "initial state" in proc.stdout
+    table = np.genfromtxt(csv, delimiter=",", names=True)
+    assert table.shape == () and table.dtype.names == tuple(mm.as_columns())
+    assert table["drum_bend_z1_frequency"] == pytest.approx(bend, rel=1e-9)
+    assert table["drum_torsion1_frequency"] == pytest.approx(held_torsion1(), rel=1e-9)
+    image = plt.imread(png)
+    assert image.shape[0] > 300 and np.ptp(image[..., :3]) > 0.5
+    bad = subprocess.run([sys.executable, "-m", "winder", "modes", str(path), "--csv",
+                          str(tmp_path / "bad.csv"), "--radius-min", "0.1"],
+                         capture_output=True, text=True, timeout=600)
+    assert bad.returncode == 2 and "--radius-min" in bad.stderr
+    assert "Traceback" not in bad.stderr and not (tmp_path / "bad.csv").exists()
+
+
+def test_contact_off_gives_the_free_bodies_modes() -> None:
+    """Issue #32 item 5: the drum under its roll with ``[effects] contact = false``: the
+    drum's modes are those of the drum alone (the chain on its bearings, the held torsion
+    chain: measured 1.8e-14, 4.6e-15), the roll free in ``z`` falls freely: its mode is a
+    zero eigenvalue (exactly 0), free, not overdamped; every bending order of the drum is
+    labelled (its x and z orders of equal frequency, any mix of the two an eigenvector,
+    are split by coordinate: without that ``drum.bend.x5`` found no mode)."""
+    mm = mode_map(scene(contact=False))
+    assert len(mm.radius) == 1 and mm.radius[0] == RC and mm.initial_state
+    assert abs(mm.natural["drum.bend.z1"][0] / lone_bend1() - 1) < 1e-12
+    assert abs(mm.torsion["drum.torsion1"][0] / held_torsion1() - 1) < 1e-12
+    for k in range(1, N + 1):  # equal bearings: x and z alike (measured 5e-14)
+        x, z = mm.natural[f"drum.bend.x{k}"][0], mm.natural[f"drum.bend.z{k}"][0]
+        assert abs(x / z - 1) < 1e-12, (k, x, z)
+    assert mm.frequencies["roll.z"][0] == 0.0 and mm.natural["roll.z"][0] == 0.0
+    assert mm.overdamped("roll.z") == []  # free, not overdamped
+
+
+def test_a_friction_oscillation_takes_no_shape_label() -> None:
+    """The labelling on a hand-built Jacobian: two masses (``b.bend.z1``, a shape label, and
+    ``r.z``) on springs ``k₁ = 100``, ``k₂ = 400``, coupled by ``k_c = 50`` (unit masses),
+    and two friction-like states oscillating by themselves at ``w = 3`` rad/s that push the
+    first mass (``ε = 1``). The friction oscillation moves the masses as ``(K − w²)⁻¹ e₁``,
+    98.7 % ``b.bend.z1`` by kinetic energy, more than the masses' own first mode (97.4 %),
+    but its mechanical participation is 0 (the left eigenvector has no mass part; measured
+    exactly 0): ``b.bend.z1`` is the masses' mode at ``√λ₁(K)`` (closed form, measured
+    1e-16) and the friction oscillation a slip mode. Without the participation gate
+    (``MECHANICAL_SHARE = 0``) ``b.bend.z1`` is the friction's 3 rad/s and this fails.
+    Two more masses, each on ``k = 100`` with damping ``c = 100`` (ζ = 5: two real roots
+    ``−50 ± √2400``): the shape label ``b.bend.z2`` names no mode (only an oscillating one
+    may carry it), the rigid ``q.z`` names one of its real roots (closed form, measured
+    1e-16): overdamped. Were every mode left over of a twist's shape, none would be a
+    torsion mode (none oscillates with the masses): without the oscillation gate the
+    friction's pair or a real root would be ``b.torsion1``."""
+    from types import SimpleNamespace
+
+    from winder.analysis.mode_labels import label_modes
+
+    k1, k2, kc, w, eps, k, c = 100.0, 400.0, 50.0, 3.0, 1.0, 100.0, 100.0
+    K = np.zeros((4, 4))
+    K[:2, :2] = [[k1 + kc, -kc], [-kc, k2 + kc]]
+    K[2, 2] = K[3, 3] = k
+    A = np.zeros((10, 10))
+    A[0:4, 4:8] = np.eye(4)
+    A[4:8, 0:4] = -K
+    A[6, 6] = A[7, 7] = -c
+    A[4, 8] = eps
+    A[8, 9], A[9, 8] = w, -w
+    labels = ["b.bend.z1", "r.z", "b.bend.z2", "q.z"]
+    # as if every mode left over had a twist's shape: only an oscillating mode of the
+    # masses may carry a torsion label, and none is left over
+    shapes = SimpleNamespace(Q=np.eye(4), labels=labels,
+                             torsion_label=lambda *a: ("b.torsion1", 1.0))
+    ms = label_modes(A, shapes=shapes, n_positions=4, n_speeds=0, mass=np.ones(4),
+                     inertia=np.zeros(0),
+                     names=[*labels, *(f"{x}_dot" for x in labels), "F1", "F2"],
+                     mechanical=np.array([True] * 8 + [False] * 2))
+    by = {m.coordinate: m for m in ms}
+    want = math.sqrt(np.linalg.eigvalsh(K[:2, :2])[0])
+    assert by["b.bend.z1"].kind == "bending"
+    assert abs(by["b.bend.z1"].eigenvalue.imag / want - 1) < 1e-12, by["b.bend.z1"]
+    friction = [m for m in ms if abs(abs(m.eigenvalue) - w) < 1e-9]
+    assert len(friction) == 1 and friction[0].kind == "slip"
+    assert friction[0].coordinate in ("F1", "F2")
+    assert {m.coordinate for m in ms if m.kind == "slip"} - {"F1", "F2"} == \
+        {"b.bend.z2_dot", "q.z_dot"}  # the real roots left over, by their velocity
+    assert "b.bend.z2" not in by and "b.torsion1" not in by
+    roots = -c / 2 + np.array([1, -1]) * math.sqrt(c * c / 4 - k)
+    assert by["q.z"].kind == "bounce" and by["q.z"].frequency == 0.0
+    assert np.min(np.abs(by["q.z"].eigenvalue.real / roots - 1)) < 1e-12

@@ -368,8 +368,13 @@ def test_modes_cli_against_closed_forms(models_dir, tmp_path) -> None:
     (lambda s: mode_map(s, []), r"radii must be a 1-D array of 1 … 10000 radii"),
     (lambda s: mode_map(s.replace(drum={"drive": {"web_speed": 0.0}})),
      r"web_speed is not given and the scene's \[drum.drive\] web_speed is 0.0"),
+    (lambda s: operating_point(s.replace(effects={"contact": False,
+                                                  "slip_relaxation": False}), 0.3),
+     r"needs the nip: \[effects\] contact = false"),
     (lambda s: modes_at(s.replace(effects={"contact": False, "slip_relaxation": False}),
-                        0.3), r"needs the nip: \[effects\] contact = false"),
+                        0.3), r"modes_at: radius = 0.3 m: .*\[effects\] contact = false.*"
+                              r"initial state; valid: no radius"),
+    (lambda s: modes_at(s), r"modes_at: radius is required"),
     (lambda s: modes_at(s.replace(effects={"gravity": False}), 0.3),
      r"needs the roll's weight on the nip, but \[effects\] gravity = false"),
     (lambda s: modes_at(s.replace(drum={"drive": {"kind": "torque"}}), 0.3),
@@ -451,3 +456,60 @@ def test_exact_jacobian_in_implicit_methods(models_dir) -> None:
         np.testing.assert_allclose(a[k], b[k], rtol=1e-5, atol=1e-6 * np.max(np.abs(b[k])))
     with pytest.raises(winder.ArgumentError, match="valid: exact, fd, pinocchio"):
         winder.simulate(scene, t_end=0.1, jacobian="analytic")
+
+
+def test_contact_off_two_drum_modes_are_free_masses(models_dir, tmp_path) -> None:
+    """Issue #32 item 5: the two-drum winder with ``[effects] contact = false`` (``winder
+    run`` accepts it): one row at its initial state. Nothing holds the set (free in x, z)
+    or the rider (free in z): the rider's rows of the Jacobian vanish (gravity and its load
+    are constant: a zero eigenvalue, measured exactly 0); the set's only stiffness is the
+    web's pull ``T`` at the nip turning with the line of centres, ``K = T/(m d) · n tᵀ``
+    (``n`` along the line of centres to the rear drum, ``d`` = 0.55 m, ``t ⊥ n``):
+    ``|K|_F = T/(m d)`` (measured exact), nilpotent (trace and determinant 0: measured 8e-17
+    and 9e-17 of ``|K|``, ``|K|²``), so its modes are zero eigenvalues too (round-off splits
+    the fourfold root to ``(ε |K|²)^¼``: |λ|/2π = 1.1e-4 Hz, below ``FREE_BELOW`` = 1e-3).
+    ``set.x``, ``set.z``, ``rider.z`` are reported free (0 Hz), neither oscillating nor
+    overdamped. ``winder modes`` exits 0 with the one row and the map's columns; radii are
+    refused."""
+    from winder.analysis.modes import FREE_BELOW, _at_rest
+
+    text = (models_dir / "two_drum_winder.toml").read_text()
+    text = re.sub(r"(?m)^(contact|slip_relaxation) = true", r"\1 = false", text)
+    path = tmp_path / "apart.toml"
+    path.write_text(text)
+    scene = winder.load_scene(path)
+    assert not scene.effects.contact
+    lin = _at_rest(scene, "test", None)
+    y = lin.initial()
+    A = lin.fast_jacobian(y)
+    names = [lin.machine.state_names[i] for i in lin.fast]
+    acc = [names.index(f"set.{c}_dot") for c in "xz"]
+    K = A[np.ix_(acc, [names.index("set.x"), names.index("set.z")])]
+    d = math.hypot(y[lin.system.index("set.x")] - 0.525, y[lin.system.index("set.z")])
+    norm = 1000.0 / (40.0 * d)  # T / (m d): the core alone at r = r_c
+    assert np.linalg.norm(K) == pytest.approx(norm, rel=1e-13)
+    assert abs(np.trace(K)) < 1e-15 * norm and abs(np.linalg.det(K)) < 1e-15 * norm ** 2
+    assert not np.any(A[names.index("rider.z_dot")])
+    ms = modes_at(scene)
+    assert ms and all(m.natural_frequency < FREE_BELOW for m in ms)
+    bounce = {m.coordinate: m for m in ms if m.kind == "bounce"}
+    assert set(bounce) == {"set.x", "set.z", "rider.z"}
+    assert bounce["rider.z"].eigenvalue == 0
+    mm = mode_map(scene)
+    assert mm.initial_state and len(mm.radius) == 1 and mm.radius[0] == 0.05
+    for c in ("set.x", "set.z", "rider.z"):
+        assert mm.natural[c][0] < FREE_BELOW and mm.overdamped(c) == []
+    np.testing.assert_allclose(mm.rotation_1x, 41.7 / (2 * math.pi * 0.05), rtol=1e-12)
+    with pytest.raises(winder.ArgumentError, match=r"radii given: .*contact = false"):
+        mode_map(scene, [0.1, 0.2])
+    csv = tmp_path / "m.csv"
+    proc = subprocess.run([sys.executable, "-m", "winder", "modes", str(path), "--csv",
+                           str(csv), "--plot", str(tmp_path / "m.png")],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert "initial state" in proc.stdout and "contact = false" in proc.stdout
+    assert "bounce mode set.z 0 Hz: free" in proc.stdout
+    table = np.genfromtxt(csv, delimiter=",", names=True)
+    assert table.shape == () and table.dtype.names == tuple(mm.as_columns())
+    assert table["rider_z_frequency"] == 0.0 and table["radius"] == 0.05
+    assert (tmp_path / "m.png").exists()

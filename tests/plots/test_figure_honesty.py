@@ -14,6 +14,7 @@ from conftest import MODELS
 import winder
 import winder.plots.figures as _plots
 from winder.cli import main
+from winder.plots.campbell import campbell_figure
 
 
 def test_torque_panels_full_range_and_clipped_share() -> None:
@@ -153,7 +154,7 @@ def test_resonance_map_axis_is_the_maps_radii(tmp_path, monkeypatch):
         return save(fig, path)
 
     monkeypatch.setattr(_plots, "_save", capture)
-    _plots.campbell_figure(mm, tmp_path / "map.png", result=res)
+    campbell_figure(mm, tmp_path / "map.png", result=res)
     for lo, hi in limits["map.png"]:
         assert lo == pytest.approx(0.1 - 0.004, abs=1e-12)
         assert hi == pytest.approx(0.3 + 0.004, abs=1e-12)

@@ -4,22 +4,30 @@ roll grows (a Campbell chart), for any machine from parts.
 At each radius of the wound roll (the roll the web enters, ``[web] entry_nip``) the machine
 is linearised with its exact Jacobian (:func:`winder.jacobian`) about its quasi-steady
 **operating point** (:mod:`winder.analysis.operating_point`: drums at full speed, rolls
-at constant surface speed, free coordinates in balance). Each free
-coordinate names one **bounce mode**: the eigenpair in which that coordinate carries the
-largest share of the mode's kinetic energy (``½ m |ẋ|²`` per free coordinate, ``½ J |θ̇|²``
-per turning body), an oscillating pair first (share ≥ 1/4), each pair used once
-(``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a single-drum scene); the rest are the
-slip/torsion modes. The roll turns at ``f₁ = v/(2π r)``; where ``k f₁`` (``k = 1, 2, 3``)
-or a drum's rotation frequency crosses an oscillating bounce mode, the imbalance (or a
-drum's runout) drives that mode at resonance (critical radii). For each radius the web
-speed at which the 1× line meets the roll's own vertical bounce mode is
-``v_crit = 2π r f_bounce``.
+at constant surface speed, free coordinates in balance). Each free coordinate names one
+**bounce mode** (:mod:`winder.analysis.mode_labels`): the eigenpair in which that
+coordinate carries the largest share of the mode's kinetic energy, an oscillating pair of
+the bodies first, each pair used once (``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a
+single-drum scene); the rest are the slip/torsion modes. The roll turns at
+``f₁ = v/(2π r)``; where ``k f₁`` (``k = 1, 2, 3``) or a drum's rotation frequency crosses
+an oscillating bounce mode, the imbalance (or a drum's runout) drives that mode at
+resonance (critical radii). For each radius the web speed at which the 1× line meets the
+roll's own vertical bounce mode is ``v_crit = 2π r f_bounce``.
 
 A flexible body (issue #25) has bending and torsion modes in place of its segments'
 bounce: labelled by shape, the dominant order ``n`` of the segment displacements' (or
 angles') projection onto ``sin(nπ y/L)`` (:mod:`winder.analysis.shapes`):
-``front.bend.z1``, ``set.bend.x2``, ``front.torsion1``. A harmonic ``k`` meets a bending
-mode of frequency ``f_b`` where ``k v/(2π r) = f_b``, at ``r = k v/(2π f_b)``.
+``front.bend.z1``, ``set.bend.x2``, ``front.torsion1``. Only an oscillating mode of the
+bodies whose shape it is carries such a label (issue #32): not a friction state's
+relaxation (a real eigenvalue, a slip mode), and no label where no oscillating mode has
+that shape (NaN in the map). A harmonic ``k`` meets a bending mode of frequency ``f_b``
+where ``k v/(2π r) = f_b``, at ``r = k v/(2π f_b)``.
+
+A scene without a winding operating point (no wound roll: no ``[web]``, e.g. a drum alone
+on its bearings; or ``[effects] contact = false``) has one row: the modes of the machine at
+its initial state (``winder run``'s at ``t = 0``, the imbalance off; the free bodies as
+they are, a body nothing holds with a zero eigenvalue), ``radius`` the wound roll's initial
+radius (none: NaN), the same columns (:attr:`ModeMap.initial_state`).
 """
 
 from __future__ import annotations
@@ -33,13 +41,16 @@ import numpy as np
 from winder._args import integer, number, show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.operating_point import (
+    WEB_SPEED_MAX,
     Mode,
+    _check_type,
     _core_key,
     _entry_drive,
     _Linearisation,
     _linearisation,
     _radius,
     operating_point,
+    winding_reason,
 )
 from winder.parts.roll import KEYS as ROLL_KEYS
 from winder.scene.load import Scene
@@ -55,22 +66,62 @@ _JUMP = 0.25
 ORDERS = (1, 2, 3)
 #: A flexible body's bending orders a chart draws (and the CLI reports).
 SHOWN_ORDERS = 2
+#: [Hz] A mode slower than this (a period beyond 1000 s, far longer than any run) is a free
+#: coordinate's (nothing holds it: a zero eigenvalue, split by round-off), not overdamped.
+FREE_BELOW = 1e-3
 
 
-def modes_at(scene: Scene, radius: float, *, web_speed: float | None = None) -> list[Mode]:
-    """Modes of the linearised machine at ``radius`` [m] and ``web_speed`` [m/s] (see
-    :func:`operating_point` for the valid range): the bounce modes, one per free
+def modes_at(scene: Scene, radius: float | None = None, *, web_speed: float | None = None
+             ) -> list[Mode]:
+    """Modes of the linearised machine at ``radius`` [m] of the wound roll and ``web_speed``
+    [m/s] (see :func:`operating_point` for the valid range): the bounce modes, one per free
     translational coordinate in the machine's order (a single-drum scene: its one bounce
-    mode first), then the slip/torsion modes."""
+    mode first; a flexible body's bending orders where an oscillating mode has that shape),
+    then the slip and torsion modes (:mod:`winder.analysis.mode_labels`). A scene without a
+    winding operating point (no wound roll, or ``[effects] contact = false``:
+    :func:`~winder.analysis.operating_point.winding_reason`) has the modes of its initial
+    state: give no ``radius`` (``web_speed`` is checked, and unused)."""
+    _check_type(scene, "modes_at")
+    reason = winding_reason(scene)
+    if reason is not None:
+        _no_radius("modes_at", "radius", radius, scene, reason)
+        lin = _at_rest(scene, "modes_at", web_speed)
+        return lin.modes(lin.initial())
     where = "operating_point"
     lin = _linearisation(scene, where, web_speed, lo_open=False)
+    if radius is None:
+        raise ArgumentError(f"modes_at: radius is required: {scene.source} winds its roll; "
+                            f"valid: a finite radius >= {_core_key(lin)} = {lin.rc:g} m")
     r = _radius(where, lin, radius)
     return lin.modes(lin.solve(r, where))
 
 
+def _no_radius(where: str, name: str, value: object, scene: Scene, reason: str) -> None:
+    """An :class:`ArgumentError` where a radius is given for a scene without a winding
+    operating point (``reason``)."""
+    if value is not None:
+        given = f"{name} = {show(value)}{' m' if isinstance(value, int | float) else ''}" \
+            if name != "radii" else "radii given"
+        raise ArgumentError(f"{where}: {given}: {scene.source} has {reason}, so no map "
+                            "over a wound roll's radius: its modes are those of its initial "
+                            f"state; valid: no {name}")
+
+
+def _at_rest(scene: Scene, where: str, web_speed: float | None) -> _Linearisation:
+    """The machine of a scene without a winding operating point, for the modes of its
+    initial state; ``web_speed`` [m/s] (``>= 0``) checked."""
+    v = math.nan
+    if web_speed is not None:
+        v = number(where, "web_speed", web_speed, lo=0.0, hi=WEB_SPEED_MAX, unit="m/s")
+    elif scene.web is not None:
+        v = _entry_drive(scene).drive_web_speed()
+    return _Linearisation(scene, v, winding=False)
+
+
 @dataclass(frozen=True)
 class ModeMap:
-    """Modes against the wound roll's radius. Arrays over ``radius`` [m]; frequencies
+    """Modes against the wound roll's radius (or, :attr:`initial_state`, one row: the
+    modes at the initial state). Arrays over ``radius`` [m]; frequencies
     [Hz]; speeds [m/s].
 
     ``frequencies``/``dampings``: per bounce mode (``coordinates``, e.g. ``set.x``) its
@@ -96,10 +147,16 @@ class ModeMap:
     #: per bounce mode its natural frequency ``|λ|/2π`` [Hz] (also where it is overdamped)
     natural: dict[str, np.ndarray] = field(default_factory=dict)
     #: per torsion mode of a flexible body (``BODY.torsion{n}``) its natural frequency
-    #: ``|λ|/2π`` [Hz] (as the slip mode's: the nips' friction overdamps most torsion
-    #: modes) and damping ratio [-]; NaN at a radius where no mode has that label
+    #: ``|λ|/2π`` [Hz] and damping ratio [-] (< 1: only an oscillating mode of that shape
+    #: carries the label); NaN at a radius where no mode has that label (the nips'
+    #: friction overdamps it)
     torsion: dict[str, np.ndarray] = field(default_factory=dict)
     torsion_damping: dict[str, np.ndarray] = field(default_factory=dict)
+    #: True: one row, the modes of the machine at its initial state, where the scene has no
+    #: winding operating point (``initial_reason``: no wound roll, or contact off);
+    #: ``radius`` the wound roll's initial radius (none: NaN)
+    initial_state: bool = False
+    initial_reason: str = ""
 
     @property
     def coordinates(self) -> list[str]:
@@ -124,26 +181,29 @@ class ModeMap:
     @property
     def main(self) -> str:
         """The wound roll's vertical mode (``ROLL.z``; flexible: ``ROLL.bend.z1``), else
-        the first."""
+        the first; ``""`` for a machine without free coordinates."""
         for z in (f"{self.roll}.z", f"{self.roll}.bend.z1"):
-            if z in self.frequencies:
+            if self.roll and z in self.frequencies:
                 return z
-        return self.coordinates[0]
+        return self.coordinates[0] if self.coordinates else ""
 
     @property
     def bounce_frequency(self) -> np.ndarray:
-        return self.frequencies[self.main]
+        return self.frequencies.get(self.main, np.full(len(self.radius), np.nan))
 
     @property
     def bounce_damping(self) -> np.ndarray:
-        return self.dampings[self.main]
+        return self.dampings.get(self.main, np.full(len(self.radius), np.nan))
 
     def overdamped(self, mode: str | None = None) -> list[tuple[float, float]]:
         """The radius ranges ``(first, last)`` [m] over which a bounce mode (default
         :attr:`main`) is overdamped: its eigenvalue is real (damping ratio 1, damped
         frequency 0), so it has no oscillation and no crossing there (the nips' damping and
-        the friction relaxation couple into it)."""
-        over = self.frequencies[mode or self.main] == 0.0
+        the friction relaxation couple into it); not where its eigenvalue is zero (a free
+        coordinate: nothing holds it; ``|λ|/2π`` below :data:`FREE_BELOW`)."""
+        mode = mode or self.main
+        over = (self.frequencies[mode] == 0.0) & (self.natural[mode] >= FREE_BELOW) \
+            if mode in self.natural else self.frequencies[mode] == 0.0
         out, i = [], 0
         while i < len(over):
             if over[i]:
@@ -210,14 +270,23 @@ class ModeMap:
     def summary(self) -> list[str]:
         """The lines ``winder modes`` prints: each bounce mode from the first to the last
         radius (where it is overdamped), then where each harmonic meets it; a flexible
-        machine: the modes :meth:`shown` and only the crossings found."""
+        machine: the modes :meth:`shown` and only the crossings found (a bending or torsion
+        mode from its first to its last radius where an oscillating mode has its shape); a
+        map of the initial state: each mode at it."""
+        if self.initial_state:
+            return self._initial_summary()
         if self.flexible:
             out = []
             for c in self.shown():
                 f = self.frequencies.get(c, self.torsion.get(c))
                 kind = "torsion" if c in self.torsion else \
                     "bending" if ".bend." in c else "bounce"
-                out.append(f"{kind} mode {c} {f[0]:.1f} -> {f[-1]:.1f} Hz")
+                ok = np.nonzero(np.isfinite(f))[0]
+                out.append(f"{kind} mode {c} {f[ok[0]]:.1f} -> {f[ok[-1]]:.1f} Hz"
+                           + ("" if len(ok) == len(f) else
+                              f" (found at {len(ok)} of {len(f)} radii)")
+                           if len(ok) else f"{kind} mode {c}: no oscillating mode of this "
+                           "shape over the map")
             crossings = self.crossings(self.shown())
             out += [f"{h} rotation meets {c} at r = {rc:.4f} m" for c, h, rc in crossings]
             return out or ["no harmonic meets these modes over the map's radii"]
@@ -236,6 +305,36 @@ class ModeMap:
                 out.append(f"{h} rotation meets the bounce mode{'' if one else ' ' + c} at "
                            "r = " + (", ".join(f"{x:.4f} m" for x in crit) if crit
                                      else "(no crossing)"))
+        return out
+
+    def _initial_summary(self) -> list[str]:
+        """The lines of a map of the initial state: each bounce or bending mode (a flexible
+        body's :meth:`shown` orders) and torsion mode at it, the slowest slip mode, the
+        drums' rotation."""
+        out = []
+        shown = self.shown() if self.flexible else self.coordinates
+        for c in shown:
+            f = self.frequencies.get(c, self.torsion.get(c))[0]
+            z = self.dampings[c][0] if c in self.dampings else self.torsion_damping[c][0]
+            kind = "torsion" if c in self.torsion else "bending" if ".bend." in c \
+                else "bounce"
+            if not np.isfinite(f):
+                out.append(f"{kind} mode {c}: no oscillating mode of this shape")
+            elif c in self.natural and self.natural[c][0] < FREE_BELOW:
+                out.append(f"{kind} mode {c} 0 Hz: free, nothing holds it (|λ|/2π = "
+                           f"{self.natural[c][0]:.2g} Hz: a zero eigenvalue)")
+            elif c in self.frequencies and f == 0.0:
+                out.append(f"{kind} mode {c} overdamped (real eigenvalue, "
+                           f"|λ|/2π = {self.natural[c][0]:.1f} Hz)")
+            else:
+                out.append(f"{kind} mode {c} {f:.1f} Hz, damping ratio {z:.3f}")
+        if not shown:
+            out.append("no free coordinate and no flexible body: no bounce, bending or "
+                       "torsion mode")
+        if np.isfinite(self.slip_frequency[0]):
+            out.append(f"slowest slip mode |λ|/2π = {self.slip_frequency[0]:.1f} Hz, damping "
+                       f"ratio {self.slip_damping[0]:.3f}")
+        out += [f"{name} rotation {f:.2f} Hz" for name, f in self.drum_rotation.items()]
         return out
 
     def as_columns(self) -> dict[str, np.ndarray]:
@@ -306,13 +405,26 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     one caliper per revolution at no slip: ``r² = r₀² + h L/π`` with ``L`` the paper brought
     in by the drive's ramp and full speed)) at ``web_speed`` [m/s] (``> 0``; default the
     scene's). Each radius starts from the operating point of the one before (continuation).
+    A scene without a winding operating point (no wound roll, or ``[effects] contact =
+    false``) gives one row, the modes of its initial state (:attr:`ModeMap.initial_state`;
+    ``n`` checked and unused, ``web_speed`` [m/s] ``>= 0`` only for the drums' rotation,
+    default each drum's own).
 
     Raises
     ------
-    ArgumentError: ``n``, ``radii`` or ``web_speed`` out of range, or a scene without a
-        winding operating point (see :func:`operating_point`).
+    ArgumentError: ``n``, ``radii`` or ``web_speed`` out of range, a scene whose winding
+        operating point cannot be found (see :func:`operating_point`), or radii given for
+        a scene without one.
     """
     where = "mode_map"
+    _check_type(scene, where)
+    reason = winding_reason(scene)
+    if reason is not None:  # one row: the modes of the initial state
+        integer(where, "n", n, lo=2, hi=MAX_POINTS)  # checked, unused
+        for name, value in (("radii", radii), (_names[0], radius_min),
+                            (_names[1], radius_max)):
+            _no_radius(where, name, value, scene, reason)
+        return _initial_map(scene, where, web_speed, reason)
     lin = _linearisation(scene, where, web_speed, lo_open=True)
     v, rc = lin.v, lin.rc
     if radii is None:
@@ -335,6 +447,26 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
         key = _core_key(lin)
         raise ArgumentError(f"{where}: radii[{i}] = {float(radii[i])!r} is out of range; "
                             f"valid: finite radii >= {key} = {rc:g} m")
+    rows = []
+    prev = None
+    for r in radii:  # continued in radius from the previous point
+        if prev is None:
+            start, guess = None, None
+        else:
+            start, guess = lin.continued(float(r), where, prev)
+        y = lin.solve(float(r), where, start)
+        prev = (y, guess if guess is not None else lin.guess(float(r)))
+        rows.append(lin.modes(y))
+    drums = {b.segment_of or b.name: b.operating_speed(v) / (2 * math.pi)
+             for b in lin.machine.bodies if b.prescribed}  # a flexible drum by its name
+    surface = lin.machine.entry.a.surface_speed(v)  # the roll's surface: ratio · v
+    return _assembled(lin, scene, radii, rows, surface / (2 * math.pi * radii), drums)
+
+
+def _assembled(lin: _Linearisation, scene: Scene, radii: np.ndarray, rows: list[list[Mode]],
+               rotation_1x: np.ndarray, drums: dict[str, float], reason: str = ""
+               ) -> ModeMap:
+    """The :class:`ModeMap` of the modes ``rows`` (one list per radius of ``radii``)."""
     nt = len(lin.labels)
     torsion: dict[str, np.ndarray] = {}
     tdamp: dict[str, np.ndarray] = {}
@@ -342,34 +474,41 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     damp = np.full((nt, len(radii)), np.nan)
     natural = np.full((nt, len(radii)), np.nan)
     slip = np.full((2, len(radii)), np.nan)
-    prev = None
-    for i, r in enumerate(radii):  # continued in radius from the previous point
-        if prev is None:
-            start, guess = None, None
-        else:
-            start, guess = lin.continued(float(r), where, prev)
-        y = lin.solve(float(r), where, start)
-        prev = (y, guess if guess is not None else lin.guess(float(r)))
-        ms = lin.modes(y)
-        for m in ms[:nt]:
-            j = lin.labels.index(m.coordinate)
-            freq[j, i], damp[j, i] = m.frequency, m.damping_ratio
-            natural[j, i] = m.natural_frequency
-        slips = [m for m in ms[nt:] if m.kind == "slip"]
-        if slips:
-            slip[:, i] = slips[0].natural_frequency, slips[0].damping_ratio
-        for m in ms[nt:]:  # the slowest mode of each torsion label
-            if m.kind == "torsion":
+    for i, ms in enumerate(rows):
+        for m in ms:
+            if m.kind in ("bounce", "bending"):
+                j = lin.labels.index(m.coordinate)
+                freq[j, i], damp[j, i] = m.frequency, m.damping_ratio
+                natural[j, i] = m.natural_frequency
+            elif m.kind == "torsion":  # each label on one oscillating mode
                 f = torsion.setdefault(m.coordinate, np.full(len(radii), np.nan))
                 d = tdamp.setdefault(m.coordinate, np.full(len(radii), np.nan))
-                if np.isnan(f[i]):  # |λ|/2π: the nips' friction damps torsion heavily
-                    f[i], d[i] = m.natural_frequency, m.damping_ratio
-    drums = {b.segment_of or b.name: b.operating_speed(v) / (2 * math.pi)
-             for b in lin.machine.bodies if b.prescribed}  # a flexible drum by its name
-    surface = lin.machine.entry.a.surface_speed(v)  # the roll's surface: ratio · v
+                f[i], d[i] = m.natural_frequency, m.damping_ratio
+        slips = [m for m in ms if m.kind == "slip"]
+        if slips:
+            slip[:, i] = slips[0].natural_frequency, slips[0].damping_ratio
     order = sorted(torsion, key=lambda c: (c.rsplit(".", 1)[0], int(c.rsplit("n", 1)[1])))
+    roll = "" if lin.roll is None else lin.roll.segment_of or lin.roll.name
     return ModeMap(radii, dict(zip(lin.labels, freq, strict=True)),
-                   dict(zip(lin.labels, damp, strict=True)), slip[0], slip[1],
-                   surface / (2 * math.pi * radii), v, lin.roll.segment_of or lin.roll.name, drums,
-                   naming_of(scene), dict(zip(lin.labels, natural, strict=True)),
-                   {c: torsion[c] for c in order}, {c: tdamp[c] for c in order})
+                   dict(zip(lin.labels, damp, strict=True)), slip[0], slip[1], rotation_1x,
+                   lin.v, roll, drums, naming_of(scene),
+                   dict(zip(lin.labels, natural, strict=True)),
+                   {c: torsion[c] for c in order}, {c: tdamp[c] for c in order},
+                   initial_state=bool(reason), initial_reason=reason)
+
+
+def _initial_map(scene: Scene, where: str, web_speed: float | None, reason: str) -> ModeMap:
+    """The one-row map of a scene without a winding operating point (``reason``): the
+    modes of its initial state; ``radius`` the wound roll's initial radius (none: NaN), the
+    drums' rotation at ``web_speed`` (default: each drum's own drive ``web_speed``)."""
+    lin = _at_rest(scene, where, web_speed)
+    y = lin.initial()
+    drums = {}
+    for b in lin.machine.bodies:
+        if b.prescribed:
+            v = b.drive_web_speed() if web_speed is None else lin.v
+            drums[b.segment_of or b.name] = b.operating_speed(v) / (2 * math.pi)
+    r = np.array([y[lin.i_r] if lin.roll is not None else math.nan])
+    surface = lin.machine.entry.a.surface_speed(lin.v) if lin.roll is not None else math.nan
+    return _assembled(lin, scene, r, [lin.modes(y)], surface / (2 * math.pi * r), drums,
+                      reason)

@@ -24,25 +24,25 @@ damped Newton steps on the exact Jacobian from touching positions and no-slip sp
 nips held in contact while solving, checked in contact after). The Jacobian restricted to
 the fast states (positions and velocities of the free coordinates, rotation speeds,
 friction states, a flexible body's segment angles; the other angles and radii are slow or
-absent) gives the modes. Each free coordinate (a flexible body's: each order of its shape,
-``front.bend.z1``, :mod:`winder.analysis.shapes`) names one **bounce mode**: the eigenpair
-in which that coordinate carries the
-largest share of the mode's kinetic energy (``½ m |ẋ|²`` per free coordinate, ``½ J |θ̇|²``
-per turning body), an oscillating pair first (share ≥ 1/4), each pair used once
-(``set.x``, ``set.z``, ``rider.z``; ``roll.z`` for a single-drum scene); the rest are the
-slip modes, and the torsion modes of the flexible bodies (``front.torsion1``).
+absent) gives the modes, named by their shapes (:mod:`winder.analysis.mode_labels`): each
+free coordinate (a flexible body's: each order of its shape, ``front.bend.z1``,
+:mod:`winder.analysis.shapes`) names one **bounce mode** (``set.x``, ``set.z``,
+``rider.z``; ``roll.z`` for a single-drum scene), the flexible bodies' twist the torsion
+modes (``front.torsion1``), the rest are slip modes. A scene without a winding operating
+point (:func:`winding_reason`) has the modes of its initial state
+(:meth:`_Linearisation.initial`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from winder._args import number, show
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.linearise import jacobian
+from winder.analysis.mode_labels import Mode, label_modes
 from winder.analysis.shapes import Shapes
 from winder.model.locked_modes import AUTO, IN_CONTACT, ModeKind
 from winder.parts import BodyElement, body_elements
@@ -51,7 +51,7 @@ from winder.scene.load import Scene
 from winder.solve.equilibrium import EquilibriumError, nip_key, resting_state
 from winder.solve.system import MachineSystem
 
-__all__ = ["Mode", "operating_point", "WEB_SPEED_MAX"]
+__all__ = ["Mode", "operating_point", "winding_reason", "WEB_SPEED_MAX"]
 
 WEB_SPEED_MAX = DRIVE_KEYS["web_speed"].hi  # [m/s], as in a scene
 #: Most Newton steps of one operating point.
@@ -64,42 +64,31 @@ _ROUND_OFF = 1e-12
 _RATE_UNIT = {"x_dot": " m/s²", "z_dot": " m/s²", "theta_dot": " rad/s²", "friction": " N/s"}
 
 
-@dataclass(frozen=True)
-class Mode:
-    """One eigenvalue (of a pair): ``frequency`` [Hz] (damped, 0 for a real eigenvalue),
-    ``natural_frequency`` ``|λ|/2π`` [Hz], ``damping_ratio`` [-], ``kind`` (``bounce``,
-    ``bending``, ``slip`` or ``torsion``) and ``coordinate``: the free coordinate that
-    dominates a bounce mode (``BODY.x``/``BODY.z``), a flexible body's bending order
-    (``BODY.bend.z1``, :mod:`winder.analysis.shapes`) or torsion order
-    (``BODY.torsion1``), or the state that dominates a slip mode."""
-
-    eigenvalue: complex
-    kind: str
-    coordinate: str = ""
-
-    @property
-    def frequency(self) -> float:
-        return abs(self.eigenvalue.imag) / (2 * math.pi)
-
-    @property
-    def natural_frequency(self) -> float:
-        return abs(self.eigenvalue) / (2 * math.pi)
-
-    @property
-    def damping_ratio(self) -> float:
-        lam = self.eigenvalue
-        return -lam.real / abs(lam) if abs(lam) > 0 else 0.0
-
-
 def _where_drive(scene: Scene, body: BodyElement) -> str:
     return scene.naming.key(body.table, body.name, "drive")
 
 
-def _check_scene(scene: Scene, where: str) -> None:
-    """An :class:`ArgumentError` if the scene has no winding operating point."""
+def _check_type(scene: Scene, where: str) -> None:
     if not isinstance(scene, Scene):
         raise ArgumentTypeError(f"{where}: scene must be a winder.Scene (winder.load_scene), "
                                 f"got {show(scene)} ({type(scene).__name__})")
+
+
+def winding_reason(scene: Scene) -> str | None:
+    """Why ``scene`` has no winding operating point to map over the radius of a wound roll
+    (``[effects] contact = false``; no wound roll: no ``[web]``), or None: the resonance
+    map then holds the modes of its initial state (:func:`winder.mode_map`)."""
+    _check_type(scene, "winding_reason")
+    if not scene.effects.contact:
+        return "[effects] contact = false: the bodies are apart"
+    if scene.web is None:
+        return "no wound roll (no [web])"
+    return None
+
+
+def _check_scene(scene: Scene, where: str) -> None:
+    """An :class:`ArgumentError` if the scene has no winding operating point."""
+    _check_type(scene, where)
     if not scene.effects.contact:
         raise ArgumentError(f"{where}: {scene.source}: the resonance map needs the nip: "
                             "[effects] contact = false; valid: contact = true")
@@ -159,7 +148,9 @@ class _Linearisation:
     """The machine of a scene at its operating points (see the module docstring): one
     :class:`MachineSystem` with the imbalance off and the drums at full speed ``v``."""
 
-    def __init__(self, scene: Scene, v: float) -> None:
+    def __init__(self, scene: Scene, v: float, *, winding: bool = True) -> None:
+        """``winding`` false: the machine as the scene has it (its drives' ramps), for the
+        modes at its :meth:`initial` state (no wound roll, or contact off)."""
         self.scene, self.v = scene, v
         self.system = sys_ = MachineSystem(scene)
         m = self.machine = sys_.machine
@@ -167,12 +158,14 @@ class _Linearisation:
         for b in m.bodies:
             if f"{b.name}.com_offset" in m.param_names:
                 p[m.param_index(f"{b.name}.com_offset")] = 0.0
-        for b in m.bodies:  # the prescribed ones at full speed from t = 0
+        for b in m.bodies if winding else ():  # the prescribed ones at full speed from t = 0
             b.hold_operating_speed(m, p, v)
         self.t = 0.0
-        self.roll = m.entry.b
-        self.i_r = m.index(_radius_state(self.roll))
-        self.rc = self.roll.least_radius
+        #: the wound roll (the web's), or None
+        self.roll = m.entry.b if m.entry is not None else None
+        if self.roll is not None:
+            self.i_r = m.index(_radius_state(self.roll))
+            self.rc = self.roll.least_radius
         names = m.state_names
         self.positions = [m.index(f"{b.name}.{c}") for b in m.bodies for c in b.free]
         self.coords = [f"{b.name}.{c}" for b in m.bodies for c in b.free]
@@ -196,9 +189,9 @@ class _Linearisation:
             drive = next((b for b in segs if b.prescribed), None)
             turning = [m.index(f"{b.name}.theta") for b in segs if not b.prescribed]
             self.angles += turning if drive is not None else turning[1:]
+            spin = drive.sense * drive.operating_speed(v) if winding and drive else 0.0
             for i in turning if drive is not None else turning[1:]:
-                self.twists[i] = (None, drive.sense * drive.operating_speed(v)) \
-                    if drive is not None else (turning[0], 0.0)
+                self.twists[i] = (None, spin) if drive is not None else (turning[0], 0.0)
         slow = {m.index(f"{b.name}.theta") for b in m.bodies if not b.prescribed}
         slow -= set(self.angles)
         slow |= {m.index(_radius_state(b)) for b in m.bodies if b.radius_state}
@@ -210,7 +203,7 @@ class _Linearisation:
                       for b in m.bodies if b.radius_state}
         self._speed_slots = np.arange(len(self.positions),
                                       len(self.positions) + len(self.speeds))
-        self.v_ref = min(n.part.friction.slip_velocity for n in m.nips)
+        self.v_ref = min((n.part.friction.slip_velocity for n in m.nips), default=1.0)
         self.contact = np.array([mode.kind is ModeKind.CONTACT for mode in m.modes])
         self.idle: list[str] = []  # states without dynamics, found at the first solve
         self._idle_checked = False
@@ -503,48 +496,31 @@ class _Linearisation:
 
     # ---- the modes ----------------------------------------------------------------------
     def modes(self, y: np.ndarray) -> list[Mode]:
-        """Bounce modes (in the order of the generalised coordinates :attr:`labels`: a
-        flexible body's bending orders ``BODY.bend.z1`` …), then slip modes (slowest
-        first), then torsion modes ``BODY.torsion{n}`` (slowest first), at the operating
-        point ``y``."""
-        from scipy.optimize import linear_sum_assignment
-
-        A = self.fast_jacobian(y)
-        lam, vec = np.linalg.eig(A)
-        nt, ns = len(self.positions), len(self.speeds)
-        keep = [i for i in range(len(lam)) if lam[i].imag >= 0.0]  # one of each pair
-        # kinetic energy of each eigenvector: ½ m |ẋ|² per free coordinate, ½ J |θ̇|² per
-        # turning body; a coordinate's share of it names the bounce mode
+        """Bounce and bending modes (in the order of the generalised coordinates
+        :attr:`labels` that have one: a flexible body's bending orders ``BODY.bend.z1`` …
+        only where an oscillating mode has that shape), then slip modes (slowest first),
+        then torsion modes ``BODY.torsion{n}`` (slowest first), at ``y``
+        (:func:`~winder.analysis.mode_labels.label_modes`)."""
         ev = self.system.evaluate_numeric(self.t, y, outputs=False)
         mass = np.array([float(ev.bodies[c.rsplit(".", 1)[0]].mass) for c in self.coords])
         inertia = np.array([float(ev.bodies[b.name].inertia)
                             for b in self.machine.bodies if not b.prescribed])
-        V = vec[:, keep]
-        Q = self.shapes.Q  # onto the generalised coordinates (a flexible body's orders)
-        kin = np.vstack([((Q * Q) @ mass)[:, None] * np.abs(Q @ V[nt:2 * nt]) ** 2,
-                         inertia[:, None] * np.abs(V[2 * nt:2 * nt + ns]) ** 2])
-        share = kin[:nt] / np.maximum(kin.sum(axis=0), 1e-300)
-        # each coordinate takes the eigenpair in which it has the largest share, an
-        # oscillating one first (its share >= 1/4), every pair at most once
-        oscillating = np.array([lam[i].imag > 0.0 for i in keep])
-        score = share + (oscillating[None, :] & (share >= 0.25))
-        rows, cols = linear_sum_assignment(-score)
-        bounce = {int(r): keep[int(c)] for r, c in zip(rows, cols, strict=True)}
-        names = [self.machine.state_names[i] for i in self.fast]
-        out = [Mode(complex(lam[bounce[c]]), "bending" if ".bend." in self.labels[c]
-                    else "bounce", self.labels[c]) for c in range(nt)]
-        slips, torsions = [], []
-        for k in sorted((k for k in range(len(keep)) if keep[k] not in bounce.values()),
-                        key=lambda k: abs(lam[keep[k]])):
-            i = keep[k]
-            label = self.shapes.torsion_label(V[2 * nt:2 * nt + ns, k], inertia,
-                                              float(kin[:, k].sum()))
-            if label is not None:
-                torsions.append(Mode(complex(lam[i]), "torsion", label[0]))
-            else:
-                slips.append(Mode(complex(lam[i]), "slip",
-                                  names[2 * nt + int(np.argmax(np.abs(vec[2 * nt:, i])))]))
-        return out + slips + torsions
+        others = set(self.others)
+        return label_modes(self.fast_jacobian(y), shapes=self.shapes,
+                           n_positions=len(self.positions), n_speeds=len(self.speeds),
+                           mass=mass, inertia=inertia,
+                           names=[self.machine.state_names[i] for i in self.fast],
+                           mechanical=np.array([i not in others for i in self.fast],
+                                               dtype=bool))
+
+    def initial(self) -> np.ndarray:
+        """The machine's initial state (``winder run``'s at ``t = 0``: the static balance
+        of machines.md §7) with the imbalance off, its idle states dropped: where the scene
+        has no winding operating point (:func:`winding_reason`)."""
+        y = self.system.initial_state()
+        with np.errstate(all="ignore"):
+            self._drop_idle(y)
+        return y
 
 
 def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: bool

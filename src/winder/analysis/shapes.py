@@ -17,7 +17,8 @@ Torsion: the segments' rotation speeds of a flexible body, where they carry most
 mode's kinetic energy, name a **torsion mode** ``BODY.torsion{n}``: the dominant order of
 their projection onto the body's own torsion shapes (:func:`torsion_basis`: held at the
 drive segment, or free–free); a mode whose energy is mostly a free body's rigid rotation is
-a slip mode, no torsion mode.
+a slip mode, no torsion mode. Only an oscillating mode of the bodies carries a bending or
+torsion label (:mod:`winder.analysis.mode_labels`).
 """
 
 from __future__ import annotations
@@ -99,8 +100,10 @@ class Shapes:
         bodies are ``omega`` (complex, in the order of ``speeds``; ``inertia`` [kg·m²]
         alike) and whose kinetic energy is ``total``: where the flexible bodies' segments'
         rotation carries at least half of it, the body with the most of it and the
-        dominant order of its shape in :func:`torsion_basis`; ``None`` where the twist does
-        not dominate (a slip mode: a free body turning as a whole)."""
+        dominant order of its shape in :func:`torsion_basis`, ``share`` [-] the part of
+        the kinetic energy in that body's rotation times that order's part of its shape;
+        ``None`` where the twist does not dominate (a slip mode: a free body turning as a
+        whole)."""
         best, rotation = None, 0.0
         for g in self.torsion:
             live = [r for r in g.rows if r >= 0]
@@ -119,7 +122,9 @@ class Shapes:
             return None  # mostly the rigid rotation
         phi = torsion_basis(len(g.rows), fixed)
         share = np.abs(phi @ w) ** 2 / np.sum(phi * phi, axis=1)
-        return f"{g.body}.torsion{int(np.argmax(share)) + 1}", e / max(total, 1e-300)
+        k = int(np.argmax(share))
+        return (f"{g.body}.torsion{k + 1}",
+                e / max(total, 1e-300) * share[k] / max(float(np.sum(np.abs(w) ** 2)), 1e-300))
 
 
 def torsion_basis(n: int, fixed: bool) -> np.ndarray:

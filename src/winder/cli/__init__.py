@@ -301,19 +301,29 @@ def _cmd_modes(args: argparse.Namespace) -> int:
 
     mm = mode_map(scene, web_speed=args.web_speed, n=args.points, radius_min=args.radius_min,
                   radius_max=args.radius_max, _names=("--radius-min", "--radius-max"))
-    print(f"{scene.name}: modes at {len(mm.radius)} radii, {mm.radius[0]:.3f}-"
-          f"{mm.radius[-1]:.3f} m, web speed {mm.web_speed:g} m/s")
+    if mm.initial_state:  # no wound roll, or contact off: one row
+        where = "" if math.isnan(mm.radius[0]) else \
+            f", the wound roll at r = {mm.radius[0]:.3f} m"
+        print(f"{scene.name}: modes at the initial state ({mm.initial_reason}: no map over "
+              f"a wound roll's radius{where})")
+    else:
+        print(f"{scene.name}: modes at {len(mm.radius)} radii, {mm.radius[0]:.3f}-"
+              f"{mm.radius[-1]:.3f} m, web speed {mm.web_speed:g} m/s")
     for line in mm.summary():
         print(f"  {line}")
     if csv is not None:
         atomic_write(csv, csv_writer(mm.as_columns(), fmt="%.10g"))
         print(f"  table written to {csv}")
     if plot is not None:
-        from winder.plots.figures import campbell_figure, nip_colours
+        from winder.plots.campbell import campbell_figure
+        from winder.plots.figures import nip_colours
         from winder.solve.simulate import simulate
 
         result = None
-        if args.simulate:
+        if args.simulate and mm.initial_state:
+            print("  (the normal-force envelope needs a map over a wound roll's radius: not "
+                  "simulated)", file=sys.stderr)
+        elif args.simulate:
             print("  simulating the scene for the normal-force envelope ...", file=sys.stderr)
             result = simulate(scene, progress=sys.stderr.isatty())
         out = scene.naming.output_name  # the result's channels as the scene names them
@@ -412,7 +422,9 @@ def _build_parser() -> argparse.ArgumentParser:
                           "scene's drive)")
     fmu.set_defaults(func=_cmd_fmu)
     modes = sub.add_parser("modes", help="bounce modes against the wound roll's radius and "
-                           "the rotation harmonics (resonance map)")
+                           "the rotation harmonics (resonance map); a machine without a "
+                           "wound roll, or with [effects] contact = false: its modes at the "
+                           "initial state (one row)")
     modes.add_argument("scene", help="scene file (TOML)")
     modes.add_argument("--plot", nargs="?", const="campbell.png",
                        help="write the resonance map (PNG; default name campbell.png)")
