@@ -36,6 +36,9 @@ DOCS = ROOT / "docs"
 OLD_ENGINE_PAPER = 0.50  # [s] the old engine's 700 s paper cycle, DOPRI5 rtol 1e-6, quiet
 OLD_ENGINE_STIFF = "about 28 min (LSODA, Pinocchio backend, finite-difference Jacobian)"
 IMPLICIT = ("Radau", "BDF", "LSODA")
+#: No evaluation budget: each attempt is capped by its wall clock alone (the step-wise
+#: paths' default budget would stop them first).
+MAX_RHS = 10**12
 
 
 def run(scene: winder.Scene, method: str, *, repeats: int, max_wall: float,
@@ -45,7 +48,8 @@ def run(scene: winder.Scene, method: str, *, repeats: int, max_wall: float,
     for _ in range(repeats):
         t0, c0 = time.perf_counter(), time.process_time()
         try:
-            res = winder.simulate(scene, method=method, rtol=1e-6, max_wall=max_wall, **kw)
+            res = winder.simulate(scene, method=method, rtol=1e-6, max_wall=max_wall,
+                                  max_rhs=MAX_RHS, **kw)
         except winder.SimulationError as exc:
             msg = str(exc)
             need = re.search(r"needs about ([0-9.e+]+) evaluations and ([0-9.e+]+) s", msg)

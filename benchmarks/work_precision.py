@@ -109,6 +109,7 @@ class Problem:
         return winder.simulate(self.scene, t_end=t_end or self.t_end, method=method, rtol=rtol,
                                atol=rtol * 1e-2, output_step=self.output_step,
                                backend=backend, max_step=max_step, max_wall=max_wall,
+                               max_rhs=10**12,  # capped by max_wall alone
                                t_start=self.t_start, initial_state=self.y0,
                                jacobian=jacobian)
 

@@ -13,7 +13,7 @@ from typing import Any
 from winder._errors import ArgumentError, ArgumentTypeError
 
 __all__ = ["show", "range_text", "check_real", "real_argument", "number", "integer",
-           "RTOL_MAX", "ATOL_MAX"]
+           "RTOL_MAX", "ATOL_MAX", "COMPILED_MAX_RHS", "STEPWISE_MAX_RHS", "STEPWISE_STATES"]
 
 #: The largest relative tolerance a scene, :func:`winder.simulate` or the CLI accepts [-]
 #: (beyond it the integrators' error control means nothing).
@@ -23,6 +23,24 @@ RTOL_MAX = 0.1
 #: position whose nip penetration is µm, 1 mN on a friction state. Beyond it the error
 #: control no longer sees the contact (an atol of 1e300 lets a roll sink through its drum).
 ATOL_MAX = 1e-3
+
+# The default evaluation budgets (``max_rhs`` when neither the call nor ``[solver]`` gives
+# one; :func:`winder.solve.budgets.default_max_rhs`), each about a minute of its path's work.
+#: On the compiled methods (DOPRI5, ROS2, RK4 in C): 0.2–3 µs an evaluation (the paper
+#: scene with a 1e12 N/m nip stops on DOPRI5 after 6 s).
+COMPILED_MAX_RHS = 50_000_000
+#: On a step-wise path (scipy's RK45, RK23, DOP853, Radau, BDF, LSODA; RK4 on the numeric
+#: backend), per backend, for a machine of at most :data:`STEPWISE_STATES` states: one step
+#: at a time from Python costs 16–83 µs of CPU an evaluation of the generated right-hand side
+#: (DOP853 the least, BDF the most: its Newton iterations and LU solves) and 350–400 µs on
+#: the numeric Pinocchio path (the paper scene with a 1e12 N/m nip; docs/speed.md: the
+#: time each method takes to stop).
+STEPWISE_MAX_RHS = {"compiled": 300_000, "pinocchio": 30_000}
+#: Above this many states a step-wise path's default budget shrinks in proportion: an
+#: evaluation costs more with the machine (the implicit methods' Jacobians and LU solves:
+#: 250–280 µs of CPU on the 213 states of the flexible two-drum winder against 25–95 µs on
+#: the paper scene's 6, single-threaded BLAS).
+STEPWISE_STATES = 50
 
 
 def show(value: Any, limit: int = 60) -> str:

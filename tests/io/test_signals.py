@@ -1,6 +1,9 @@
 """Stopping the command line with SIGINT, SIGTERM and SIGHUP at different phases (real
-processes, real signals): exit status 128 + signal, one line on stderr, no traceback, no
-temporary file, no partial output, no child process left, the temp directory empty."""
+processes, real signals): exit status 128 + signal, one line on stderr naming the signal, no
+traceback, no temporary file, no partial output, no child process left, the temp directory
+empty. The result and its NPZ twin are written both or neither whenever the signal comes:
+at each step of the write, a process signals itself (deterministically, from a wrapped write
+step) and the files on disk, the line and the status are checked."""
 
 from __future__ import annotations
 
@@ -12,13 +15,17 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 import pytest
-from cli_corpus import FREE_SPIN, good_result_arrays, write_npz
+from cli_corpus import FREE_SPIN, good_result_arrays, quick_scene, write_npz
 
 SIGNALS = [signal.SIGINT, signal.SIGTERM, signal.SIGHUP]
+#: The line of a command stopped by each signal.
+SAYS = {signal.SIGINT: "interrupted (SIGINT)", signal.SIGTERM: "terminated (SIGTERM)",
+        signal.SIGHUP: "hung up (SIGHUP)"}
 
 
 def _spawn(tmp_path: Path, *args: str) -> subprocess.Popen:
@@ -48,8 +55,7 @@ def _finish(proc: subprocess.Popen) -> tuple[int, str]:
 def _assert_stopped(status: int, err: str, sig: int) -> None:
     assert status == 128 + sig, (status, err)
     assert "Traceback" not in err, err
-    assert err.strip() == f"winder: stopped by {signal.Signals(sig).name} (no partial file " \
-        "left)", err
+    assert err.strip() == f"winder: {SAYS[sig]}; no partial file left", err
 
 
 def _debris(folder: Path) -> list[Path]:
@@ -269,3 +275,171 @@ def test_partial_npz_never_loads(tmp_path: Path) -> None:
         (tmp_path / "cut.npz").write_bytes(full[:cut])
         with pytest.raises(winder.WinderError, match="cut.npz"):
             winder.load_result(tmp_path / "cut.npz")
+
+
+# ---- a signal at each step of writing a result and its twin -------------------------------
+
+#: ``winder run SCENE --out OUT/r.csv`` in a process that signals itself (signal number
+#: argv[2]) at one step (argv[1]) of writing r.csv and r.npz, and notes it in argv[3].
+_PHASE_RUN = r"""
+import atexit, os, sys
+from pathlib import Path
+
+phase, signo, note = sys.argv[1], int(sys.argv[2]), Path(sys.argv[3])
+scene, out = sys.argv[4], Path(sys.argv[5])
+fired = []
+
+def fire(where):
+    if where == phase and not fired:
+        fired.append(where)
+        note.write_text(where)
+        os.kill(os.getpid(), signo)  # acted on at the next bytecode: right here
+
+import numpy.lib.format as npy_format
+import winder.io.files as files
+import winder.io.result as result
+
+writer, write_array, replace = result.Result._writer, npy_format.write_array, os.replace
+commit = files.atomic_write_all
+
+def _writer(self, path):
+    write, kind = writer(self, path), Path(path).suffix[1:]
+    def wrapped(tmp):
+        fire(f"{kind}-start")    # its temporary is there, empty
+        write(tmp)
+        fire(f"{kind}-end")      # its temporary is complete
+    return wrapped
+
+arrays = []
+def _write_array(*args, **kwargs):
+    arrays.append(1)
+    if len(arrays) == 3:
+        fire("npz-middle")       # inside np.savez: two members of the NPZ written
+    return write_array(*args, **kwargs)
+
+def _replace(src, dst, **kwargs):
+    replace(src, dst, **kwargs)
+    if Path(dst).parent == out.parent:
+        fire("renamed-" + Path(dst).suffix[1:])  # that file is in place
+
+def _commit(items):
+    done = commit(items)
+    fire("committed")            # both in place, the write over
+    return done
+
+result.Result._writer = _writer
+npy_format.write_array = _write_array
+os.replace = _replace
+files.atomic_write_all = _commit
+atexit.register(fire, "exiting")  # main has returned; Python is shutting down
+from winder.cli import main
+
+sys.argv = ["winder", "run", scene, "--out", str(out)]
+sys.exit(main())
+"""
+
+#: The steps, in the order they happen: all before "committed" leave neither file.
+PHASES = ["csv-start", "csv-end", "npz-start", "npz-middle", "npz-end", "renamed-csv",
+          "renamed-npz", "committed", "exiting"]
+_CASES = [(sig, phase, False) for sig in SIGNALS for phase in PHASES] + [
+    (sig, phase, True) for sig in (signal.SIGTERM, signal.SIGHUP)
+    for phase in ("npz-middle", "renamed-csv", "renamed-npz")]
+_EARLIER = {".csv": "t,x\n0,1\n", ".npz": "an earlier file\n"}
+
+
+def _run_phase(case: tuple[int, str, bool], folder: Path) -> dict:
+    sig, phase, previous = case
+    folder.mkdir(parents=True)
+    (folder / "tmp").mkdir()
+    out = folder / "out" / "r.csv"
+    if previous:
+        out.parent.mkdir()
+        for suffix, text in _EARLIER.items():
+            out.with_suffix(suffix).write_text(text)
+    env = dict(os.environ, TMPDIR=str(folder / "tmp"), PYTHONUNBUFFERED="1")
+    proc = subprocess.run([sys.executable, "-c", _PHASE_RUN, phase, str(int(sig)),
+                           str(folder / "fired"), str(quick_scene(folder)), str(out)],
+                          capture_output=True, text=True, env=env, cwd=folder, timeout=240)
+    return {"status": proc.returncode, "out": proc.stdout, "err": proc.stderr, "csv": out,
+            "fired": (folder / "fired").read_text() if (folder / "fired").exists() else None}
+
+
+@pytest.fixture(scope="module")
+def phase_runs(request, tmp_path_factory) -> dict:
+    """The cases selected in this session, four processes at a time (each mostly imports)."""
+    cases = [item.callspec.params["case"] for item in request.session.items
+             if item.originalname == "test_both_or_neither_at_each_step_of_the_write"]
+    root = tmp_path_factory.mktemp("phases")
+    with ThreadPoolExecutor(4) as pool:
+        runs = pool.map(lambda c: _run_phase(c, root / f"{int(c[0])}-{c[1]}-{int(c[2])}"),
+                        cases)
+        return dict(zip(cases, runs, strict=True))
+
+
+@pytest.mark.parametrize("case", _CASES, ids=lambda c: f"{signal.Signals(c[0]).name}-{c[1]}"
+                         + ("-existing" if c[2] else ""))
+def test_both_or_neither_at_each_step_of_the_write(case, phase_runs) -> None:
+    """Until both files are in place and the write is over, a signal leaves neither (and
+    files that were there before untouched): the line says which signal and that no
+    partial file is left. After it, both are complete and the line names them; once the
+    command has returned, the process ends with its own status 0, without a word."""
+    import winder
+
+    sig, phase, previous = case
+    run = phase_runs[case]
+    status, err, csv = run["status"], run["err"], run["csv"]
+    npz, folder = csv.with_suffix(".npz"), csv.parent.parent
+    assert run["fired"] == phase, run  # the signal came at that step
+    assert "Traceback" not in err and "Exception ignored" not in err, err
+    assert _debris(folder) == [] and list((folder / "tmp").iterdir()) == []
+    if PHASES.index(phase) < PHASES.index("committed"):
+        _assert_stopped(status, err, sig)
+        assert run["out"] == ""
+        if previous:  # put back as they were
+            assert {p.suffix: p.read_text() for p in csv.parent.iterdir()} == _EARLIER
+        else:
+            assert not csv.parent.exists()  # neither file, nor the folder made for them
+        return
+    if phase == "committed":
+        assert status == 128 + sig, (status, err)
+        assert err.strip() == (f"winder: {SAYS[sig]} after writing {csv}, {npz} (complete); "
+                               "no partial file left")
+    else:  # "exiting": the run had ended and said so
+        assert status == 0 and err == "", (status, err)
+        assert run["out"].startswith(f"free_spin: 11 samples to {csv}")
+    a, b = winder.load_result(csv), winder.load_result(npz)
+    assert list(a) == list(b) and len(a.t) == 11
+    for name in a:  # the CSV's 15 digits: within 5e-15 relative (10x margin)
+        np.testing.assert_allclose(a[name], b[name], rtol=5e-14, atol=0.0, err_msg=name)
+
+
+@pytest.mark.parametrize("links", [True, False], ids=["hard-links", "no-hard-links"])
+def test_a_failed_move_puts_back_the_files_it_replaced(links: bool, tmp_path: Path,
+                                                       monkeypatch) -> None:
+    """The second of two moves into place fails (an error, as a signal would act there):
+    the first is taken back and both earlier files are as they were, on a file system with
+    hard links and on one without (where the earlier file is moved aside, not linked)."""
+    import winder.io.files as files
+
+    a, b = tmp_path / "r.csv", tmp_path / "r.npz"
+    a.write_text("earlier a\n")
+    b.write_text("earlier b\n")
+    real_replace, failed = os.replace, []
+
+    def replace(src, dst, **kw):
+        if Path(dst) == b and not failed:  # moving the new b into place
+            failed.append(src)
+            raise OSError(5, "I/O error")
+        return real_replace(src, dst, **kw)
+
+    def no_link(*args, **kwargs):
+        raise OSError(1, "Operation not permitted")
+
+    monkeypatch.setattr(files.os, "replace", replace)
+    if not links:
+        monkeypatch.setattr(files.os, "link", no_link)
+    with pytest.raises(files.OutputError, match="cannot write .*r.npz: I/O error"):
+        files.atomic_write_all([(a, lambda p: p.write_text("new a\n")),
+                                (b, lambda p: p.write_text("new b\n"))])
+    assert failed and a.read_text() == "earlier a\n" and b.read_text() == "earlier b\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.npz"]

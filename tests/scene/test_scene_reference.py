@@ -114,8 +114,8 @@ def test_documented_defaults_are_what_loading_gives():
     rows = _rows(reference())
     got = {
         "[scene]": {k: getattr(scene.scene, k) for k in ("output_step", "gravity")},
-        "[solver]": {k: getattr(scene.solver, k) for k in ("rtol", "atol", "max_rhs",
-                                                           "max_wall", "method", "backend")},
+        "[solver]": {k: getattr(scene.solver, k) for k in ("rtol", "atol", "max_wall",
+                                                           "method", "backend")},
         "[[drum]]": {"sense": scene.drums[0].sense},
         "[[drum]] drive": {"ratio": scene.drums[0].drive.ratio,
                            "web_acceleration": scene.drums[0].drive.web_acceleration},
@@ -136,6 +136,13 @@ def test_documented_defaults_are_what_loading_gives():
             assert shown == want, (head, key, shown, value)
     assert scene.rolls[0].initial_radius == scene.rolls[0].core_radius
     assert rows["[[roll]]"]["initial_radius"][3] == "core_radius"
+    # no max_rhs: the path's own budget (winder.solve.budgets.default_max_rhs), each shown
+    from winder.solve.budgets import default_max_rhs
+
+    assert scene.solver.max_rhs is None
+    shown = rows["[solver]"]["max_rhs"][3]
+    for stepwise, backend in ((False, "compiled"), (True, "compiled"), (True, "pinocchio")):
+        assert f"{default_max_rhs(stepwise=stepwise, backend=backend, n_states=6):,}" in shown
     assert scene.rolls[0].free == ("z",)
     assert rows["[[roll]]"]["free"][3].startswith('["z"] (wound)')
     assert scene.web.name == scene.web.entry_nip

@@ -5,12 +5,15 @@ step, the state, the partial result, and whether the run is long, stiff or colla
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import winder
 from winder.solve.simulate import budget_error
+
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 PATHS = [("DOPRI5", "compiled"), ("RK4", "compiled"), ("LSODA", "compiled"),
          ("RK45", "compiled"), ("LSODA", "pinocchio"), ("RK4", "pinocchio")]
@@ -118,3 +121,46 @@ def test_stepper_tiny_step_names_dt(paper_scene) -> None:
         sim.step(1e-300)
     sim.step(1e-14)  # the resolution itself is a valid step
     assert sim.t == 1e-14
+
+
+def test_default_budget_of_each_path() -> None:
+    """Without max_rhs: 50 M evaluations on the compiled methods; on the step-wise paths
+    (scipy's methods, the numeric backend) about a minute of their work, fewer in
+    proportion for a machine of more than 50 states."""
+    from winder.solve.budgets import default_max_rhs
+
+    assert default_max_rhs(stepwise=False, backend="compiled", n_states=213) == 50_000_000
+    assert default_max_rhs(stepwise=True, backend="compiled", n_states=6) == 300_000
+    assert default_max_rhs(stepwise=True, backend="pinocchio", n_states=6) == 30_000
+    assert default_max_rhs(stepwise=True, backend="compiled", n_states=213) == 70_422
+    assert winder.load_scene(MODELS / "paper_winding.toml").solver.max_rhs is None
+
+
+def test_stiff_nip_on_lsoda_stops_at_the_step_wise_budget(tmp_path, monkeypatch, capsys) -> None:
+    """Issue 32: ``winder run`` of the paper scene with a 1e12 N/m nip and ``--method
+    LSODA`` ran 7 min (9.85 M evaluations) without a word; the step-wise paths' default
+    budget (300 000 evaluations: the whole scene stops after 5.5–25 s of CPU on each of
+    scipy's methods, docs/speed.md) stops it with exit 2 and a message naming what to
+    change, with the progress bar drawn where it stopped. Here
+    the default is 10 000 (the same mechanism, the test quick): t_end 20 s needs about
+    26 000 evaluations."""
+    from winder.cli import main
+    from winder.solve import budgets
+
+    scene = tmp_path / "stiff.toml"
+    scene.write_text((MODELS / "paper_winding.toml").read_text().replace(
+        "stiffness = 2e7 ", "stiffness = 1e12 "))
+    assert "stiffness = 1e12" in scene.read_text()
+    monkeypatch.setitem(budgets.STEPWISE_MAX_RHS, "compiled", 10_000)
+    out = tmp_path / "out" / "r.csv"
+    status = main(["run", str(scene), "--out", str(out), "--method", "LSODA", "--t-end", "20",
+                   "--progress"])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert "Traceback" not in err
+    assert "budget max_rhs = 10000 evaluations reached at t = " in err
+    t = float(err.split("reached at t = ")[1].split()[0])
+    assert 0.0 < t < 20.0
+    assert "--max-evals" in err and "--method ROS2" in err
+    assert f"t = {t:8.2f} s" in err  # the progress bar, drawn at the time reached
+    assert sorted(tmp_path.rglob("*")) == [scene]  # nothing on disk

@@ -9,9 +9,13 @@ Exit status
   the bad value and what is valid; nothing is left on disk. Every output location is
   checked before a run starts.
 - 128 + N when stopped by signal N: 130 for Ctrl-C (SIGINT), 143 for SIGTERM, 129 for
-  SIGHUP. Temporary files are removed and child processes stopped; files already complete
-  stay, no partial file is left. A second signal during that clean-up stops at once, with
-  a message.
+  SIGHUP; one line names it ("winder: terminated (SIGTERM); no partial file left").
+  Temporary files are removed and child processes stopped; a set of files written together
+  (a result and its NPZ twin, the figures) is complete or absent whenever the signal
+  comes (files it would have replaced are put back); files a command had completed
+  before the signal stay, and the line names them. A second signal during that clean-up
+  stops at once, with a message. A signal after the command has finished (while Python
+  shuts down) is ignored: the status is the command's own.
 - 141 when the reader of stdout went away (``winder modes ... | head``), as for SIGPIPE.
 - 1: an internal error of winder (a bug): the traceback and a line saying so; for
   ``winder sweep``, also: runs are missing (their workers died), listed on stderr.
@@ -489,41 +493,62 @@ def _say(text: str) -> None:
         pass
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run one command; returns the exit status (see the module text)."""
-    with handling_signals(exiting=argv is None):
+def _stopped(exc: Interrupted) -> str:
+    """The line of a command stopped by a signal: which signal, and what is on disk."""
+    from winder.io.interrupt import committed_files
+
+    done = committed_files()
+    if not done:
+        return f"winder: {exc.describe()}; no partial file left"
+    names = ", ".join(done[:4]) + (f" and {len(done) - 4} more" if len(done) > 4 else "")
+    return f"winder: {exc.describe()} after writing {names} (complete); no partial file left"
+
+
+def _command(argv: Sequence[str] | None) -> int:
+    """Run one command inside the signal handling of :func:`main`; returns the status."""
+    try:
         try:
-            try:
-                args = _build_parser().parse_args(argv)
-            except _UsageError as exc:
-                _say(str(exc))
-                return EXIT_ERROR
-            except _Exit as exc:
-                return exc.status
-            return int(args.func(args) or 0)
-        except WinderError as exc:
-            _say(f"winder: error: {exc}")
+            args = _build_parser().parse_args(argv)
+        except _UsageError as exc:
+            _say(str(exc))
             return EXIT_ERROR
-        except Interrupted as exc:
-            _say(f"winder: stopped by {exc.name} (no partial file left)")
-            return exc.exit_status
-        except KeyboardInterrupt:
-            _say("winder: interrupted (no partial file left)")
-            return 130
-        except BrokenPipeError:  # stdout closed by the reader (winder ... | head)
-            if argv is None:  # keep Python's exit flush from failing on it too
-                with contextlib.suppress(OSError):
-                    os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-            return 128 + 13  # as if killed by SIGPIPE
-        except MemoryError:
-            _say("winder: error: not enough memory for this run (shorten it or sample it "
-                 "more coarsely)")
-            return EXIT_ERROR
-        except Exception:
-            _say(traceback.format_exc())
-            _say("winder: internal error: this is a bug in winder; please report it with "
-                 "the command line and the traceback above")
-            return EXIT_INTERNAL
+        except _Exit as exc:
+            return exc.status
+        status = int(args.func(args) or 0)
+        if argv is None:  # the process ends next: its output out before the handlers go
+            sys.stdout.flush()
+        return status
+    except WinderError as exc:
+        _say(f"winder: error: {exc}")
+        return EXIT_ERROR
+    except Interrupted as exc:
+        _say(_stopped(exc))
+        return exc.exit_status
+    except KeyboardInterrupt:
+        _say("winder: interrupted; no partial file left")
+        return 130
+    except BrokenPipeError:  # stdout closed by the reader (winder ... | head)
+        if argv is None:  # keep Python's exit flush from failing on it too
+            with contextlib.suppress(OSError):
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 128 + 13  # as if killed by SIGPIPE
+    except MemoryError:
+        _say("winder: error: not enough memory for this run (shorten it or sample it "
+             "more coarsely)")
+        return EXIT_ERROR
+    except Exception:
+        _say(traceback.format_exc())
+        _say("winder: internal error: this is a bug in winder; please report it with "
+             "the command line and the traceback above")
+        return EXIT_INTERNAL
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; returns the exit status (see the module text). With ``argv``
+    None (the ``winder`` program) the process is about to end: a signal after the command
+    is ignored (the status stays)."""
+    with handling_signals(exiting=argv is None):
+        return _command(argv)
 
 
 if __name__ == "__main__":

@@ -69,7 +69,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                       threshold=args.vibration_threshold, trajectories=args.trajectories,
                       progress=args.progress)
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM/SIGHUP as Interrupted
-        print(f"winder: interrupted; finished runs are kept in {args.out}/runs; run the same "
+        what = exc.describe() if isinstance(exc, Interrupted) else "interrupted (SIGINT)"
+        print(f"winder: {what}; finished runs are kept in {args.out}/runs; run the same "
               "command again to resume", file=sys.stderr)
         return exc.exit_status if isinstance(exc, Interrupted) else 130
     n_bad = len(table.failed)

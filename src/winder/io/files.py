@@ -12,7 +12,9 @@ and atomic writes that leave the complete file or nothing.
 - :func:`atomic_write` and :func:`atomic_write_all` write into hidden temporary files
   (``.winder-XXXXXXXX.tmp``, short whatever the target's name) beside the targets and move
   them into place when all are complete; on an error, Ctrl-C, SIGTERM or SIGHUP the
-  temporaries are removed (see :mod:`winder.io.interrupt`).
+  temporaries are removed and the files already moved are taken back (the files they
+  replaced put back), so a set of files is written whole or not at all (see
+  :mod:`winder.io.interrupt`).
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from winder._errors import WinderError
-from winder.io.interrupt import deferred, on_abort
+from winder.io.interrupt import checkpoint, committed, deferred, on_abort
 
 __all__ = ["OutputError", "atomic_write", "atomic_write_all", "check_output_dir", "csv_writer",
            "check_output_file", "safe_stem", "scratch_dir"]
@@ -199,18 +201,39 @@ def csv_writer(columns: Mapping[str, Any], *, fmt: str) -> Writer:
                                   fmt=fmt)
 
 
+def _set_aside(target: Path) -> Path | None:
+    """A hidden hard link (a renamed copy where the file system has no hard links) of the
+    file ``target`` beside it, to put back if the write that replaces it is undone; None
+    when there is no file there."""
+    if not os.path.lexists(target):
+        return None
+    fd, name = tempfile.mkstemp(prefix=_TMP_PREFIX, suffix=_TMP_SUFFIX, dir=target.parent)
+    os.close(fd)
+    aside = Path(name)
+    try:
+        os.unlink(aside)
+        os.link(target, aside, follow_symlinks=False)
+    except OSError:
+        os.replace(target, aside)  # no hard links here: the target is absent until replaced
+    return aside
+
+
 def atomic_write_all(items: Sequence[tuple[str | os.PathLike[str], Writer]]) -> list[Path]:
     """Call each ``write(tmp_path)``, then move all the files into place together: the
-    targets are all written or none is (no partial file, no temporary left) on an error,
-    Ctrl-C, SIGTERM or SIGHUP. Missing parent directories are created (and removed again
-    on failure). Errors of the file system raise :class:`OutputError` naming the file."""
+    targets are all written or none is (no partial file, no temporary left; a file that
+    was there before stays as it was) on an error, Ctrl-C, SIGTERM or SIGHUP, whenever it
+    comes: while the temporaries are written, and while they are moved into place (a
+    signal that arrives then undoes the moves: the files that were there are put back).
+    Missing parent directories are created (and removed again on failure). Errors of the
+    file system raise :class:`OutputError` naming the file."""
     targets = [Path(p) for p, _ in items]
     temps: list[Path] = []
+    asides: list[Path] = []
     created: list[Path] = []
     current = targets[0] if targets else Path()
 
     def cleanup() -> None:
-        for tmp in temps:
+        for tmp in (*temps, *asides):
             _unlink(tmp)
         _remove_dirs(created)
 
@@ -226,17 +249,30 @@ def atomic_write_all(items: Sequence[tuple[str | os.PathLike[str], Writer]]) -> 
                     temps.append(Path(name))
                 write(temps[-1])
                 os.chmod(temps[-1], 0o666 & ~_UMASK)  # mkstemp makes 0600
-            done: list[Path] = []
-            with deferred():  # all or nothing, even under a signal
+            done: list[tuple[Path, Path | None]] = []  # (target, the file it replaces)
+            with deferred():  # a signal is acted on at the checkpoint: all or nothing
                 try:
                     for tmp, target in zip(temps, targets, strict=True):
                         current = target
+                        aside = _set_aside(target)
+                        if aside is not None:
+                            asides.append(aside)
+                        done.append((target, aside))  # undone below, moved or not
                         os.replace(tmp, target)
-                        done.append(target)
+                    checkpoint()  # a signal so far: undo the moves (below)
                 except BaseException:
-                    for target in done:
-                        _unlink(target)
+                    for target, aside in reversed(done):
+                        if aside is None:
+                            _unlink(target)
+                            continue
+                        try:
+                            os.replace(aside, target)
+                        except OSError:  # keep the earlier file (hidden) rather than lose it
+                            asides.remove(aside)
                     raise
+                for aside in asides:
+                    _unlink(aside)
+                committed(targets)
         except BaseException as exc:
             cleanup()
             if isinstance(exc, OSError) and not isinstance(exc, WinderError):

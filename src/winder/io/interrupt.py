@@ -2,13 +2,23 @@
 
 While :func:`handling_signals` is active (the command line installs it first thing), each of
 the three signals raises :class:`Interrupted` (a ``KeyboardInterrupt`` carrying the signal
-number), so every ``finally`` and ``except BaseException`` runs: temporary files are removed,
-child processes stopped. Code that creates something that must not outlive the process
-registers its removal with :func:`on_abort`. A second signal while the first is being cleaned
-up does not kill the process silently: it runs the registered clean-ups at once, prints one
-line and exits with status ``128 + signal``. Inside :func:`deferred` (the few statements that
-move finished files into place) a signal is acted on only at its end, so a set of files is
-committed whole or not at all.
+number; :meth:`Interrupted.describe` says "interrupted (SIGINT)", "terminated (SIGTERM)",
+"hung up (SIGHUP)"), so every ``finally`` and ``except BaseException`` runs: temporary files
+are removed, child processes stopped. Code that creates something that must not outlive the
+process registers its removal with :func:`on_abort`. A second signal while the first is being
+cleaned up does not kill the process silently: it runs the registered clean-ups at once,
+prints one line and exits with status ``128 + signal``. Inside :func:`deferred` (the few
+statements that move finished files into place) a signal is held; :func:`checkpoint` acts on
+a held one where the block can still undo its work (a multi-file write rolls back there), the
+block's end on one that came after. A write that put its files in place records them with
+:func:`committed`: the message of a later signal names them (complete) instead of claiming
+that nothing was written.
+
+With ``exiting`` (the command line) the signals are ignored after the block: the command
+is over, its output complete and flushed, and one that arrives while Python shuts down
+leaves the exit status as it is, instead of Python's default action (killed without a word
+by SIGTERM or SIGHUP, a ``KeyboardInterrupt`` traceback from SIGINT). Only ``SIG_IGN``
+outlasts Python's finalization, which puts every Python-level handler back to the default.
 
 Outside the command line (``handling_signals`` not active) :func:`on_abort` and
 :func:`deferred` do nothing: a library user's own signal handling is left alone.
@@ -20,16 +30,20 @@ import itertools
 import os
 import signal
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 
-__all__ = ["Interrupted", "SIGNALS", "deferred", "handling_signals", "on_abort",
-           "run_abort_cleanups"]
+__all__ = ["Interrupted", "SIGNALS", "checkpoint", "committed", "committed_files", "deferred",
+           "handling_signals", "on_abort", "run_abort_cleanups"]
 
 #: The signals that stop a command cleanly (SIGHUP where the platform has it).
 SIGNALS: tuple[int, ...] = tuple(
     int(s) for s in (getattr(signal, n, None) for n in ("SIGINT", "SIGTERM", "SIGHUP"))
     if s is not None)
+
+
+#: What a signal did to the command, for its message.
+_VERBS = {"SIGINT": "interrupted", "SIGTERM": "terminated", "SIGHUP": "hung up"}
 
 
 class Interrupted(KeyboardInterrupt):
@@ -48,12 +62,17 @@ class Interrupted(KeyboardInterrupt):
     def exit_status(self) -> int:
         return 128 + self.signo
 
+    def describe(self) -> str:
+        """``interrupted (SIGINT)``, ``terminated (SIGTERM)``, ``hung up (SIGHUP)``."""
+        return f"{_VERBS.get(self.name, 'stopped')} ({self.name})"
+
 
 class _State:
     active = False      # handlers installed
     stopping = False    # a first signal has been turned into Interrupted
     depth = 0           # nesting of deferred()
     pending: int | None = None
+    committed: list[str] = []  # files complete and in place (committed())
 
 
 _CLEANUPS: dict[int, Callable[[], None]] = {}
@@ -87,7 +106,8 @@ def on_abort(cleanup: Callable[[], None]) -> Iterator[None]:
 
 @contextmanager
 def deferred() -> Iterator[None]:
-    """Act on a signal that arrives inside the block only when the block ends."""
+    """Act on a signal that arrives inside the block only when the block ends (or at a
+    :func:`checkpoint` in it)."""
     _State.depth += 1
     try:
         yield
@@ -96,6 +116,31 @@ def deferred() -> Iterator[None]:
         if _State.depth == 0 and _State.pending is not None:
             signo, _State.pending = _State.pending, None
             _handle(signo, None)
+
+
+def checkpoint() -> None:
+    """Inside :func:`deferred`: act now on a signal held so far (raise :class:`Interrupted`
+    here, where the caller can still undo its work); nothing when none is held."""
+    if _State.pending is None:
+        return
+    signo, _State.pending = _State.pending, None
+    depth, _State.depth = _State.depth, 0
+    try:
+        _handle(signo, None)
+    finally:
+        _State.depth = depth
+
+
+def committed(paths: Iterable[str | os.PathLike[str]]) -> None:
+    """Record files that a write has just put in place, complete (the command line's
+    message on a later signal names them)."""
+    if _State.active:
+        _State.committed.extend(os.fspath(p) for p in paths)
+
+
+def committed_files() -> list[str]:
+    """The files recorded by :func:`committed` since :func:`handling_signals` began."""
+    return list(_State.committed)
 
 
 def _handle(signo: int, frame: object) -> None:
@@ -120,18 +165,20 @@ def handling_signals(*, exiting: bool = False) -> Iterator[None]:
     """Turn SIGINT, SIGTERM and SIGHUP into :class:`Interrupted` inside the block (main
     thread only; elsewhere the block runs unchanged). Registered clean-ups left over when
     the block ends are run. ``exiting``: the process ends right after the block (the
-    command line); once stopped by a signal, further signals are then ignored instead of
-    killing it between the block and its exit."""
+    command line, with its output flushed); the signals are then ignored, so that one
+    arriving while Python shuts down neither kills the process with Python's default action
+    nor changes its exit status."""
     try:
         previous = {s: signal.signal(s, _handle) for s in SIGNALS}
     except ValueError:  # not the main thread
         yield
         return
     _State.active, _State.stopping, _State.depth, _State.pending = True, False, 0, None
+    _State.committed = []
     try:
         yield
     finally:
         run_abort_cleanups()
         _State.active = False
         for s, h in previous.items():
-            signal.signal(s, signal.SIG_IGN if exiting and _State.stopping else h)
+            signal.signal(s, signal.SIG_IGN if exiting else h)

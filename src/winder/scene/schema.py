@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping, Sequence
 
-from winder._args import ATOL_MAX, RTOL_MAX
+from winder._args import ATOL_MAX, COMPILED_MAX_RHS, RTOL_MAX, STEPWISE_MAX_RHS, STEPWISE_STATES
 from winder._schema import Key, Table
 from winder.forces import FORCES
 from winder.parts import PARTS, drum, nip, roll, web
@@ -93,7 +93,12 @@ SOLVER_KEYS = Table((
     Key(name="atol", unit="", doc_unit="state units", **_POS, hi=ATOL_MAX,
         doc="absolute tolerance"),
     Key(name="max_rhs", unit="-", **_POS, hi=1e12,
-        doc="budget: most right-hand side evaluations of a run (a whole number)"),
+        default_text=f"{COMPILED_MAX_RHS:,} on the compiled methods, "
+                     f"{STEPWISE_MAX_RHS['compiled']:,} on scipy's, "
+                     f"{STEPWISE_MAX_RHS['pinocchio']:,} on the pinocchio backend (times "
+                     f"{STEPWISE_STATES} / states above {STEPWISE_STATES} states)",
+        doc="budget: most right-hand side evaluations of a run (a whole number); each "
+            "default stops a run within about a minute"),
     Key(name="backend", kind="str", choices=BACKENDS,
         doc="compiled: the generated code; pinocchio: the numeric Pinocchio path (the "
             "cross-check)"),

@@ -151,6 +151,6 @@ class Solver:
     method: str = "auto"
     rtol: float = 1e-6
     atol: float = 1e-8
-    max_rhs: int = 50_000_000
+    max_rhs: int | None = None  # None: the path's own (winder.solve.budgets.default_max_rhs)
     max_wall: float = 600.0
     backend: str = "compiled"

@@ -11,14 +11,23 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from winder._args import ATOL_MAX, RTOL_MAX, real_argument
+from winder._args import (
+    ATOL_MAX,
+    COMPILED_MAX_RHS,
+    RTOL_MAX,
+    STEPWISE_MAX_RHS,
+    STEPWISE_STATES,
+    real_argument,
+)
 from winder._errors import BudgetExceeded, SimulationError, state_text
 from winder.io.result import Result
 
-__all__ = ["check_tolerances", "check_budgets", "budget_error", "RAISE_SIMULATE"]
+__all__ = ["check_tolerances", "check_budgets", "budget_error", "default_max_rhs",
+           "COMPILED_MAX_RHS", "STEPWISE_MAX_RHS", "STEPWISE_STATES", "RAISE_SIMULATE"]
 
 _WALL_EVERY = 256  # evaluations between wall-clock checks on the Python paths
 _STEP_OVER = 1e-6  # [s] integrated without contact events after a grazing contact
+
 
 
 # ---- arguments ----------------------------------------------------------------------
@@ -34,14 +43,28 @@ def check_tolerances(rtol: Any, atol: Any) -> tuple[float, float]:
     return r, a
 
 
-def check_budgets(max_rhs: Any, max_wall: Any) -> tuple[int, float]:
-    """Validated ``(max_rhs, max_wall)``: a whole number of evaluations ``>= 1`` and a wall
-    time ``> 0`` [s] (``inf`` for none)."""
-    n = real_argument("max_rhs", max_rhs, lambda v: math.isfinite(v) and v >= 1 and v == int(v),
-                   "a whole number >= 1 (right-hand side evaluations)")
+def check_budgets(max_rhs: Any, max_wall: Any) -> tuple[int | None, float]:
+    """Validated ``(max_rhs, max_wall)``: a whole number of evaluations ``>= 1`` (None: the
+    path's default, :func:`default_max_rhs`) and a wall time ``> 0`` [s] (``inf`` for
+    none)."""
     w = real_argument("max_wall", max_wall, lambda v: v > 0.0,
                    "> 0 (wall-clock seconds; inf for no limit)")
+    if max_rhs is None:
+        return None, w
+    n = real_argument("max_rhs", max_rhs, lambda v: math.isfinite(v) and v >= 1 and v == int(v),
+                   "a whole number >= 1 (right-hand side evaluations)")
     return int(n), w
+
+
+def default_max_rhs(*, stepwise: bool, backend: str, n_states: int) -> int:
+    """The evaluation budget of a run given none (``max_rhs`` and ``[solver] max_rhs``
+    unset): :data:`COMPILED_MAX_RHS` on the compiled methods; on a step-wise path (scipy's
+    methods, or the numeric backend) :data:`STEPWISE_MAX_RHS` of its ``backend``, times
+    ``STEPWISE_STATES / n_states`` for a machine of more states."""
+    if not stepwise:
+        return COMPILED_MAX_RHS
+    scale = min(1.0, STEPWISE_STATES / max(1, n_states))
+    return max(1000, int(STEPWISE_MAX_RHS[backend] * scale))
 
 
 class _Bar(Protocol):
@@ -65,10 +88,12 @@ def budget_error(kind: str, limit: float, *, meth: str, t: float, t_start: float
                  t_end: float, step: float | None, steps: int, stiff_steps: int | None,
                  nfev: int, wall: float, state: dict[str, float],
                  partial: Result | None = None, how: dict[str, str] = RAISE_SIMULATE,
-                 alternatives: str = "method='Radau' or 'LSODA'") -> BudgetExceeded:
+                 alternatives: str = "method='Radau' or 'LSODA'",
+                 faster: str | None = None) -> BudgetExceeded:
     """The :class:`~winder.BudgetExceeded` of a run that reached its budget ``kind``
     (``max_rhs`` or ``max_wall``) at ``t`` [s], naming the time, the last step [s] and the
-    state, and saying which of three it is:
+    state, and saying which of three it is (``faster``: a last sentence naming a faster
+    path, for the step-wise paths):
 
     - the step size collapsed (last step below 1e-3 of the mean step so far, or no
       progress): stiff or discontinuous here;
@@ -102,6 +127,8 @@ def budget_error(kind: str, limit: float, *, meth: str, t: float, t_start: float
     else:
         msg += (f"The run is long, not stiff (steady steps, mean {mean_step:.3g} s): "
                 f"{projection}; {raise_it}.")
+    if faster is not None:
+        msg += f" {faster}"
     if partial is not None:
         msg += f" The samples up to t = {partial.t[-1]:.6g} s are in .partial."
     return BudgetExceeded(msg, time=t, state=state, step=step, partial=partial)
@@ -127,6 +154,8 @@ class _Guards:
         self.wall0 = time.perf_counter()
         self.steps = 0
         self.stiff_steps: int | None = None  # known for the compiled DOPRI5
+        self.alternatives = "method='Radau' or 'LSODA'"  # for a stiff run, in its message
+        self.faster: str | None = None  # a faster path, in the budget's message
 
     def state(self, y: np.ndarray) -> dict[str, float]:
         return dict(zip(self.names, map(float, y), strict=True))
@@ -153,4 +182,5 @@ class _Guards:
                             t_end=self.t_end, step=step, steps=self.steps,
                             stiff_steps=self.stiff_steps, nfev=nfev,
                             wall=time.perf_counter() - self.wall0, state=self.state(y),
-                            partial=partial)
+                            partial=partial, alternatives=self.alternatives,
+                            faster=self.faster)

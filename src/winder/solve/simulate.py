@@ -19,7 +19,14 @@ from winder.scene import naming_of
 from winder.scene.load import Scene, load_scene
 from winder.scene.schema import BACKENDS, MAX_SAMPLES, METHODS
 from winder.solve import integrators as integ
-from winder.solve.budgets import _Guards, _Stop, budget_error, check_budgets, check_tolerances
+from winder.solve.budgets import (
+    _Guards,
+    _Stop,
+    budget_error,
+    check_budgets,
+    check_tolerances,
+    default_max_rhs,
+)
 from winder.solve.system import MachineSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
@@ -153,6 +160,18 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     return k
 
 
+def _compiled_instead(meth: str, system: MachineSystem) -> tuple[str, str]:
+    """For a run on a step-wise path: the stiff alternative and the sentence naming the
+    compiled methods, for its budget error."""
+    on = "" if system.generated is not None else " on backend='compiled' (--backend compiled)"
+    where = ("step by step from Python" if system.generated is not None else
+             "on the numeric Pinocchio backend, step by step from Python")
+    return (f"method='ROS2'{on} (compiled, for stiff machines)",
+            f"{meth} runs {where}, at 30 to 100 times the cost per evaluation of the "
+            f"compiled methods: method='DOPRI5' (--method DOPRI5){on}, or method='ROS2' "
+            "(--method ROS2) for a stiff machine, runs the scene compiled.")
+
+
 # ---- simulate -----------------------------------------------------------------------
 
 def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
@@ -186,9 +205,12 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         core events of spec §2, the roll unwinding to its core and turning forwards
         again, are located on every path.)
     max_step: largest step [s], finite > 0 (the step of RK4).
-    max_rhs, max_wall: budgets: right-hand side evaluations (default ``[solver] max_rhs``)
-        and wall-clock seconds (default ``[solver] max_wall``); reaching one raises
-        :class:`~winder.BudgetExceeded` with the samples so far in ``.partial``.
+    max_rhs, max_wall: budgets: right-hand side evaluations (default ``[solver] max_rhs``,
+        else the path's: 50 million on the compiled methods, 500 000 on scipy's methods,
+        50 000 on the numeric backend, fewer for machines over 50 states:
+        :func:`~winder.solve.budgets.default_max_rhs`) and wall-clock seconds (default
+        ``[solver] max_wall``); reaching one raises :class:`~winder.BudgetExceeded` with
+        the samples so far in ``.partial``.
     backend: ``compiled`` (the machine's generated C, default) or ``pinocchio``
         (``pin.aba`` on numbers with the same force elements); default ``[solver] backend``.
     t_start, initial_state: start the run at ``t_start`` [s] from a full state vector
@@ -209,8 +231,9 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     progress, events = _check_bool("progress", progress), _check_bool("events", events)
     rtol, atol = check_tolerances(scene.solver.rtol if rtol is None else rtol,
                                   scene.solver.atol if atol is None else atol)
-    limit, wall_limit = check_budgets(scene.solver.max_rhs if max_rhs is None else max_rhs,
-                                      scene.solver.max_wall if max_wall is None else max_wall)
+    given_rhs, wall_limit = check_budgets(
+        scene.solver.max_rhs if max_rhs is None else max_rhs,
+        scene.solver.max_wall if max_wall is None else max_wall)
     positive = "finite and > 0 [s]"
     t_key = "[scene] duration" if t_end is None else "t_end"
     T = real_argument(t_key, scene.scene.duration if t_end is None else t_end,
@@ -246,11 +269,15 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         from winder.io.progress import Progress
 
         bar = Progress(T, scene.name)
+    compiled_run = system.generated is not None and meth in (*COMPILED_METHODS, "RK4")
+    limit = given_rhs if given_rhs is not None else default_max_rhs(
+        stepwise=not compiled_run, backend=system.backend, n_states=system.n_states)
     guards = _Guards(system.state_names, meth, limit=limit, max_wall=wall_limit, bar=bar,
                      t_start=t_s, t_end=T)
+    if not compiled_run:  # what to change names the compiled methods
+        guards.alternatives, guards.faster = _compiled_instead(meth, system)
     breaks = sorted({b for b in system.breakpoints if t_s < b < T} | {T})
     Ys = np.empty((len(y0), len(t_out)))
-    compiled_run = system.generated is not None and meth in (*COMPILED_METHODS, "RK4")
     stats = np.zeros(5, dtype=np.int64)
     at: list[Any] = [t_s, None, 0]
     try:

@@ -15,7 +15,7 @@ from winder.io.result import Result
 from winder.scene import naming_of
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
-from winder.solve.budgets import budget_error, check_budgets, check_tolerances
+from winder.solve.budgets import COMPILED_MAX_RHS, budget_error, check_budgets, check_tolerances
 from winder.solve.simulate import _as_scene
 from winder.solve.system import MachineSystem
 
@@ -65,7 +65,7 @@ class Stepper:
     rtol, atol: tolerances of the internal integrator (default ``1e-8``, ``1e-10``): rtol
         finite in (0, 0.1], atol finite in (0, 1e-3] [state units].
     max_rhs, max_wall: budget of each :meth:`step`: evaluations and wall-clock seconds
-        (default ``[solver] max_rhs`` and ``max_wall``).
+        (default ``[solver] max_rhs``, else 50 million, and ``max_wall``).
     """
 
     def __init__(self, scene: Scene | str | os.PathLike, *, rtol: float = 1e-8,
@@ -74,7 +74,7 @@ class Stepper:
         scene = _as_scene(scene)
         self.rtol, self.atol = check_tolerances(rtol, atol)
         self.max_rhs, self.max_wall = check_budgets(
-            scene.solver.max_rhs if max_rhs is None else max_rhs,
+            (scene.solver.max_rhs or COMPILED_MAX_RHS) if max_rhs is None else max_rhs,
             scene.solver.max_wall if max_wall is None else max_wall)
         self.scene = scene
         self.system = MachineSystem(scene)
