@@ -19,6 +19,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.transforms import Bbox  # noqa: E402
 
 from winder.io.files import atomic_write, safe_stem  # noqa: E402
 from winder.io.result import Result  # noqa: E402
@@ -297,9 +298,12 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     drawn = mm.shown() if mm.flexible else mm.coordinates  # flexible: orders 1-2, torsion 1
     crossings = mm.crossings(drawn)
     width, height = (13.5, 6.5) if mm.flexible else (8, 4.2) if one else (11, 4.6)
-    ncol = max(1, min(math.ceil(len(crossings) / 8), int(width // 4.3)))
-    lines = min(math.ceil(len(crossings) / ncol), _TABLE_LINES) if crossings and not one \
-        else 0
+    rows = _crossing_rows(crossings)
+    # the table's columns: as many as fit beside the legend (its longest label, 7 pt)
+    legend = _PT * 7 * max([54, *(len(f"bending mode {c} (damped)") for c in drawn)]) + 0.9
+    column = _PT * 7.5 * max([len(x) for x in rows] + [1]) + 0.3
+    ncol = max(1, min(math.ceil(len(rows) / 6), int((width - legend - 0.9) // column)))
+    lines = min(math.ceil(len(rows) / ncol), _TABLE_LINES) if rows and not one else 0
     heights = [height] * (2 if result is not None else 1) + ([0.35 + 0.16 * lines]
                                                                if lines else [])
     fig = plt.figure(figsize=(width, sum(heights)), layout="constrained")
@@ -348,8 +352,8 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
                 label=("bounce mode overdamped here (real eigenvalue: no oscillation)"
                        if one else "_"))
     if over and not one:
-        ax.plot([], [], color="0.6", lw=4, label="bar at the bottom: the named mode is "
-                "overdamped there (real eigenvalue: no oscillation)")
+        ax.plot([], [], color="0.6", lw=4, label="bar: the mode named at its end is "
+                "overdamped there (no oscillation)")
     points = []
     for c, h, rc in crossings:
         f = float(np.interp(rc, r, mm.frequencies[c] if c in mm.frequencies
@@ -366,9 +370,9 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     ax.set_ylabel("frequency [Hz]")
     if one:
         ax.legend(fontsize=8, loc="upper right")
-    else:  # many lines: the legend beside the chart
-        ax.legend(fontsize=7 if mm.flexible else 7.5, loc="upper left",
-                  bbox_to_anchor=(1.01, 1.0))
+    else:  # many lines: the legend beside the chart (the layout makes room for it)
+        fig.legend(*ax.get_legend_handles_labels(), fontsize=7 if mm.flexible else 7.5,
+                   loc="outside right upper")
     ax.grid(alpha=0.3, which="both" if log else "major")
     ax.set_title(_label(title, 120) or "Resonance map (Campbell chart)")
     axes = [ax]
@@ -394,43 +398,54 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
             b.set_xlim(*ax.get_xlim())
     axes[-1].set_xlabel("roll radius r [m]")
     if lines:
-        _crossing_labels(fig, ax, grid[-1], crossings, points, over, ncol, lines)
+        _crossing_labels(fig, ax, grid[-1], rows, points, over, ncol, lines, r)
     return _save(fig, Path(path))
 
 
 #: The crossings' table lists at most this many lines per column (the rest: a count).
 _TABLE_LINES = 30
+#: Width of a monospace character per point of font size [in] (DejaVu Sans Mono: 0.6 em).
+_PT = 0.6 / 72
 
 
-def _crossing_labels(fig: plt.Figure, ax: plt.Axes, cell, crossings: list, points: list,
-                     over: list, ncol: int, lines: int) -> None:
-    """Number the ``crossings`` of the resonance map ``ax`` (those closer than a marker
+def _crossing_rows(crossings: list[tuple[str, str, float]]) -> list[str]:
+    """The table's lines: number, harmonic, mode, radius, in aligned columns."""
+    if not crossings:
+        return []
+    wide = max(len(short_harmonic(h)) for _, h, _ in crossings)
+    mode = max(len(c) for c, _, _ in crossings)
+    return [f"{i + 1:>2}  {short_harmonic(h):<{wide}}  {c:<{mode}}  r = {rc:.4f} m"
+            for i, (c, h, rc) in enumerate(crossings)]
+
+
+def _crossing_labels(fig: plt.Figure, ax: plt.Axes, cell, rows: list[str], points: list,
+                     over: list, ncol: int, lines: int, radius: np.ndarray) -> None:
+    """Number the crossings (``points``, data coordinates; ``rows`` their table lines)
+    of the resonance map ``ax`` (those closer than a marker
     share one label: ``3,7``) where no label overlaps another, name the overdamped bars
     (``over``) at their right ends, and list the numbers in a table in ``cell``. The
     layout is fixed first (the labels are placed in display coordinates)."""
     table = fig.add_subplot(cell)
     table.axis("off")
+    table.set_title("crossings (critical radii): where a harmonic of the rotation meets a "
+                    "mode", fontsize=8, loc="left")
     fig.canvas.draw()  # the constrained layout, once
     fig.set_layout_engine("none")
     renderer = fig.canvas.get_renderer()
     avoid = []
     for k, (c, mask) in enumerate(over):  # name each bar at its right end
-        last = float(ax.get_lines()[0].get_xdata()[np.flatnonzero(mask)[-1]]) \
-            if np.any(mask) else 0.0
+        last = float(radius[np.flatnonzero(mask)[-1]])
         art = ax.text(last, 0.02 + 0.03 * k, f" {c}", transform=ax.get_xaxis_transform(),
                       fontsize=6.5, va="center", color="0.25")
         avoid.append(art.get_window_extent(renderer))
     xy = ax.transData.transform(np.array(points)) if points else np.zeros((0, 2))
-    groups = cluster(xy, 6.0)
+    avoid += [Bbox.from_extents(x - 4, y - 4, x + 4, y + 4) for x, y in xy]  # the markers
+    groups = cluster(xy, 9.0)
     place_labels(ax, [points[g[0]] for g in groups],
                  [",".join(str(i + 1) for i in g) for g in groups], avoid=avoid)
-    rows = [f"{i + 1:>2}  {short_harmonic(h)} rotation × {c}: r = {rc:.4f} m"
-            for i, (c, h, rc) in enumerate(crossings)]
     shown = rows[:ncol * lines]
     if len(rows) > len(shown):
         shown[-1] = f"… and {len(rows) - len(shown) + 1} more (winder modes prints them all)"
-    table.set_title("crossings (critical radii): a harmonic of the rotation meets a mode",
-                    fontsize=8, loc="left")
     for i, text in enumerate(shown):
         col, line = divmod(i, lines)
         table.text(col / ncol, 1.0 - (line + 0.5) / lines, text, fontsize=7.5,

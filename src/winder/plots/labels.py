@@ -66,6 +66,12 @@ def overlaps(boxes: list[Bbox]) -> list[tuple[int, int]]:
             if boxes[i].overlaps(boxes[j])]
 
 
+#: The labels' background: the lines beneath show through faintly.
+_BOX = {"boxstyle": "square,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.75}
+
+#: The line from a label placed away from its marker to the marker.
+_LEADER = {"arrowstyle": "-", "color": "C3", "lw": 0.5, "shrinkA": 0, "shrinkB": 3}
+
 #: Offsets [pt] tried for a label, nearest first: right, above, left, below, diagonals.
 _OFFSETS = [(dx * s, dy * s) for s in (4, 10, 18, 28, 40)
             for dx, dy in ((1, 0.6), (1, -1.6), (-1, 0.6), (-1, -1.6), (0, 1.4), (0, -2.6),
@@ -73,22 +79,24 @@ _OFFSETS = [(dx * s, dy * s) for s in (4, 10, 18, 28, 40)
 
 
 def place_labels(ax: plt.Axes, xy: list[tuple[float, float]], texts: list[str], *,
-                 fontsize: float = 7.0, color: str = "C3") -> list[Text]:
+                 fontsize: float = 7.0, color: str = "C3", avoid: list[Bbox] | None = None
+                 ) -> list[Text]:
     """Write ``texts[i]`` near the data point ``xy[i]`` of ``ax``, each at the nearest of
-    a set of offsets where it overlaps no label placed before it and stays inside the
-    axes (the nearest one when none is free). The figure's layout must be final (drawn
+    a set of offsets where it overlaps no label placed before it (nor a box of ``avoid``,
+    display coordinates) and stays inside the axes (the nearest one when none is free). The figure's layout must be final (drawn
     once, its layout engine off): the placement is in display coordinates."""
     fig = ax.figure
     renderer = fig.canvas.get_renderer()
     frame = ax.get_window_extent(renderer)
-    placed: list[Bbox] = []
+    placed: list[Bbox] = list(avoid or [])
     out = []
     for (x, y), text in zip(xy, texts, strict=True):
         best = None
         for dx, dy in _OFFSETS:
             art = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
                               fontsize=fontsize, color=color, ha="left" if dx >= 0 else
-                              "right", va="bottom")
+                              "right", va="bottom", bbox=_BOX,
+                              arrowprops=_LEADER if np.hypot(dx, dy) > 15 else None)
             box = art.get_window_extent(renderer).expanded(1.08, 1.15)
             inside = frame.containsx(box.x0) and frame.containsx(box.x1) and \
                 frame.containsy(box.y0) and frame.containsy(box.y1)
@@ -99,7 +107,7 @@ def place_labels(ax: plt.Axes, xy: list[tuple[float, float]], texts: list[str], 
         if best is None:  # nowhere free: the first offset, where it is least in the way
             dx, dy = _OFFSETS[0]
             art = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
-                              fontsize=fontsize, color=color, va="bottom")
+                              fontsize=fontsize, color=color, va="bottom", bbox=_BOX)
             best = (art, art.get_window_extent(renderer))
         placed.append(best[1])
         out.append(best[0])
@@ -107,5 +115,6 @@ def place_labels(ax: plt.Axes, xy: list[tuple[float, float]], texts: list[str], 
 
 
 def short_harmonic(name: str) -> str:
-    """``1x`` → ``1×``; a drum's rotation keeps its name."""
-    return re.sub(r"^(\d)x$", r"\1×", name)
+    """A harmonic's name in a table: ``1x`` → ``1× roll``; a drum's rotation keeps its
+    name (``drum front/rear``)."""
+    return re.sub(r"^(\d)x$", r"\1× roll", name)
