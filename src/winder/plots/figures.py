@@ -25,6 +25,7 @@ from winder.io.files import atomic_write, safe_stem  # noqa: E402
 from winder.io.result import Result  # noqa: E402
 from winder.plots.labels import cluster, mode_styles, place_labels, short_harmonic  # noqa: E402
 from winder.plots.layout import DPI  # noqa: E402
+from winder.plots.smooth import centred_mean  # noqa: E402
 from winder.scene.load import Scene  # noqa: E402
 
 __all__ = ["paper_figures", "closeup_end", "CLOSEUP_STEP", "machine_figures",
@@ -223,7 +224,8 @@ def _torque_panels(full: plt.Axes, zoom: plt.Axes, t: np.ndarray, torque: np.nda
     lo, hi = np.percentile(torque[late], [0.5, 99.5])
     pad = 0.3 * (hi - lo) + 1.0
     zoom.plot(t, torque, color="C3", lw=0.6)
-    zoom.plot(*window_mean(t, torque), color="k", lw=0.8, label="mean over 0.5 s")
+    tm, mean, used = centred_mean(t, torque, 0.5)
+    zoom.plot(tm, mean, color="k", lw=0.8, label=f"centred mean over {used:.3g} s")
     zoom.set_ylim(lo - pad, hi + pad)
     zoom.axhline(0.0, color="k", lw=0.5)
     zoom.set_ylabel(label)

@@ -21,6 +21,7 @@ from winder.plots import figures as _f
 from winder.plots.flex import flex_figures
 from winder.plots.layout import LEGEND_INSIDE, MAX_HEIGHT, line_styles, page_suffix
 from winder.plots.positions import FigureBody, figure_bodies, positions_figures
+from winder.plots.smooth import centred_mean
 from winder.scene.load import Scene
 
 __all__ = ["machine_figures"]
@@ -119,8 +120,8 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
             unit = _f._in(result, f"{d.name}_torque", "k")
             _panel(a, t, [(_body_label(d), result[f"{d.name}_torque"] / 1e3)],
                    "torque" + unit, f"{_body_label(d)}: drive torque{unit}", lw=0.4)
-            a.plot(*_f.window_mean(t, result[f"{d.name}_torque"] / 1e3), color="k", lw=0.8,
-                   label="mean over 0.5 s")
+            tm, mean, used = centred_mean(t, result[f"{d.name}_torque"] / 1e3, 0.5)
+            a.plot(tm, mean, color="k", lw=0.8, label=f"centred mean over {used:.3g} s")
             a.legend(fontsize=8, loc="upper left")
             a.axhline(0.0, color="k", lw=0.5)
         ax[-1].set_xlabel("t" + _f._in(result, "t"))
@@ -183,8 +184,8 @@ def _nip_forces(result: Result, forces: dict[str, np.ndarray],
                (f"{name}: nip normal forces{kn} (F_n = 0: nip open)\n" if i == 0 else "")
                + f"{nip_label[n]}: {np.mean(f <= 0.0):.1%} of samples open", lw=0.4,
                colors=[color[n]])
-        tm, fm = _f.window_mean(t, f / 1e3)
-        ax[i].plot(tm, fm, color="k", lw=0.8, label="mean over 0.5 s")
+        tm, fm, used = centred_mean(t, f / 1e3, 0.5)
+        ax[i].plot(tm, fm, color="k", lw=0.8, label=f"centred mean over {used:.3g} s")
         ax[i].legend(fontsize=8, loc="upper left")
         if i:
             ax[i].sharex(ax[0])

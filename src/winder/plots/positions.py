@@ -80,7 +80,7 @@ def _bounce_row(result: Result, y: np.ndarray, label: str, what: str, unit_mm: s
     def draw(ax: plt.Axes, _: plt.Axes) -> None:
         tb, b, used = bounce(t, y, BOUNCE_WINDOW)
         ax.plot(tb, 1e3 * b, lw=0.4, label=label)
-        ax.set_ylabel("bounce" + (unit_mm or " [mm]"))
+        ax.set_ylabel("bounce" + unit_mm)
         edge = f" (none in the first and last {used / 2:.3g} s)" if len(tb) \
             else " (the run is shorter than a window)"
         _title(ax, f"{what}: bounce, less its centred mean over {used:.3g} s{unit_mm}{edge}")
@@ -130,7 +130,7 @@ def _flex_rows(result: Result, body: FigureBody, units: Callable[[str, str], str
         for c in coords:
             ax.plot(t, 1e3 * (mean[c] - mean[c][0]), lw=0.6, label=f"{c} − {c}(0)",
                     ls="-" if c == "x" else "--")
-        ax.set_ylabel(", ".join(f"Δ{c}" for c in coords) + (mm or " [mm]"))
+        ax.set_ylabel(", ".join(f"Δ{c}" for c in coords) + mm)
         _title(ax, f"{body.label}: motion of its axis (the mean of its {n} segments) "
                f"from the start{mm}")
         ax.legend(fontsize=8, loc="upper left")

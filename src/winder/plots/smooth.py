@@ -10,15 +10,15 @@ __all__ = ["window_samples", "centred_mean", "bounce", "dirichlet_gain"]
 
 
 def window_samples(t: np.ndarray, window: float) -> int:
-    """The odd number of samples ``w`` of a centred window of about ``window`` [s] on the
-    time axis ``t`` (its median step), at most about half of the run (so that at least
-    half of the samples have a whole window; a run shorter than twice ``window`` gets a
-    shorter one: the caller states :func:`centred_mean`'s window). At least 1."""
+    """The odd number of samples ``w = 2h + 1`` of a centred window reaching ``h ≈
+    window/2`` [s] either side on the time axis ``t`` (its median step), at most about
+    half of the run (so that at least half of the samples have a whole window; a run
+    shorter than twice ``window`` gets a shorter one: the caller states
+    :func:`centred_mean`'s window). At least 1."""
     n = len(t)
-    dt = float(np.median(np.diff(t))) if n > 1 else window
-    w = max(1, int(round(window / dt))) if dt > 0 else 1
-    w = min(w, max(1, (n + 1) // 2))
-    return w if w % 2 else max(1, w - 1)
+    dt = float(np.median(np.diff(t))) if n > 1 else 0.0
+    h = int(round(window / (2 * dt))) if dt > 0 else 0
+    return 2 * max(0, min(h, (n - 1) // 4)) + 1
 
 
 def centred_mean(t: np.ndarray, y: np.ndarray, window: float = 0.5
