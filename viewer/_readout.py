@@ -15,15 +15,14 @@ import json
 from types import SimpleNamespace
 
 import numpy as np
-
 from winder.viewer._motion import BodyMotion, Motion
 
 from winder.forces import FORCES
 from winder.model.channels import GENERIC_CHANNELS, WEB_SPEED
 from winder.parts import PARTS
 
-__all__ = ["readout_text", "deflections", "with_readout", "unit_of", "DEFAULT_UNITS", "SURFACE_SPEED_UNIT",
-           "READOUT_ID"]
+__all__ = ["readout_text", "deflections", "with_readout", "unit_of", "DEFAULT_UNITS",
+           "SURFACE_SPEED_UNIT", "READOUT_ID"]
 
 READOUT_ID = "winder-readout"
 

@@ -38,10 +38,11 @@ def test_readout_has_a_line_per_flexible_body_and_per_sliced_nip() -> None:
     largest force. Oracles: the deflections from the channels as the figures take them
     (winder.plots.flex.deflection), the total against the scene nip's own channel
     (flex_beam writes it: the other path), to the printed resolution."""
-    import winder
-    from winder.plots.flex import deflection, flexible_bodies
     from winder.viewer._motion import motion
     from winder.viewer._readout import readout_text
+
+    import winder
+    from winder.plots.flex import deflection, flexible_bodies
 
     models = Path(__file__).resolve().parents[2] / "models"
     scene = winder.load_scene(models / "two_drum_winder_flexible.toml")

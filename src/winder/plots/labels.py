@@ -83,8 +83,9 @@ def place_labels(ax: plt.Axes, xy: list[tuple[float, float]], texts: list[str], 
                  ) -> list[Text]:
     """Write ``texts[i]`` near the data point ``xy[i]`` of ``ax``, each at the nearest of
     a set of offsets where it overlaps no label placed before it (nor a box of ``avoid``,
-    display coordinates) and stays inside the axes (the nearest one when none is free). The figure's layout must be final (drawn
-    once, its layout engine off): the placement is in display coordinates."""
+    display coordinates) and stays inside the axes (the nearest one when none is free).
+    The figure's layout must be final (drawn once, its layout engine off): the placement
+    is in display coordinates."""
     fig = ax.figure
     renderer = fig.canvas.get_renderer()
     frame = ax.get_window_extent(renderer)
