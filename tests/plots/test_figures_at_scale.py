@@ -207,3 +207,19 @@ def test_the_positions_figure_draws_the_bounce_without_edge_artefact(tmp_path) -
     np.testing.assert_allclose(b, 1e3 * A * (1 - D) * np.sin(2 * np.pi * f * tb), rtol=0,
                                atol=1e-11)
     assert tb[-1] < t[-1] and tb[0] > t[0]  # no sample without a whole window
+
+
+def test_rows_go_onto_pages_of_at_most_4000_px() -> None:
+    """The layout rule by count: bodies' groups of rows packed in order onto pages, a
+    group never split, each page's height (header + rows) at most 4000 px."""
+    from winder.plots.layout import HEADER, ROW, pages, rows_per_page
+
+    limit = rows_per_page()
+    assert (HEADER + ROW * limit) * DPI <= MAX_HEIGHT_PX < (HEADER + ROW * (limit + 1)) * DPI
+    for groups in ([3] * 40, [4, 5, 3, 2] * 9, [1] * 100, [limit] * 3):
+        out = pages(groups)
+        assert [i for page in out for i in page] == list(range(len(groups)))
+        for page in out:
+            assert (HEADER + ROW * sum(groups[i] for i in page)) * DPI <= MAX_HEIGHT_PX
+        assert len(out) == len(pages(groups))  # deterministic
+    assert len(pages([4] * 4)) == 1  # the flexible machine: 4 bodies of 4 rows, one page

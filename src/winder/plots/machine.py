@@ -122,7 +122,7 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
                    "torque" + unit, f"{_body_label(d)}: drive torque{unit}", lw=0.4)
             tm, mean, used = centred_mean(t, result[f"{d.name}_torque"] / 1e3, 0.5)
             a.plot(tm, mean, color="k", lw=0.8, label=f"centred mean over {used:.3g} s")
-            a.legend(fontsize=8, loc="upper left")
+            a.legend(fontsize=8, loc="lower right")
             a.axhline(0.0, color="k", lw=0.5)
         ax[-1].set_xlabel("t" + _f._in(result, "t"))
         paths.append(_f._save(fig, out / f"{stem}_drums{page_suffix(page)}.png"))
@@ -186,7 +186,7 @@ def _nip_forces(result: Result, forces: dict[str, np.ndarray],
                colors=[color[n]])
         tm, fm, used = centred_mean(t, f / 1e3, 0.5)
         ax[i].plot(tm, fm, color="k", lw=0.8, label=f"centred mean over {used:.3g} s")
-        ax[i].legend(fontsize=8, loc="upper left")
+        ax[i].legend(fontsize=8, loc="lower right")
         if i:
             ax[i].sharex(ax[0])
     top = max([float(np.max(f)) / 1e3 for f in every.values()] + [0.0])
