@@ -67,6 +67,12 @@ def _groups(m: Motion) -> dict[str, list[BodyMotion]]:
     return out
 
 
+def _mean(values: list[float]) -> float:
+    """The mean of a flexible body's segments' values; a rigid body's own value (its
+    sign of zero too)."""
+    return float(values[0]) if len(values) == 1 else float(np.mean(values))
+
+
 def deflections(segments: list[BodyMotion], k: int) -> np.ndarray:
     """The deflection [m] of each segment of a flexible body at sample ``k``: its
     distance in the ``x``–``z`` plane from its bearings' line (a drum), else from the
@@ -95,11 +101,11 @@ def readout_text(m: Motion, k: int) -> str:
     width = max(len(n) for n in (*groups, *nips, "span", *labels))
     for name, segs in groups.items():
         if segs[0].radius_state:
-            r = float(np.mean([b.radius[k] for b in segs]))
+            r = _mean([b.radius[k] for b in segs])
             lines.append(f"{name:<{width}}  r {r:8.4f} {unit_of(m, 'radius', segs[0].name)}")
     for name, segs in groups.items():
-        w = float(np.mean([b.speed[k] for b in segs]))
-        v = float(np.mean([b.speed[k] * b.radius[k] for b in segs]))
+        w = _mean([b.speed[k] for b in segs])
+        v = _mean([b.speed[k] * b.radius[k] for b in segs])
         line = f"{name:<{width}}  {w:8.2f} {unit_of(m, 'speed', segs[0].name)} " \
             f"{v:7.2f} {SURFACE_SPEED_UNIT}"
         if segs[0].segment_of is not None:
