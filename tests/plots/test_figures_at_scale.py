@@ -56,8 +56,10 @@ def _check(fig, name: str) -> dict:
         overlaps += [(texts[i].get_text(), texts[j].get_text())
                      for i in range(len(boxes)) for j in range(i + 1, len(boxes))
                      if boxes[i].overlaps(boxes[j])]
+    outside = [(leg.get_window_extent(renderer), fig.axes[0].get_window_extent(renderer),
+                fig.bbox.frozen()) for leg in fig.legends]
     return {"height": fig.get_size_inches()[1] * DPI, "styles": styles,
-            "overlaps": overlaps, "name": name}
+            "overlaps": overlaps, "name": name, "outside": outside}
 
 
 def _capture(monkeypatch) -> dict[str, dict]:
@@ -127,6 +129,9 @@ def test_resonance_map_of_the_flexible_machine(tmp_path, monkeypatch) -> None:
     fig = info["figure"]
     chart = fig.axes[0]
     assert chart.get_legend() is None and len(fig.legends) == 1  # beside the chart
+    legend, frame, page = info["outside"][0]
+    assert legend.x0 >= frame.x1 and not legend.overlaps(frame)
+    assert legend.x1 <= page.x1 + 0.5  # inside the figure
     crossings = mm.crossings(mm.shown())
     assert len(crossings) >= 20
     numbers = [n for t in chart.texts if t.get_text()[:1].isdigit()
