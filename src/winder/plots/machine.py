@@ -26,6 +26,8 @@ from winder.scene.load import Scene
 
 __all__ = ["machine_figures"]
 
+#: Line styles and markers of lines that share a colour (the k-th of a colour).
+_DASHES, _MARKS = ("-", "--", "-.", ":"), ("", "o", "s", "^")
 #: Height of a row of the drums', nips' and slip figures [in].
 _ROW = 2.3
 
@@ -52,11 +54,16 @@ def _panel(ax: plt.Axes, t: np.ndarray, lines: list[tuple[str, np.ndarray]], yla
            title: str, *, lw: float = 0.8, colors: list[str] | None = None) -> None:
     """One axes: a line per ``(label, values)``, legend naming the parts."""
     many = len(lines) > LEGEND_INSIDE  # distinct styles, the legend beside the panel
-    styles = line_styles(len(lines)) if many else [(None, "-", "")] * len(lines)
+    if colors is not None:  # given colours (a nip's): a repeated one gets another style
+        seen = [colors[:i].count(c) for i, c in enumerate(colors)]
+        styles = [(c, _DASHES[k % 4], _MARKS[k // 4 % 4]) for c, k in zip(colors, seen,
+                                                                        strict=True)]
+    else:
+        styles = line_styles(len(lines)) if many else [(None, "-", "")] * len(lines)
     for i, (label, y) in enumerate(lines):
         colour, ls, marker = styles[i]
-        ax.plot(t, y, lw=lw, label=label, color=colour if colors is None else colors[i],
-                ls=ls, marker=marker or None, markevery=0.1 if marker else None, ms=4)
+        ax.plot(t, y, lw=lw, label=label, color=colour, ls=ls, marker=marker or None,
+                markevery=0.1 if marker else None, ms=4)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
