@@ -214,7 +214,7 @@ def _nip_forces(result: Result, forces: dict[str, np.ndarray],
     for line in ax[-1].get_lines():
         line.set_marker(".")
         line.set_markersize(3)
-    ax[-1].legend(fontsize=7, loc="upper right", framealpha=0.9)
+    ax[-1].legend(fontsize=7, loc="best", framealpha=0.9)
     ax[-1].set_xlabel("t" + _f._in(result, "t"))
     return _f._save(fig, path)
 
