@@ -17,7 +17,8 @@ web-speed rate in ``ω̇_ref`` is, by default, the mean over the coming step of 
 speed reference ``min(a_w t, v_w)`` (the drive master's, known ahead);
 ``--feedforward measured`` takes the drum's acceleration output at the step's start
 instead, which holds the ramp's feed-forward one step past the ramp's end. The run goes
-on until the parent reaches its core (the FMU's step then fails with the reason logged).
+on until the parent reaches its core: the FMU then refuses the step (fmi2Discard) and
+terminates at the run-out time, which is printed as the planned end it is.
 Writes ``tension_control_fmu.png`` and ``tension_control_fmu.npz`` to ``--out``.
 
     python examples/tension_control_fmu.py [--t-end 60] [--step 0.002] [--out out]
@@ -94,15 +95,65 @@ class TensionLaw:
         return J * w_ref_dot - r * self.T_set - kp * e - ki * integral + kd * T_dot, e
 
 
+#: The FMU's message of the planned run-out (logged with status fmi2Discard).
+RUN_OUT = "ran out of web"
+
+
+class RunOutLog:
+    """FMPy's callbacks for the FMU's log (FMI 2.0) that keep the planned run-out's
+    message (status fmi2Discard, :data:`RUN_OUT`) instead of printing it, and print every
+    other message as FMPy does: the run-out is reported once, as planned."""
+
+    def __init__(self) -> None:
+        from ctypes import byref
+
+        from fmpy.fmi2 import (
+            defaultCallbacks,
+            fmi2CallbackFunctions,
+            fmi2CallbackLoggerTYPE,
+            printLogMessage,
+        )
+
+        self.planned: list[str] = []
+
+        def logger(component, instance, status, category, message) -> None:
+            text = message.decode("utf-8", "replace")
+            if status == 2 and RUN_OUT in text:  # fmi2Discard: the planned run-out
+                self.planned.append(text)
+            else:
+                printLogMessage(component, instance, status, category, message)
+
+        self._logger = fmi2CallbackLoggerTYPE(logger)  # kept alive while the FMU runs
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = self._logger
+        self.callbacks.allocateMemory = defaultCallbacks.allocateMemory
+        self.callbacks.freeMemory = defaultCallbacks.freeMemory
+        try:  # FMPy's proxy formats the message's printf arguments
+            from fmpy.logging import addLoggerProxy
+
+            addLoggerProxy(byref(self.callbacks))
+        except Exception:  # noqa: BLE001 - without it the message comes unformatted
+            pass
+
+
 def run(fmu_file: Path, law: TensionLaw, t_end: float, dt: float
-        ) -> tuple[dict[str, np.ndarray], str | None]:
+        ) -> tuple[dict[str, np.ndarray], float | None]:
     """The closed loop until ``t_end`` [s] or the parent's run-out: the log by name
-    (``tau``, ``e`` and the outputs :data:`READS`), and why it stopped early (None)."""
+    (``tau``, ``e`` and the outputs :data:`READS`), and the time [s] of the run-out
+    (None: none). The run-out is the FMU's step refused with fmi2Discard and the FMU
+    terminated (fmi2Terminated) at its last successful time; any other failure of a step
+    is raised."""
+    from fmpy.fmi1 import FMICallException
+    from fmpy.fmi2 import fmi2LastSuccessfulTime, fmi2Terminated
+
     from winder.fmu.host import loaded_fmu, start_fmu
 
     rows: list[list[float]] = []
     ended = None
+    log = RunOutLog()
     with loaded_fmu(fmu_file, instance_name="tension") as (fmu, refs, _):
+        instantiate = fmu.instantiate  # with the callbacks that keep the planned message
+        fmu.instantiate = lambda **kw: instantiate(**kw, callbacks=log.callbacks)
         start_fmu(fmu, refs, logging=False)
         vr, u = [refs[k] for k in READS], [refs["parent_torque"]]
         integral, e_prev, i = 0.0, None, 0
@@ -119,14 +170,16 @@ def run(fmu_file: Path, law: TensionLaw, t_end: float, dt: float
             fmu.setReal(u, [tau])
             try:
                 fmu.doStep(currentCommunicationPoint=i * dt, communicationStepSize=dt)
-            except Exception as exc:  # FMPy raises on a failed step: the run-out
-                ended = f"the FMU stopped at step {i} ({exc})"
+            except FMICallException as exc:  # fmi2Discard and terminated: the run-out
+                if exc.status != 2 or not fmu.getBooleanStatus(fmi2Terminated):
+                    raise
+                ended = fmu.getRealStatus(fmi2LastSuccessfulTime)
                 # the outputs are those of the run-out time (read once more above)
             i += 1
         fmu.terminate()
         fmu.freeInstance()
-    log = np.array(rows)
-    return dict(zip(("tau", "e", *READS), log.T, strict=True)), ended
+    table = np.array(rows)
+    return dict(zip(("tau", "e", *READS), table.T, strict=True)), ended
 
 
 def plot(log: dict[str, np.ndarray], T_set: float, path: Path) -> None:
@@ -195,7 +248,8 @@ def main(argv: list[str] | None = None) -> int:
           + (f"{args.fmu}" if args.fmu is not None else f"built in {wall1 - wall0:.1f} s")
           + f"), {args.step * 1e3:g} ms steps, "
           f"{len(t) - 1} steps, feed-forward: {args.feedforward}")
-    print(f"run-out: {ended}" if ended else "the parent did not run out")
+    print(f"run-out at t = {ended:.4f} s (planned: the parent reached its core)"
+          if ended is not None else "the parent did not run out")
     print(f"parent radius {log['parent_radius'][-1]:.6f} m, set radius "
           f"{log['set_radius'][-1]:.6f} m at the end")
     print(f"tension error: peak {abs(e[k]):.3f} N at t = {t[k]:.3f} s, "

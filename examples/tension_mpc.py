@@ -25,7 +25,7 @@ both over the ramp are printed and drawn.
 
 Writes ``tension_mpc.png`` to ``--out``.
 
-    python examples/tension_mpc.py [--t-end 21] [--dt 0.01] [--horizon 20]
+    python examples/tension_mpc.py [--t-end 23] [--dt 0.01] [--horizon 20]
                                    [--move-scale 300] [--out out] [--quick]
 """
 
@@ -129,8 +129,9 @@ class TensionMPC:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--t-end", type=float, default=21.0,
-                    help="end time [s] (default 21: the drums' ramp to 41.7 m/s, 20.85 s)")
+    ap.add_argument("--t-end", type=float, default=23.0,
+                    help="end time [s] (default 23: the drums' ramp to 41.7 m/s, 20.85 s, "
+                    "and 2 s at full speed after it)")
     ap.add_argument("--dt", type=float, default=0.01, help="MPC step [s] (default 0.01)")
     ap.add_argument("--horizon", type=int, default=20, help="steps (default 20)")
     ap.add_argument("--move-scale", type=float, default=300.0,
@@ -175,7 +176,7 @@ def main() -> None:
     err_ref = np.interp(ts, ref.t, ref["tension_error"])
     ramp_end = 41.7 / 2.0  # [s] the drums reach 41.7 m/s at 2 m/s²
     windows = {"over the ramp (0.5 s <= t < 20.8 s)": (ts >= 0.5) & (ts < ramp_end - 0.05),
-               "at the ramp's end (t >= 20.8 s)": ts >= ramp_end - 0.05}
+               f"at the ramp's end (20.8 s <= t <= {t_end:g} s)": ts >= ramp_end - 0.05}
     print(f"casadi_model {t_model:.2f} s, MPC built {t_build:.2f} s, {steps} MPC steps "
           f"in {t_loop:.1f} s ({1e3 * t_loop / steps:.1f} ms each, the line's step "
           "included)")
@@ -185,19 +186,43 @@ def main() -> None:
         for name, e in (("MPC", err_mpc), ("built-in controller", err_ref)):
             print(f"{name}: tension error {what}: max {np.max(np.abs(e[w])):.4g} N, "
                   f"rms {np.sqrt(np.mean(e[w] ** 2)):.4g} N")
-    fig, (ax_e, ax_u) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
-    ax_e.plot(ts, err_mpc, label="MPC on casadi_model")
-    ax_e.plot(ts, err_ref, label="built-in controller (simulate)")
-    ax_e.set_yscale("symlog", linthresh=1e-3)
-    ax_e.set(ylabel="tension error T* − T [N]",
-             title="Span tension of the small winder line over the drums' ramp")
-    ax_e.legend()
-    ax_u.plot(ts, us, label="MPC unwind torque")
-    ax_u.plot(ref.t[ref.t <= t_end], ref["parent_torque"][ref.t <= t_end],
-              label="built-in controller's torque")
-    ax_u.set(xlabel="t [s]", ylabel="parent torque [N·m]")
-    ax_u.legend()
-    fig.tight_layout()
+    ref_t, ref_u = ref.t[ref.t <= t_end], ref["parent_torque"][ref.t <= t_end]
+    # left: the whole run; right: the event, the ramp's end, framed (from 0.5 s before it
+    # to 1.5 s after it, or the run's end)
+    lo, hi = max(0.0, ramp_end - 0.5), min(t_end, ramp_end + 1.5)
+    fig, ax = plt.subplots(2, 2, figsize=(13, 7.5), sharex="col",
+                           gridspec_kw={"width_ratios": (3, 2)}, layout="constrained")
+    for col, (a, b) in enumerate(((0.0, t_end), (lo, hi))):
+        w, wr = (ts >= a) & (ts <= b), (ref_t >= a) & (ref_t <= b)
+        ax_e, ax_u = ax[0, col], ax[1, col]
+        ax_e.plot(ts[w], err_mpc[w], label="MPC on casadi_model")
+        ax_e.plot(ts[w], err_ref[w], label="built-in controller (simulate)")
+        ax_u.plot(ts[w], np.array(us)[w], label="MPC unwind torque")
+        ax_u.plot(ref_t[wr], ref_u[wr], label="built-in controller's torque")
+        for a_ in (ax_e, ax_u):
+            a_.grid(True, alpha=0.3)
+            if ramp_end <= t_end:
+                a_.axvline(ramp_end, color="k", lw=0.8, ls=":")
+        ax_u.set_xlabel("t [s]")
+    ax[0, 0].set_yscale("symlog", linthresh=1e-3)
+    ax[0, 0].set(ylabel="tension error T* − T [N]", title="the whole run")
+    fig.suptitle("Span tension of the small winder line over the drums' ramp")
+    ax[1, 0].set(ylabel="parent torque [N·m]")
+    ax[0, 0].legend(loc="lower left")
+    ax[1, 0].legend(loc="lower left")
+    if hi > lo:
+        for a_ in ax[:, 0]:  # where the right column looks
+            a_.axvspan(lo, hi, color="0.85", zorder=0)
+        after = f"{hi - ramp_end:.2g} s after it" + (" (the run's end)" if hi >= t_end
+                                                      else "")
+        ax[0, 1].set_title(f"the event: the ramp's end at t = {ramp_end:.2f} s (dotted),\n"
+                           f"from 0.5 s before it to {after}", fontsize=10)
+        ax[0, 1].set_ylabel("tension error T* − T [N]")
+        ax[1, 1].set_ylabel("parent torque [N·m]")
+        ax[0, 1].set_xlim(lo, hi)
+    else:
+        for a_ in ax[:, 1]:
+            a_.set_visible(False)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     fig.savefig(out / "tension_mpc.png", dpi=100)

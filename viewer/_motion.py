@@ -157,6 +157,11 @@ class BodyMotion:
     radius: np.ndarray
     speed: np.ndarray
     radius_state: bool = False
+    #: a segment of a flexible body: that body's name (the readout aggregates them)
+    segment_of: str | None = None
+    #: a flexible drum's segment: the centre of its bearings' line ``(x, z)`` [m], which
+    #: its deflection is taken from (None: from its segments' mean)
+    support: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -193,6 +198,8 @@ class Motion:
     span_tension: np.ndarray | None = None
     webs: tuple[WebMotion, ...] = ()
     units: Mapping[str, str] = field(default_factory=dict)
+    #: the slices of a sliced nip (against a flexible body): slice name → the scene's nip
+    slices: Mapping[str, str] = field(default_factory=dict)
 
     def web(self, k: int) -> np.ndarray | None:
         """The first web's path at sample ``k`` (:meth:`web_paths`), or ``None``."""
@@ -244,9 +251,12 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
             if role in ch and ch[role] in result:
                 return sample(ch[role])
             return np.full_like(times, const[role])
+        segment_of = getattr(b, "segment_of", None)
+        support = tuple(b.part.centre) if segment_of and \
+            type(b.part).__name__ == "DrumPart" else None
         bodies[b.name] = BodyMotion(b.name, b.role, b.sense, get("x"), get("z"),
                                     b.sense * get("angle") * spin_gain, get("radius"),
-                                    get("speed"), b.radius_state)
+                                    get("speed"), b.radius_state, segment_of, support)
     forces = {n: (sample(c) if c in result else None)
               for n, c in nip_channels(scene, m).items()}
     webs = []
@@ -259,11 +269,12 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
             tension = sample(ch) if ch in result else None
         webs.append(WebMotion(w.name, (w.entry.a.name, w.entry.b.name), unwind, exit_,
                               tension))
+    slices = {n.name: n.whole for n in m.nips if getattr(n, "whole", None)}
     if not webs:
-        return Motion(times, bodies, forces, None, units=dict(result.units))
+        return Motion(times, bodies, forces, None, units=dict(result.units), slices=slices)
     first = webs[0]
     return Motion(times, bodies, forces, first.entry, first.unwind, first.exit,
-                  first.span_tension, tuple(webs), units=dict(result.units))
+                  first.span_tension, tuple(webs), units=dict(result.units), slices=slices)
 
 
 def exit_points(machine: Machine, bodies: dict[str, BodyMotion], web: Web | None = None

@@ -14,14 +14,15 @@ import html
 import json
 from types import SimpleNamespace
 
-from winder.viewer._motion import Motion
+import numpy as np
+from winder.viewer._motion import BodyMotion, Motion
 
 from winder.forces import FORCES
 from winder.model.channels import GENERIC_CHANNELS, WEB_SPEED
 from winder.parts import PARTS
 
-__all__ = ["readout_text", "with_readout", "unit_of", "DEFAULT_UNITS", "SURFACE_SPEED_UNIT",
-           "READOUT_ID"]
+__all__ = ["readout_text", "deflections", "with_readout", "unit_of", "DEFAULT_UNITS",
+           "SURFACE_SPEED_UNIT", "READOUT_ID"]
 
 READOUT_ID = "winder-readout"
 
@@ -58,28 +59,70 @@ def unit_of(m: Motion, quantity: str, name: str = "") -> str:
     return DEFAULT_UNITS[quantity]
 
 
+def _groups(m: Motion) -> dict[str, list[BodyMotion]]:
+    """The bodies of ``m`` by part: a flexible body's segments under its name."""
+    out: dict[str, list[BodyMotion]] = {}
+    for b in m.bodies.values():
+        out.setdefault(b.segment_of or b.name, []).append(b)
+    return out
+
+
+def _mean(values: list[float]) -> float:
+    """The mean of a flexible body's segments' values; a rigid body's own value (its
+    sign of zero too)."""
+    return float(values[0]) if len(values) == 1 else float(np.mean(values))
+
+
+def deflections(segments: list[BodyMotion], k: int) -> np.ndarray:
+    """The deflection [m] of each segment of a flexible body at sample ``k``: its
+    distance in the ``x``–``z`` plane from its bearings' line (a drum), else from the
+    segments' mean (its bending alone), as the figures take it."""
+    xz = np.array([(b.x[k], b.z[k]) for b in segments])
+    ref = segments[0].support if segments[0].support is not None else xz.mean(axis=0)
+    return np.hypot(*(xz - np.asarray(ref)).T)
+
+
 def readout_text(m: Motion, k: int) -> str:
     """The readout of sample ``k`` of ``m``: ``t``; per paper roll its radius; per body
     its speed and surface speed (:data:`SURFACE_SPEED_UNIT`); per nip its normal force
     (in thousands: kN); on a winder line the span's tension ``span  T … N`` (``-``
     without its channel). The units are the result's (:func:`unit_of`): [s], [m],
-    [rad/s], [N] for a result of winder."""
+    [rad/s], [N] for a result of winder. A flexible body is one line (its segments'
+    mean speed, their largest and mean deflection :func:`deflections` [mm]) and a sliced
+    nip one (its slices' total force, their least and largest), whatever their number."""
     lines = [f"t  {m.times[k]:10.2f} {unit_of(m, 't')}"]
     spans = [w for w in m.webs if w.unwind is not None] or (
         [SimpleNamespace(name="", span_tension=m.span_tension)] if m.unwind is not None else [])
     labels = ["span" if len(spans) == 1 else f"{w.name} span" for w in spans]
-    width = max(len(n) for n in (*m.bodies, *m.normal_forces, "span", *labels))
-    for b in m.bodies.values():
-        if b.radius_state:
-            lines.append(f"{b.name:<{width}}  r {b.radius[k]:8.4f} "
-                         f"{unit_of(m, 'radius', b.name)}")
-    for b in m.bodies.values():
-        w = b.speed[k]
-        lines.append(f"{b.name:<{width}}  {w:8.2f} {unit_of(m, 'speed', b.name)} "
-                     f"{w * b.radius[k]:7.2f} {SURFACE_SPEED_UNIT}")
-    for name, f in m.normal_forces.items():
-        value = "      -" if f is None else f"{f[k] / 1e3:8.3f}"
-        lines.append(f"{name:<{width}}  N {value} k{unit_of(m, 'normal_force', name)}")
+    groups = _groups(m)
+    nips: dict[str, list[str]] = {}
+    for name in m.normal_forces:
+        nips.setdefault(m.slices.get(name, name), []).append(name)
+    width = max(len(n) for n in (*groups, *nips, "span", *labels))
+    for name, segs in groups.items():
+        if segs[0].radius_state:
+            r = _mean([b.radius[k] for b in segs])
+            lines.append(f"{name:<{width}}  r {r:8.4f} {unit_of(m, 'radius', segs[0].name)}")
+    for name, segs in groups.items():
+        w = _mean([b.speed[k] for b in segs])
+        v = _mean([b.speed[k] * b.radius[k] for b in segs])
+        line = f"{name:<{width}}  {w:8.2f} {unit_of(m, 'speed', segs[0].name)} " \
+            f"{v:7.2f} {SURFACE_SPEED_UNIT}"
+        if segs[0].segment_of is not None:
+            d = 1e3 * deflections(segs, k)
+            line += f"  δ max {d.max():.3f} mean {d.mean():.3f} mm"
+        lines.append(line)
+    for name, parts in nips.items():
+        forces = [m.normal_forces[p] for p in parts]
+        if any(f is None for f in forces):
+            value, more = "      -", ""
+        else:
+            each = np.array([f[k] for f in forces]) / 1e3
+            value = f"{each.sum():8.3f}"
+            more = f"  ({len(parts)} slices {each.min():.3f}–{each.max():.3f} kN)" \
+                if len(parts) > 1 else ""
+        lines.append(f"{name:<{width}}  N {value} k{unit_of(m, 'normal_force', parts[0])}"
+                     + more)
     for label, w in zip(labels, spans, strict=True):
         T = w.span_tension
         value = "      -" if T is None else f"{T[k]:8.1f}"

@@ -480,9 +480,13 @@ def test_units_come_from_the_key_declarations() -> None:
     assert key_unit("drum.drive.radius", {"drum": [{"name": "drive"}]}) == "m"
     assert key_unit("drum.drive.web_speed", {"drum": {"drive": {}}}) == "m/s"
     assert axis_label(TIED, {"drum": []}) == \
-        "drum.front.drive.web_speed,\ndrum.rear.drive.web_speed [m/s]"
+        "drum front drive: web speed,\ndrum rear drive: web speed [m/s]"
     assert axis_label("drum.front.radius,roll.set.core_mass", {"drum": [], "roll": []}) == \
-        "drum.front.radius [m],\nroll.set.core_mass [kg]"
+        "drum front: drum radius R [m],\nroll set: mass of the core [kg]"
+    # in words, from the keys' declarations (#36): no raw key path on an axis
+    assert axis_label("drum.drive.web_speed", {"drum": {"drive": {}}}) == \
+        "drum drive: web speed [m/s]"
+    assert axis_label("roll.com_offset", {"roll": {}}) == "roll: centre-of-mass offset [m]"
 
 
 def test_tied_sweep_runs_are_the_hand_edited_scenes(cluster, two_drum, tmp_path, capsys,
@@ -529,7 +533,7 @@ def test_tied_sweep_runs_are_the_hand_edited_scenes(cluster, two_drum, tmp_path,
     assert again.computed == () and len(again.skipped) == 3  # the same runs: all done
     (fig,) = figures
     labels = [ax.get_ylabel() for ax in fig.axes if ax.get_ylabel()]
-    assert "drum.front.drive.web_speed,\ndrum.rear.drive.web_speed [m/s]" in labels
+    assert "drum front drive: web speed,\ndrum rear drive: web speed [m/s]" in labels
     assert any(ax.get_xlabel() == "roll diameter [m]" for ax in fig.axes)
 
 

@@ -695,3 +695,22 @@ def test_cli_builds_either_single_drum_machine(tmp_path, models_dir) -> None:
     assert proc.returncode == 2 and "speed_profile" in proc.stderr, proc.stderr
     assert "Traceback" not in proc.stderr
     assert not (tmp_path / "parts.fmu").exists()
+
+
+def test_tension_example_reports_the_planned_run_out(line_fmu, tmp_path) -> None:
+    """examples/tension_control_fmu.py to the parent's run-out (about 56.2 s): the FMU's
+    refused step (fmi2Discard, terminated) is reported once, as the planned end it is
+    ("run-out at t = ... (planned ...)"), its time that of the log's last outputs; no
+    "[DISCARD]" log line, no "failed with status" (it printed "fmi2DoStep failed with
+    status 2")."""
+    example = Path(__file__).resolve().parents[2] / "examples" / "tension_control_fmu.py"
+    proc = subprocess.run([sys.executable, str(example), "--fmu", str(line_fmu), "--out",
+                           str(tmp_path)], capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = proc.stdout + proc.stderr
+    assert "[DISCARD]" not in out and "failed with status" not in out, out
+    lines = [s for s in out.splitlines() if "run-out" in s]
+    assert len(lines) == 1 and lines[0].endswith("(planned: the parent reached its core)")
+    t_out = float(lines[0].split("t = ")[1].split()[0])
+    t = np.load(tmp_path / "tension_control_fmu.npz")["t"]
+    assert t_out == pytest.approx(t[-1], abs=1e-4) and 56.0 < t_out < 56.5

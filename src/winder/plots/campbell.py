@@ -5,9 +5,11 @@ without a wound roll, or with contact off) as markers."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
+from matplotlib.transforms import Bbox
 
 from winder.analysis.modes import FREE_BELOW
 from winder.io.result import Result
@@ -20,6 +22,7 @@ from winder.plots.figures import (
     normal_force_envelope,
     plt,
 )
+from winder.plots.labels import cluster, mode_styles, place_labels, short_harmonic
 
 __all__ = ["campbell_figure"]
 
@@ -36,41 +39,57 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     marked; with ``result``, the simulated normal-force envelopes below on the same radius
     axis (``envelopes``: label → (force channel, radius channel); default the single-drum
     ``normal_force`` against ``radius``; ``colours``: label → colour, :func:`nip_colours`
-    when the labels are nip names, so that a nip has its colour of the run figures)."""
+    when the labels are nip names, so that a nip has its colour of the run figures).
+
+    With more than one mode: a colour per body and a line style and marker per mode of it
+    (:func:`winder.plots.labels.mode_styles`, no two alike), the legend beside the chart,
+    each crossing numbered where its number overlaps no other (crossings closer than a
+    marker share one) and listed in a table below the chart."""
     mm = mode_map
-    rows = 2 if result is not None else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(12, 6.5 * rows) if mm.flexible else (8, 4.2 * rows),
-                             sharex=True, squeeze=False)
-    ax = axes[0, 0]
+    one = len(mm.coordinates) == 1
+    drawn = mm.shown() if mm.flexible else mm.coordinates  # flexible: orders 1-2, torsion 1
+    crossings = mm.crossings(drawn)
+    width, height = (13.5, 6.5) if mm.flexible else (8, 4.2) if one else (11, 4.6)
+    rows = _crossing_rows(crossings)
+    # the table's columns: as many as fit beside the legend (its longest label, 7 pt)
+    legend = _PT * 7 * max([54, *(len(f"bending mode {c} (damped)") for c in drawn)]) + 0.9
+    column = _PT * 7.5 * max([len(x) for x in rows] + [1]) + 0.3
+    ncol = max(1, min(math.ceil(len(rows) / 6), int((width - legend - 0.9) // column)))
+    lines = min(math.ceil(len(rows) / ncol), _TABLE_LINES) if rows and not one else 0
+    heights = [height] * (2 if result is not None else 1) + ([0.35 + 0.16 * lines]
+                                                               if lines else [])
+    fig = plt.figure(figsize=(width, sum(heights)), layout="constrained")
+    grid = fig.add_gridspec(len(heights), 1, height_ratios=heights)
+    ax = fig.add_subplot(grid[0])
     r = mm.radius
     single = len(r) == 1  # the initial state (or a map of one radius): markers, no lines
     if single and not np.isfinite(r[0]):  # no wound roll: no radius axis
         r = np.zeros(1)
-    one = len(mm.coordinates) == 1
-    drawn = mm.shown() if mm.flexible else mm.coordinates  # flexible: orders 1-2, torsion 1
+    styles = {c: (MODE_COLOURS[i % len(MODE_COLOURS)], "-", "") for i, c in enumerate(drawn)} \
+        if not mm.flexible else mode_styles(drawn, MODE_COLOURS)
+    over = []  # the overdamped stretches: (mode, mask)
     for i, c in enumerate(drawn):
         f = mm.frequencies[c] if c in mm.frequencies else mm.torsion[c]
-        colour = MODE_COLOURS[i % len(MODE_COLOURS)]
+        colour, ls, marker = styles[c]
         kind = "torsion" if c in mm.torsion else "bending" if ".bend." in c else "bounce"
-        style = {"marker": "D" if kind == "torsion" else "o", "ls": "none", "ms": 7} \
-            if single else {"lw": 2 if kind == "bounce" else 1.5,
-                            "ls": "-" if kind != "torsion" else (0, (5, 1))}
-        if single and ".bend.x" in c:  # beside its z order of the same frequency: hollow
-            style.update(mfc="none", ms=11, mew=1.5)
-        free = single and c in mm.natural and mm.natural[c][0] < FREE_BELOW
-        if free:  # a zero eigenvalue: nothing holds it, a mark along the bottom
-            ax.plot(r, [0.03 + 0.04 * i], marker="v", ms=8, ls="none", color=colour,
-                    transform=ax.get_xaxis_transform(), label=f"{c} free: 0 Hz (nothing "
-                    "holds it)")
+        label = "bounce mode (damped)" if one else f"{kind} mode {c} " + (
+            "|λ|/2π" if kind == "torsion" else "(damped)")
+        if single:  # one row: markers (an x order beside its z order of the same frequency:
+            # hollow), a free body (a zero eigenvalue: nothing holds it) along the bottom
+            if c in mm.natural and mm.natural[c][0] < FREE_BELOW:
+                ax.plot(r, [0.03 + 0.04 * i], marker="v", ms=8, ls="none", color=colour,
+                        transform=ax.get_xaxis_transform(), label=f"{c} free: 0 Hz "
+                        "(nothing holds it)")
+                continue
+            hollow = {"mfc": "none", "ms": 11, "mew": 1.5} if ".bend.x" in c else {"ms": 7}
+            ax.plot(r, np.where(f > 0, f, np.nan), color=colour, ls="none",
+                    marker="D" if kind == "torsion" else "o", **hollow, label=label)
             continue
-        ax.plot(r, np.where(f > 0, f, np.nan), color=colour, **style,
-                label="bounce mode (damped)" if one else f"{kind} mode {c} "
-                + ("|λ|/2π" if kind == "torsion" else "(damped)"))
-        if np.any(f == 0) and not single:  # overdamped (real eigenvalue): a bar at the bottom
-            ax.plot(r, np.where(f == 0, 0.02 + 0.025 * i, np.nan), color=colour, lw=4,
-                    solid_capstyle="butt", transform=ax.get_xaxis_transform(),
-                    label=("bounce mode" if one else c) + " overdamped here (real "
-                    "eigenvalue: no oscillation)")
+        ax.plot(r, np.where(f > 0, f, np.nan), color=colour, ls=ls, marker=marker or None,
+                markevery=max(1, len(r) // 8), ms=4, lw=2 if kind == "bounce" else 1.3,
+                label=label)
+        if np.any(f == 0):  # overdamped (real eigenvalue): a bar along the bottom
+            over.append((c, f == 0))
     if not single or np.all(mm.slip_frequency > 0):  # (a NaN: no slip mode)
         ax.plot(r, mm.slip_frequency, "C2" if one else "C7", lw=1.0,
                 **({"marker": "s", "ls": "none"} if single else {}),
@@ -99,29 +118,44 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
         ax.set_ylim(0, top * 1.15 if top > 0 else 1.0)
     else:
         ax.set_ylim(0, float(np.nanmax(mm.bounce_frequency)) * 1.1)
-    crossings = mm.crossings(drawn)
+    if len(r) > 1:  # the map's radii (--radius-min/max), the envelope too where it is longer
+        span = float(r.max() - r.min())
+        ax.set_xlim(float(r.min()) - 0.02 * span, float(r.max()) + 0.02 * span)
+    for k, (c, mask) in enumerate(over):
+        colour = styles[c][0]
+        level = 0.02 + 0.03 * k
+        ax.plot(r, np.where(mask, level, np.nan), color=colour, lw=4, solid_capstyle="butt",
+                transform=ax.get_xaxis_transform(),
+                label=("bounce mode overdamped here (real eigenvalue: no oscillation)"
+                       if one else "_"))
+    if over and not one:
+        ax.plot([], [], color="0.6", lw=4, label="bar: the mode named at its end is "
+                "overdamped there (no oscillation)")
+    points = []
     for c, h, rc in crossings:
         f = float(np.interp(rc, r, mm.frequencies[c] if c in mm.frequencies
                             else mm.torsion[c]))
         ax.plot([rc], [f], "o", color="C3", ms=5, mfc="none", mew=1.2)
+        points.append((rc, f))
         if one:
             ax.axvline(rc, color="C3", lw=0.8, alpha=0.7)
             ax.annotate(f"{h[:-1]}×: r = {rc:.3f} m", (rc, ax.get_ylim()[1] * 0.02 + 1),
                         rotation=90, fontsize=8, color="C3", va="bottom")
-        else:
-            ax.annotate(h.split()[0], (rc, f), xytext=(3, 3), textcoords="offset points",
-                        fontsize=7, color="C3")
     if crossings and not one:
-        ax.plot([], [], "o", color="C3", mfc="none", label="crossing (critical radius)")
+        ax.plot([], [], "o", color="C3", mfc="none", label="crossing (critical radius): "
+                "numbered, listed below")
     ax.set_ylabel("frequency [Hz]")
-    if mm.flexible:  # many modes: the legend beside the chart
-        ax.legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    else:
-        ax.legend(fontsize=8 if one else 7, loc="upper right")
+    if one:
+        ax.legend(fontsize=8, loc="upper right")
+    else:  # many lines: the legend beside the chart (the layout makes room for it)
+        fig.legend(*ax.get_legend_handles_labels(), fontsize=7 if mm.flexible else 7.5,
+                   loc="outside right upper")
     ax.grid(alpha=0.3, which="both" if log else "major")
     ax.set_title(_label(title, 120) or "Resonance map (Campbell chart)")
+    axes = [ax]
     if result is not None:
-        b = axes[1, 0]
+        b = fig.add_subplot(grid[1], sharex=ax)
+        axes.append(b)
         pairs = envelopes or {"": ("normal_force", "radius")}
         for i, (label, (force, radius)) in enumerate(pairs.items()):
             rr, lo, hi, _ = normal_force_envelope(result, force=force, radius=radius)
@@ -137,15 +171,66 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
                      + _in(result, next(iter(pairs.values()))[0], "k"))
         b.grid(alpha=0.3)
         b.set_title("simulated nip normal force (min-max over 0.5 s)", fontsize=10)
-    if len(r) > 1:  # the map's radii (--radius-min/max), the envelope too where it is longer
-        span = float(r.max() - r.min())
-        ax.set_xlim(float(r.min()) - 0.02 * span, float(r.max()) + 0.02 * span)
+        if len(r) > 1:
+            b.set_xlim(*ax.get_xlim())
     if mm.initial_state and not np.isfinite(mm.radius[0]):
         ax.set_xlim(-1.0, 1.0)
         ax.set_xticks([])
-        axes[-1, 0].set_xlabel(f"the initial state ({mm.initial_reason})")
+        axes[-1].set_xlabel(f"the initial state ({mm.initial_reason})")
     elif mm.initial_state:
-        axes[-1, 0].set_xlabel(f"roll radius r [m]: the initial state ({mm.initial_reason})")
+        axes[-1].set_xlabel(f"roll radius r [m]: the initial state ({mm.initial_reason})")
     else:
-        axes[-1, 0].set_xlabel("roll radius r [m]")
+        axes[-1].set_xlabel("roll radius r [m]")
+    if lines:
+        _crossing_labels(fig, ax, grid[-1], rows, points, over, ncol, lines, r)
     return figures._save(fig, Path(path))  # (looked up: the tests capture it)
+
+
+#: The crossings' table lists at most this many lines per column (the rest: a count).
+_TABLE_LINES = 30
+#: Width of a monospace character per point of font size [in] (DejaVu Sans Mono: 0.6 em).
+_PT = 0.6 / 72
+
+
+def _crossing_rows(crossings: list[tuple[str, str, float]]) -> list[str]:
+    """The table's lines: number, harmonic, mode, radius, in aligned columns."""
+    if not crossings:
+        return []
+    wide = max(len(short_harmonic(h)) for _, h, _ in crossings)
+    mode = max(len(c) for c, _, _ in crossings)
+    return [f"{i + 1:>2}  {short_harmonic(h):<{wide}}  {c:<{mode}}  r = {rc:.4f} m"
+            for i, (c, h, rc) in enumerate(crossings)]
+
+
+def _crossing_labels(fig: plt.Figure, ax: plt.Axes, cell, rows: list[str], points: list,
+                     over: list, ncol: int, lines: int, radius: np.ndarray) -> None:
+    """Number the crossings (``points``, data coordinates; ``rows`` their table lines)
+    of the resonance map ``ax`` (those closer than a marker
+    share one label: ``3,7``) where no label overlaps another, name the overdamped bars
+    (``over``) at their right ends, and list the numbers in a table in ``cell``. The
+    layout is fixed first (the labels are placed in display coordinates)."""
+    table = fig.add_subplot(cell)
+    table.axis("off")
+    table.set_title("crossings (critical radii): where a harmonic of the rotation meets a "
+                    "mode", fontsize=8, loc="left")
+    fig.canvas.draw()  # the constrained layout, once
+    fig.set_layout_engine("none")
+    renderer = fig.canvas.get_renderer()
+    avoid = []
+    for k, (c, mask) in enumerate(over):  # name each bar at its right end
+        last = float(radius[np.flatnonzero(mask)[-1]])
+        art = ax.text(last, 0.02 + 0.03 * k, f" {c}", transform=ax.get_xaxis_transform(),
+                      fontsize=6.5, va="center", color="0.25")
+        avoid.append(art.get_window_extent(renderer))
+    xy = ax.transData.transform(np.array(points)) if points else np.zeros((0, 2))
+    avoid += [Bbox.from_extents(x - 4, y - 4, x + 4, y + 4) for x, y in xy]  # the markers
+    groups = cluster(xy, 9.0)
+    place_labels(ax, [points[g[0]] for g in groups],
+                 [",".join(str(i + 1) for i in g) for g in groups], avoid=avoid)
+    shown = rows[:ncol * lines]
+    if len(rows) > len(shown):
+        shown[-1] = f"… and {len(rows) - len(shown) + 1} more (winder modes prints them all)"
+    for i, text in enumerate(shown):
+        col, line = divmod(i, lines)
+        table.text(col / ncol, 1.0 - (line + 0.5) / lines, text, fontsize=7.5,
+                   family="monospace", va="center", transform=table.transAxes)

@@ -21,7 +21,8 @@ import numpy as np  # noqa: E402
 
 from winder.io.files import atomic_write, safe_stem  # noqa: E402
 from winder.io.result import Result  # noqa: E402
-from winder.parts import BodyElement, WebPart, body_elements  # noqa: E402
+from winder.plots.layout import DPI  # noqa: E402
+from winder.plots.smooth import centred_mean  # noqa: E402
 from winder.scene.load import Scene  # noqa: E402
 
 __all__ = ["paper_figures", "closeup_end", "CLOSEUP_STEP", "machine_figures",
@@ -47,13 +48,14 @@ def collected() -> Iterator[list[tuple[Path, bytes]]]:
 
 def _save(fig: plt.Figure, path: Path) -> Path:
     try:
-        fig.tight_layout()
+        if fig.get_layout_engine() is None:  # a figure laid out by its own engine keeps it
+            fig.tight_layout()
         if _COLLECTED is not None:
             png = io.BytesIO()
-            fig.savefig(png, dpi=110, format="png")
+            fig.savefig(png, dpi=DPI, format="png")
             _COLLECTED.append((path, png.getvalue()))
         else:
-            atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+            atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=DPI, format="png"))
     finally:
         plt.close(fig)
     return path
@@ -219,7 +221,8 @@ def _torque_panels(full: plt.Axes, zoom: plt.Axes, t: np.ndarray, torque: np.nda
     lo, hi = np.percentile(torque[late], [0.5, 99.5])
     pad = 0.3 * (hi - lo) + 1.0
     zoom.plot(t, torque, color="C3", lw=0.6)
-    zoom.plot(*window_mean(t, torque), color="k", lw=0.8, label="mean over 0.5 s")
+    tm, mean, used = centred_mean(t, torque, 0.5)
+    zoom.plot(tm, mean, color="k", lw=0.8, label=f"centred mean over {used:.3g} s")
     zoom.set_ylim(lo - pad, hi + pad)
     zoom.axhline(0.0, color="k", lw=0.5)
     zoom.set_ylabel(label)
@@ -245,33 +248,6 @@ def nip_colours(scene: Scene) -> dict[str, str]:
     return {n.name: NIP_COLOURS[i % len(NIP_COLOURS)] for i, n in enumerate(scene.nips)}
 
 
-def _parts_scene(result: Result, scene: Scene | None) -> Scene:
-    """The scene of ``result``: ``scene`` or the one stored in its meta."""
-    if scene is not None:
-        return scene
-    from winder.scene.load import scene_from_dict
-
-    return scene_from_dict(result.meta["scene_dict"])
-
-
-def _panel(ax: plt.Axes, t: np.ndarray, lines: list[tuple[str, np.ndarray]], ylabel: str,
-           title: str, *, lw: float = 0.8, colors: list[str] | None = None) -> None:
-    """One axes: a line per ``(label, values)``, legend naming the parts."""
-    for i, (label, y) in enumerate(lines):
-        ax.plot(t, y, lw=lw, label=label, color=None if colors is None else colors[i])
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
-    ax.grid(True, alpha=0.3)
-    if lines:
-        ax.legend(fontsize=8, loc="best")
-
-
-def _first_open(t: np.ndarray, force: np.ndarray) -> float | None:
-    """First time [s] a nip carries no force (open), or None."""
-    idx = np.flatnonzero(force <= 0.0)
-    return float(t[idx[0]]) if len(idx) else None
-
-
 def window_mean(t: np.ndarray, y: np.ndarray, window: float = 0.5
                 ) -> tuple[np.ndarray, np.ndarray]:
     """``(mid time, mean)`` of ``y`` over consecutive windows of ``window`` [s] (the
@@ -281,201 +257,6 @@ def window_mean(t: np.ndarray, y: np.ndarray, window: float = 0.5
     w = max(1, min(int(round(window / dt)), len(t)))
     n = len(t) // w
     return t[:n * w].reshape(n, w).mean(axis=1), y[:n * w].reshape(n, w).mean(axis=1)
-
-
-def _rows(n: int, height: float = 2.3) -> tuple[plt.Figure, np.ndarray]:
-    fig, axes = plt.subplots(n, 1, figsize=(9, 1.6 + height * n), sharex=True, squeeze=False)
-    return fig, axes[:, 0]
-
-
-def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = None
-                    ) -> list[Path]:
-    """Figures of a run of a scene of parts (channels of machines.md §9) into ``out_dir``.
-
-    ``STEM_drums.png``: the speed of every drum, then a row per drum with its torque and
-    its mean over 0.5 s;
-    ``STEM_rolls.png``: speed and radius of every paper roll (and the rider speeds);
-    ``STEM_nip_forces.png``: a row per nip with its normal force and its mean over 0.5 s,
-    then a close-up of the first opening of a nip; ``STEM_positions.png``: a row per free
-    coordinate (``x``, ``z``) of every body, each ``z`` followed by its bounce (``z`` less
-    its mean over 0.5 s, in mm); ``STEM_slip.png``: a row per nip with its slip
-    velocity; with a web span, ``STEM_span.png``: the span tension, the controller's
-    tension error, the unwind torque and the radii; flexible parts:
-    :func:`winder.plots.flex.flex_figures`. ``STEM`` is the scene name made
-    file-safe; part names appear only in titles and legends. A nip keeps its colour in
-    every figure. Returns the paths.
-    """
-    scene = _parts_scene(result, scene)
-    out = Path(out_dir)
-    name = _label(result.meta.get("scene", scene.name))
-    stem = safe_stem(result.meta.get("scene", scene.name))
-    t = result.t
-    paths: list[Path] = []
-    color = nip_colours(scene)
-    nip_label = {n.name: f"nip {n.name} ({n.a}–{n.b})" for n in scene.nips}
-    bodies = body_elements(scene)  # in the machine's order
-    drums = [b for b in bodies if _drive(b)]
-    turning = [b for b in bodies if not _drive(b)]  # rolls, riders, ...
-    wound = [b for b in bodies if b.radius_state]  # their radius is a channel
-
-    # drums: speeds, then one torque row per drum
-    fig, ax = _rows(1 + len(drums))
-    first = drums[0].name
-    unit = _in(result, f"{first}_speed")
-    _panel(ax[0], t, [(_body_label(d), result[f"{d.name}_speed"]) for d in drums],
-           "speed Ω" + unit, f"{name}: drum speeds{unit}")
-    for a, d in zip(ax[1:], drums, strict=True):
-        unit = _in(result, f"{d.name}_torque", "k")
-        _panel(a, t, [(_body_label(d), result[f"{d.name}_torque"] / 1e3)], "torque" + unit,
-               f"{_body_label(d)}: drive torque{unit}", lw=0.4)
-        a.plot(*window_mean(t, result[f"{d.name}_torque"] / 1e3), color="k", lw=0.8,
-               label="mean over 0.5 s")
-        a.legend(fontsize=8, loc="upper left")
-        a.axhline(0.0, color="k", lw=0.5)
-    ax[-1].set_xlabel("t" + _in(result, "t"))
-    paths.append(_save(fig, out / f"{stem}_drums.png"))
-
-    # rolls: speed and radius
-    fig, ax = _rows(2, 3.0)
-    speed = _in(result, f"{wound[0].name}_speed") if wound else ""
-    radius = _in(result, f"{wound[0].name}_radius") if wound else ""
-    _panel(ax[0], t, [(_body_label(b), result[f"{b.name}_speed"]) for b in turning],
-           "speed ω" + speed, f"{name}: roll and rider speeds{speed}")
-    _panel(ax[1], t, [(_body_label(b), result[f"{b.name}_radius"]) for b in wound],
-           "radius r" + radius, "paper roll radii" + radius)
-    ax[1].set_xlabel("t" + _in(result, "t"))
-    paths.append(_save(fig, out / f"{stem}_rolls.png"))
-
-    # nips: one row per nip (same scale), then a close-up of the first opening
-    forces = {n.name: result[f"{n.name}_normal_force"] for n in scene.nips}
-    kn = _in(result, f"{scene.nips[0].name}_normal_force", "k") if scene.nips else ""
-    fig, axes = plt.subplots(len(forces) + 1, 1, figsize=(9, 3.2 + 2.3 * len(forces)),
-                             squeeze=False)
-    ax = axes[:, 0]
-    for i, (n, f) in enumerate(forces.items()):
-        _panel(ax[i], t, [(nip_label[n], f / 1e3)], "F_n" + kn,
-               (f"{name}: nip normal forces{kn} (F_n = 0: nip open)\n" if i == 0 else "")
-               + f"{nip_label[n]}: {np.mean(f <= 0.0):.1%} of samples open", lw=0.4,
-               colors=[color[n]])
-        tm, fm = window_mean(t, f / 1e3)
-        ax[i].plot(tm, fm, color="k", lw=0.8, label="mean over 0.5 s")
-        ax[i].legend(fontsize=8, loc="upper left")
-        if i:
-            ax[i].sharex(ax[0])
-    top = max([float(np.max(f)) / 1e3 for f in forces.values()] + [0.0])
-    for a in ax[:-1]:  # one scale, from 0 (nip open) to the largest force of any nip
-        a.set_ylim(-0.04 * top - 1e-3, 1.06 * top + 1e-3)
-    ax[len(forces) - 1].set_xlabel("t" + _in(result, "t"))
-    opens = [(tt, n) for n, f in forces.items() if (tt := _first_open(t, f)) is not None]
-    if opens:
-        t_open, which = min(opens)
-        w = (t >= t_open - 0.3) & (t <= t_open + 1.0)
-        title = f"close-up: first opening, {nip_label[which]} at t ≈ {t_open:.2f} s{kn}"
-    else:
-        w = t <= min(t[-1], t[0] + 5.0)
-        title = f"first 5 s{kn} (no nip opens in this run)"
-    _panel(ax[-1], t[w], [(nip_label[n], f[w] / 1e3) for n, f in forces.items()], "F_n" + kn,
-           title + f" (samples every {np.median(np.diff(t)) if len(t) > 1 else 0:g} s)",
-           colors=[color[n] for n in forces])
-    for line in ax[-1].get_lines():
-        line.set_marker(".")
-        line.set_markersize(3)
-    ax[-1].legend(fontsize=7, loc="upper right", framealpha=0.9)
-    ax[-1].set_xlabel("t" + _in(result, "t"))
-    paths.append(_save(fig, out / f"{stem}_nip_forces.png"))
-
-    # free coordinates of every body, one row each
-    coords = [(b.name, c) for b in bodies for c in ("x", "z") if f"{b.name}_{c}" in result]
-    if coords:
-        heights = [c for _, c in coords if c == "z"]
-        fig, ax = _rows(len(coords) + len(heights), 2.0)
-        i = 0
-        for body, c in coords:
-            y = result[f"{body}_{c}"]
-            unit = _in(result, f"{body}_{c}")
-            _panel(ax[i], t, [(f"{body} {c}", y)], c + unit,
-                   (f"{name}: free coordinates{unit}\n" if i == 0 else "")
-                   + f"{body}: {'horizontal' if c == 'x' else 'vertical'} position {c}{unit}",
-                   lw=0.5)
-            i += 1
-            if c == "z":  # the rise with the radius hides the bounce: show it apart
-                _panel(ax[i], t, [(f"{body} z − mean", 1e3 * (y - np.interp(
-                    t, *window_mean(t, y))))], _in(result, f"{body}_z", "m").strip(),
-                    f"{body}: bounce, z less its mean over 0.5 s"
-                    + _in(result, f"{body}_z", "m"), lw=0.4)
-                i += 1
-        ax[-1].set_xlabel("t" + _in(result, "t"))
-        paths.append(_save(fig, out / f"{stem}_positions.png"))
-
-    # slip velocities, one row per nip
-    fig, ax = _rows(len(scene.nips))
-    for i, n in enumerate(scene.nips):
-        unit = _in(result, f"{n.name}_slip_velocity")
-        _panel(ax[i], t, [(nip_label[n.name], result[f"{n.name}_slip_velocity"])],
-               "slip" + unit, (f"{name}: nip slip velocities{unit}\n" if i == 0 else "")
-               + nip_label[n.name], lw=0.4, colors=[color[n.name]])
-        ax[i].axhline(0.0, color="k", lw=0.5)
-    ax[-1].set_xlabel("t" + _in(result, "t"))
-    paths.append(_save(fig, out / f"{stem}_slip.png"))
-    spans = [w for w in scene.webs if w.span is not None]
-    for w in spans:  # one figure per span: STEM_span.png, or STEM_WEB_span.png
-        pre = f"{w.name}_" if len(spans) > 1 else ""
-        if f"{pre}span_tension" in result:
-            paths.append(_span_figure(result, scene, bodies, w, pre,
-                                      out / f"{stem}_{pre}span.png", name))
-    from winder.plots.flex import flex_figures  # flexible parts (issue #25)
-
-    return paths + flex_figures(result, scene, out, stem, name, _save)
-
-
-def _drive(body: BodyElement) -> bool:
-    """Whether ``body`` is a drive of constant radius (a drum: prescribed or on a torque
-    input, its radius no state), drawn with its drive torque."""
-    return (body.prescribed or bool(body.torque_inputs)) and not body.radius_state
-
-
-def _body_label(body: BodyElement) -> str:
-    """A body in legends and titles: its drawing role and name (``roll front``)."""
-    return f"{body.role} {body.name}"
-
-
-def _span_figure(result: Result, scene: Scene, bodies: list[BodyElement], web: WebPart,
-                 pre: str, path: Path, name: str) -> Path:
-    """A winder line: the span tension of ``web`` (channels ``PRE...``; ``pre`` empty for
-    a scene's only span) and its controller's error, the unwind torque, the radii of the
-    unwinding roll and of the wound roll the web enters."""
-    t = result.t
-    span = web.span
-    body = {b.name: b for b in bodies}
-    unwind = body[span.source]
-    entry = next(n for n in scene.nips if n.name == web.entry_nip)
-    wound = [body[entry.b]] if body[entry.b].radius_state else []
-    error = f"{pre}tension_error"
-    fig, ax = _rows(4 if error in result else 3)
-    unit = _in(result, f"{pre}span_tension")
-    _panel(ax[0], t, [("span tension", result[f"{pre}span_tension"])], "T" + unit,
-           f"{name}: web span tension{unit} (EA = {span.EA:.3g} N, L = {span.length:g} m)",
-           lw=0.6)
-    rows = 1
-    if error in result:
-        unit = _in(result, error)
-        _panel(ax[1], t, [("set-point − T", result[error])], "error" + unit,
-               f"tension error of the unwind's controller{unit}: peak "
-               f"{np.max(np.abs(result[error])):.3g} N, RMS "
-               f"{np.sqrt(np.mean(result[error] ** 2)):.3g} N", lw=0.6)
-        ax[1].axhline(0.0, color="k", lw=0.5)
-        rows = 2
-    unit = _in(result, f"{unwind.name}_torque", "k")
-    _panel(ax[rows], t, [(_body_label(unwind), result[f"{unwind.name}_torque"] / 1e3)],
-           "torque" + unit, f"unwind torque of {unwind.name}{unit} (negative: braking)",
-           lw=0.6)
-    ax[rows].axhline(0.0, color="k", lw=0.5)
-    unit = _in(result, f"{unwind.name}_radius")
-    _panel(ax[rows + 1], t, [(_body_label(b), result[f"{b.name}_radius"])
-                             for b in [unwind, *wound]], "radius r" + unit,
-           "radii of the unwinding and the wound rolls" + unit)
-    ax[-1].set_xlabel("t" + _in(result, "t"))
-    return _save(fig, path)
 
 
 def normal_force_envelope(result: Result, window: float = 0.5, *,
@@ -490,3 +271,8 @@ def normal_force_envelope(result: Result, window: float = 0.5, *,
     fn, r = fn[:n * w].reshape(n, w), r[:n * w].reshape(n, w)
     lo, hi = fn.min(axis=1), fn.max(axis=1)
     return r.mean(axis=1), lo, hi, (hi - lo) / 2
+
+
+# the figures of a scene of parts, written through this module's _save (imported last: it
+# reads this module's names when it draws)
+from winder.plots.machine import machine_figures  # noqa: E402

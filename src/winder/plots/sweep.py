@@ -8,7 +8,8 @@ Where the roll turns ``k`` times per bounce period the imbalance drives the nip 
 resonance: at diameter ``d`` that happens at web speed ``v_k(d) = π d f_bounce(d/2) / k``,
 drawn for ``k = 1, 2, 3`` from the linearised modes of the panel's scene. When swept keys
 other than the web speed exist, each of their combinations gets its own panel. Axes and
-panels are labelled with the swept keys (all of them for tied keys) and their units.
+panels are labelled with the swept keys in words (all of them for tied keys) and their
+units.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from __future__ import annotations
 import copy
 import itertools
 import math
+import re
 from pathlib import Path
 
 import matplotlib
@@ -30,10 +32,10 @@ from winder.analysis.modes import mode_map  # noqa: E402
 from winder.analysis.sweep_grid import set_path, split_keys  # noqa: E402
 from winder.analysis.sweep_table import SweepTable  # noqa: E402
 from winder.io.files import atomic_write  # noqa: E402
-from winder.scene.keys import key_unit  # noqa: E402
+from winder.scene.keys import find_key, key_unit  # noqa: E402
 from winder.scene.load import scene_from_dict  # noqa: E402
 
-__all__ = ["runnability_map", "map_layout", "axis_label"]
+__all__ = ["runnability_map", "map_layout", "axis_label", "key_words"]
 
 #: An axis whose keys are all drives' web speeds (``drum.drive.web_speed``,
 #: ``drum.NAME.drive.web_speed``, tied or not) is the map's vertical axis when it is swept.
@@ -77,15 +79,44 @@ def _with_unit(text: str, unit: str) -> str:
     return f"{text} [{unit}]" if unit else text
 
 
+#: Words for the short forms in key names.
+_WORDS = {"com": "centre-of-mass"}
+
+
+def key_words(path: str, scene: dict) -> str:
+    """A scene key in words for an axis: its owner (the table, the part's name, the
+    sub-tables) and its meaning, the first clause of its declaration's text when that is
+    short, else its name in words: ``drum.drive.web_speed`` → ``drum drive: web speed``,
+    ``drum.front.radius`` → ``drum front: drum radius R``. An unknown path stays as it
+    is."""
+    parts = path.split(".")
+    head, rest = parts[0], parts[1:]
+    array = isinstance(scene.get(head), list) if scene else False
+    owner = [head, *rest[:1]] if array and rest else [head]
+    rest = rest[1:] if array else rest
+    if not rest:
+        return path
+    try:
+        key = find_key(".".join([head + ("[]" if array else ""), *rest[:-1]]), rest[-1])
+    except KeyError:
+        return path
+    clause = re.split(r";| \(", key.doc)[0].strip()
+    meaning = clause if clause and len(clause) <= 40 and ":" not in clause else \
+        " ".join(_WORDS.get(w, w) for w in rest[-1].split("_"))
+    return f"{' '.join([*owner, *rest[:-1]])}: {meaning}"
+
+
 def axis_label(axis: str, scene: dict, *, sep: str = ",\n") -> str:
-    """The label of a swept axis (``"k1,k2"`` for tied keys): every key path and its unit
-    (``drum.drive.web_speed [m/s]``); tied keys of one unit share it at the end. ``scene``:
-    the base scene's nested tables (they tell arrays of parts from tables)."""
+    """The label of a swept axis (``"k1,k2"`` for tied keys): every key in words
+    (:func:`key_words`) with its unit (``drum drive: web speed [m/s]``); tied keys of one
+    unit share it at the end. ``scene``: the base scene's nested tables (they tell arrays
+    of parts from tables)."""
     keys = split_keys(axis)
     units = [key_unit(k, scene) for k in keys]
+    words = [key_words(k, scene) for k in keys]
     if len(set(units)) == 1:
-        return _with_unit(sep.join(keys), units[0])
-    return sep.join(_with_unit(k, u) for k, u in zip(keys, units, strict=True))
+        return _with_unit(sep.join(words), units[0])
+    return sep.join(_with_unit(k, u) for k, u in zip(words, units, strict=True))
 
 
 def _value_text(axis: str, value: object, scene: dict) -> str:
@@ -94,7 +125,7 @@ def _value_text(axis: str, value: object, scene: dict) -> str:
     unit = f" {units.pop()}" if len(units) == 1 and "" not in units and "-" not in units \
         else ""
     shown = f"{value:g}" if isinstance(value, float) else f"{value}"
-    return f"{', '.join(split_keys(axis))} = {shown}{unit}"
+    return f"{', '.join(key_words(k, scene) for k in split_keys(axis))} = {shown}{unit}"
 
 
 def map_layout(vary: dict[str, list]) -> tuple[str, list[str]]:
