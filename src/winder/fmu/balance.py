@@ -3,9 +3,10 @@ part): the force residual of machines.md §7 and its exact Jacobian, generated b
 from the same ``Machine.evaluate(static=True)`` that :func:`winder.solve.equilibrium.static_state`
 solves, for the wrapper's Newton iteration when the host sets parameters.
 
-The unknowns are those of ``static_state`` (:func:`~winder.solve.equilibrium.balance_unknowns`:
-the free ``x``/``z`` of each body not fixed at rest; without contact those its bearings hold). The locked modes are the build-time balance's active set:
-every nip touching (``IN_CONTACT``) but those that pull there (``FREE``), the other slots
+The unknowns are those of ``static_state``
+(:func:`~winder.solve.equilibrium.balance_unknowns`: the free ``x``/``z`` of each body not
+fixed at rest; without contact those its bearings hold). The locked modes are the
+build-time balance's active set: every nip touching (``IN_CONTACT``) but those that pull there (``FREE``), the other slots
 ``CORE_AUTO``. Newton starts from the build-time balance, so it solves the balance of the
 host's parameters near it; a nip that would start pulling is not opened (the build-time
 active set is kept).
@@ -36,7 +37,6 @@ def balance_of(machine: Machine, x0: np.ndarray, p: np.ndarray) -> Balance:
     """The unknowns of ``machine``'s static balance and its active set at the balance
     ``x0`` for parameters ``p`` (as :func:`winder.solve.equilibrium.static_state`)."""
     from winder.model.backends import NumericBackend
-
     from winder.solve.equilibrium import balance_unknowns
 
     unknowns = [i for _, _, i in balance_unknowns(machine)]
