@@ -68,9 +68,9 @@ def beam_sag(n: int) -> np.ndarray:
 def test_lone_flexible_drum_starts_in_its_sag_without_contact(n: int) -> None:
     """Contact off, no nip: every station of the drum starts in the beam's sag (measured
     relative error 2.2e-15 at N = 5, 1.0e-14 at N = 8), ``x`` on the bearings' line, and the
-    run of the speed profile stays there (measured largest deviation 4.2e-19 m against a 4.1e-5 m sag
-    at N = 8, 1.0e-14 of it; before the fix it started straight and swung through
-    7.9e-5 m)."""
+    run of the speed profile stays there (measured largest deviation 4.2e-19 m against a
+    4.1e-5 m sag at N = 8, 1.0e-14 of it; before the fix it started straight and swung
+    through 7.9e-5 m)."""
     sc = lone_drum(n)
     sys_ = MachineSystem(sc, backend="pinocchio")
     y = sys_.initial_state()

@@ -6,10 +6,10 @@ solves, for the wrapper's Newton iteration when the host sets parameters.
 The unknowns are those of ``static_state``
 (:func:`~winder.solve.equilibrium.balance_unknowns`: the free ``x``/``z`` of each body not
 fixed at rest; without contact those its bearings hold). The locked modes are the
-build-time balance's active set: every nip touching (``IN_CONTACT``) but those that pull there (``FREE``), the other slots
-``CORE_AUTO``. Newton starts from the build-time balance, so it solves the balance of the
-host's parameters near it; a nip that would start pulling is not opened (the build-time
-active set is kept).
+build-time balance's active set: every nip touching (``IN_CONTACT``) but those that pull
+there (``FREE``), the other slots ``CORE_AUTO``. Newton starts from the build-time
+balance, so it solves the balance of the host's parameters near it; a nip that would start
+pulling is not opened (the build-time active set is kept).
 """
 
 from __future__ import annotations
