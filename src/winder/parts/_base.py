@@ -227,6 +227,9 @@ class BodyElement(ABC):
         self.com_offset: float | None = None
         #: a segment of a flexible body: that body's name (its nips are sliced), else None
         self.segment_of: str | None = None
+        #: a segment: the axes its whole body's rigid self is free along, whose ``x``, ``z``
+        #: channels the whole body keeps (:mod:`winder.model.whole_body`); None: :attr:`free`
+        self.whole_free: tuple[str, ...] | None = None
         #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine
         self.joints: dict[str, int] = {}
 

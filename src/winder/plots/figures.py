@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 
 from winder.io.files import atomic_write, safe_stem  # noqa: E402
 from winder.io.result import Result  # noqa: E402
-from winder.parts import BodyElement, WebPart, body_elements  # noqa: E402
+from winder.parts import BodyElement, WebPart, whole_elements  # noqa: E402
 from winder.scene.load import Scene  # noqa: E402
 
 __all__ = ["paper_figures", "closeup_end", "CLOSEUP_STEP", "machine_figures",
@@ -313,7 +313,7 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     paths: list[Path] = []
     color = nip_colours(scene)
     nip_label = {n.name: f"nip {n.name} ({n.a}–{n.b})" for n in scene.nips}
-    bodies = body_elements(scene)  # in the machine's order
+    bodies = whole_elements(scene)  # in the machine's order; a flexible part as a whole
     drums = [b for b in bodies if _drive(b)]
     turning = [b for b in bodies if not _drive(b)]  # rolls, riders, ...
     wound = [b for b in bodies if b.radius_state]  # their radius is a channel
