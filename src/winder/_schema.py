@@ -29,7 +29,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-__all__ = ["Key", "Table", "Channel", "KINDS", "NO_DEFAULT", "format_number"]
+__all__ = ["Key", "Table", "Channel", "KINDS", "NO_DEFAULT", "format_number", "WHOLE_RULES"]
 
 #: Kinds of key value: ``num`` a finite number; ``bool`` true or false; ``str`` a string
 #: (one of ``choices`` where given); ``name`` a part's name; ``ref`` the name of another
@@ -222,6 +222,17 @@ class Table:
 #: paper roll, ``RIDER`` a rider, ``NIP`` a nip (each the part's name in a channel).
 PLACEHOLDERS = ("BODY", "ROLL", "RIDER", "NIP")
 
+#: How a flexible body's channel is formed from its segments' (:attr:`Channel.whole`), and
+#: what the reference says of it: the body keeps every body-level channel of its rigid
+#: self, with the same meaning.
+WHOLE_RULES = {
+    "drive": "the drive end's (segment 0) of a driven body, else the segments' mean",
+    "drive_sum": "the drive end's (segment 0) of a driven body, else the segments' sum",
+    "mean": "the segments' mean",
+    "sum": "the segments' sum",
+    "shared": "the segments' one value (segment 0's)",
+}
+
 
 @dataclass(frozen=True, kw_only=True)
 class Channel:
@@ -236,11 +247,17 @@ class Channel:
         Its SI unit (``rad/s``, ``N·m``; ``-`` a pure number), non-empty.
     doc:
         Its meaning, one line (the reference's "meaning" column).
+    whole:
+        A body's channel: how a flexible body (its segments ``BODY_s{i}``) forms it from
+        its segments' values, one of :data:`WHOLE_RULES` (``drive``, ``drive_sum``,
+        ``mean``, ``sum``, ``shared``), so the flexible body keeps the channel of its
+        rigid self with the same meaning (:mod:`winder.model.whole_body`); ``""``: none.
     """
 
     name: str
     unit: str
     doc: str
+    whole: str = ""
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*",
@@ -251,6 +268,9 @@ class Channel:
                             f"as 'm' or '-', got {self.unit!r}")
         if not isinstance(self.doc, str) or not self.doc:
             raise ValueError(f"Channel {self.name!r}: doc must say what the channel means")
+        if self.whole and self.whole not in WHOLE_RULES:
+            raise ValueError(f"Channel {self.name!r}: whole must be one of "
+                             f"{', '.join(WHOLE_RULES)} or empty, got {self.whole!r}")
 
     @property
     def placeholder(self) -> str:

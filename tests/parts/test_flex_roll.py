@@ -275,11 +275,12 @@ def test_generated_code_matches_the_numeric_path() -> None:
 KC = 1e10  # [N/m] each chuck
 
 
-def chucked(n: int, r0: float = 0.3, damping: float = 0.0, speed: float = 0.0
-            ) -> winder.Scene:
+def chucked(n: int, r0: float = 0.3, damping: float = 0.0, speed: float = 0.0,
+            effects: str = "imbalance = false") -> winder.Scene:
     """The roll of :func:`scene` on chucks 2.2 m above its nip's touching height (the nip
     stays open: no contact), free in ``x`` and ``z``."""
-    text = scene_text(n, r0=r0, free='["x", "z"]', damping=damping, speed=speed)
+    text = scene_text(n, r0=r0, free='["x", "z"]', damping=damping, speed=speed,
+                      effects=effects)
     text = text.replace(f"centre = [0.0, {0.5 + r0}]", f"centre = [0.0, {2.7 + r0}]")
     text = text.replace(f"damping_ratio = {damping} }}",
                         f'damping_ratio = {damping}, support = "chucks", '

@@ -11,6 +11,7 @@ import numpy as np
 
 import winder
 import winder.plots.figures as _plots
+from winder.parts import whole_elements
 from winder.plots.flex import deflection, flexible_bodies, line_load_map
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parts"))
@@ -27,6 +28,10 @@ def test_flexible_parts_have_their_figures(tmp_path: Path) -> None:
     assert {"flexroll_flex_drum.png", "flexroll_flex_roll.png",
             "flexroll_line_load_nip.png"} <= names
     assert all(p.stat().st_size > 1000 for p in paths)
+    # the machine's figures draw each flexible part as one body, from the channels of its
+    # rigid self (issue 32, item 4): drum speed and drive torque, roll speed, radius, z
+    assert [b.name for b in whole_elements(scene)] == ["drum", "roll"]
+    assert {"flexroll_drums.png", "flexroll_rolls.png", "flexroll_positions.png"} <= names
     bodies = {b.name: b for b in flexible_bodies(scene)}
     assert bodies["drum"].support == (0.0, 0.0) and bodies["roll"].support is None
     np.testing.assert_allclose(bodies["roll"].stations, [5 / 6, 2.5, 25 / 6])

@@ -3,12 +3,13 @@ part): the force residual of machines.md §7 and its exact Jacobian, generated b
 from the same ``Machine.evaluate(static=True)`` that :func:`winder.solve.equilibrium.static_state`
 solves, for the wrapper's Newton iteration when the host sets parameters.
 
-The unknowns are those of ``static_state``: the free ``x``/``z`` of each body not fixed at
-rest (none without contact). The locked modes are the build-time balance's active set:
-every nip touching (``IN_CONTACT``) but those that pull there (``FREE``), the other slots
-``CORE_AUTO``. Newton starts from the build-time balance, so it solves the balance of the
-host's parameters near it; a nip that would start pulling is not opened (the build-time
-active set is kept).
+The unknowns are those of ``static_state``
+(:func:`~winder.solve.equilibrium.balance_unknowns`: the free ``x``/``z`` of each body not
+fixed at rest; without contact those its bearings hold). The locked modes are the
+build-time balance's active set: every nip touching (``IN_CONTACT``) but those that pull
+there (``FREE``), the other slots ``CORE_AUTO``. Newton starts from the build-time
+balance, so it solves the balance of the host's parameters near it; a nip that would start
+pulling is not opened (the build-time active set is kept).
 """
 
 from __future__ import annotations
@@ -36,12 +37,9 @@ def balance_of(machine: Machine, x0: np.ndarray, p: np.ndarray) -> Balance:
     """The unknowns of ``machine``'s static balance and its active set at the balance
     ``x0`` for parameters ``p`` (as :func:`winder.solve.equilibrium.static_state`)."""
     from winder.model.backends import NumericBackend
+    from winder.solve.equilibrium import balance_unknowns
 
-    unknowns = []
-    if machine.scene.effects.contact:
-        for b in machine.bodies:
-            fixed = b.fixed_at_rest()
-            unknowns += [machine.index(f"{b.name}.{c}") for c in b.free if c not in fixed]
+    unknowns = [i for _, _, i in balance_unknowns(machine)]
     modes = np.full(len(machine.mode_names), float(CORE_AUTO))
     contact = machine.mode_slots(ModeKind.CONTACT)
     modes[contact] = IN_CONTACT

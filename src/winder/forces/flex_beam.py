@@ -26,9 +26,9 @@ slices ``NIP_s{i}`` have the generic nip channels; this element writes the scene
 ``NIP_normal_force`` and ``NIP_friction_force`` the sums over its slices,
 ``NIP_slip_velocity`` their mean, ``NIP_penetration`` their largest, and the line load
 ``F_i / (L/N)`` [N/m] of its slices, ``NIP_line_load_min``, ``_max`` and ``_mean``. It runs
-after the contact and the slip relaxation (``uses`` their ``steady_friction``). Each
-flexible body also has ``NAME_speed`` and ``NAME_angle``, its segments' mean, and a paper
-roll ``NAME_radius``, ``NAME_mass``, ``NAME_inertia`` and their rates (sums).
+after the contact and the slip relaxation (``uses`` their ``steady_friction``). The
+whole body's channels of its rigid self (``NAME_speed``, ``NAME_torque``, ...):
+:mod:`winder.model.whole_body`.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 from winder._schema import Channel
 from winder.forces._base import ForceElement
-from winder.model.channels import BODY_CHANNELS, NIP_CHANNELS
+from winder.model.channels import NIP_CHANNELS
 
 if TYPE_CHECKING:
     from winder.model.machine import Evaluation, Machine
@@ -152,10 +152,6 @@ class FlexBeam(ForceElement):
             machine.parameter(f"{body}.flex.k_t", bm.k_t)  # the same for x and z
             machine.parameter(f"{body}.flex.c_t", bm.c_t)
             machine.channel(TWIST, body)
-        for body, segs in self.groups.items():  # the whole body's own channels
-            for ch in (*BODY_CHANNELS[:2], *(segs[0].CHANNELS if segs[0].radius_state
-                                             else ())):
-                machine.channel(ch, body)
         self.sliced = {}
         for nip in machine.nips:
             if nip.whole is not None:
@@ -210,23 +206,6 @@ class FlexBeam(ForceElement):
         kt = p(f"{body}.flex.k_t")
         return kt, beta * kt
 
-    @staticmethod
-    def _body_channels(ev: Evaluation, body: str, segs: list[Any], states: list[Any]
-                       ) -> None:
-        """The whole body's ``NAME_speed`` and ``NAME_angle`` (its segments' mean) and, for a
-        paper roll, ``NAME_radius`` and the sums of its segments' mass, inertia and their
-        rates."""
-        n, s = len(states), segs[0].sense
-        speed, angle = BODY_CHANNELS[:2]
-        ev.output(speed, body, s * sum(bs.omega for bs in states) / n)
-        ev.output(angle, body, s * sum(bs.theta for bs in states) / n)
-        if segs[0].radius_state:
-            values = (states[0].r, sum(bs.mass for bs in states),
-                      sum(bs.inertia for bs in states), sum(bs.mass_rate for bs in states),
-                      sum(bs.inertia_rate for bs in states))
-            for ch, value in zip(segs[0].CHANNELS, values, strict=True):
-                ev.output(ch, body, value)
-
     def _nip_channels(self, ev: Evaluation) -> None:
         """The sliced scene nips' own channels (see the module text)."""
         mathns = ev.mathns
@@ -278,5 +257,4 @@ class FlexBeam(ForceElement):
                 ev.add_spatial_force(segs[i].name, [0.0, 0.0, 0.0, 0.0, tq, 0.0])
                 ev.add_spatial_force(segs[i + 1].name, [0.0, 0.0, 0.0, 0.0, -tq, 0.0])
             ev.output(TWIST, body, segs[0].sense * (states[0].theta - states[-1].theta))
-            self._body_channels(ev, body, segs, states)
         self._nip_channels(ev)

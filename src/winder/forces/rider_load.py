@@ -30,7 +30,7 @@ class RiderLoad(ForceElement):
     name = "rider_load"
     doc = "the riders' applied line load; off: only their weight"
     CHANNELS = (Channel(name="RIDER_load", unit="N",
-                        doc="applied rider load L·q(r), acting downwards (−z)"),)
+                        doc="applied rider load L·q(r), acting downwards (−z)", whole="sum"),)
     settings = (Key(name="scale", unit="-", lo=0.0, hi=100.0, default=1.0,
                     doc="factor on every rider's line-load schedule (1: as given; 0: only "
                         "the riders' weight)"),)

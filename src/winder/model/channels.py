@@ -17,25 +17,29 @@ TIME = Channel(name="t", unit="s", doc="time")
 
 #: Every body's rotation, in the order the machine writes them.
 BODY_CHANNELS = (
-    Channel(name="BODY_speed", unit="rad/s", doc="speed in the body's operation sense (s θ̇)"),
-    Channel(name="BODY_angle", unit="rad", doc="angle in the operation sense (s θ)"),
+    Channel(name="BODY_speed", unit="rad/s", doc="speed in the body's operation sense (s θ̇)",
+            whole="drive"),
+    Channel(name="BODY_angle", unit="rad", doc="angle in the operation sense (s θ)",
+            whole="drive"),
     Channel(name="BODY_torque", unit="N·m",
             doc="driven body: its drive torque (inverse dynamics for a speed profile, the "
                 "input or the controller's torque otherwise); undriven body: the torque of "
                 "the nip friction and web forces about its axis; operation sense, without "
-                "gravity, imbalance and −Ẏv"),
+                "gravity, imbalance and −Ẏv", whole="drive_sum"),
     Channel(name="BODY_accel", unit="rad/s²",
-            doc="angular acceleration in the operation sense"),
+            doc="angular acceleration in the operation sense", whole="drive"),
 )
 
 #: A free coordinate's channels by coordinate (``x``, ``z``): position, rate, acceleration.
 COORD_CHANNELS = {
-    "x": (Channel(name="BODY_x", unit="m", doc="centre x, for a body free along x"),
-          Channel(name="BODY_x_dot", unit="m/s", doc="ẋ"),
-          Channel(name="BODY_x_accel", unit="m/s²", doc="ẍ")),
-    "z": (Channel(name="BODY_z", unit="m", doc="centre z, for a body free along z"),
-          Channel(name="BODY_z_dot", unit="m/s", doc="ż"),
-          Channel(name="BODY_z_accel", unit="m/s²", doc="z̈")),
+    "x": (Channel(name="BODY_x", unit="m", doc="centre x, for a body free along x",
+                  whole="mean"),
+          Channel(name="BODY_x_dot", unit="m/s", doc="ẋ", whole="mean"),
+          Channel(name="BODY_x_accel", unit="m/s²", doc="ẍ", whole="mean")),
+    "z": (Channel(name="BODY_z", unit="m", doc="centre z, for a body free along z",
+                  whole="mean"),
+          Channel(name="BODY_z_dot", unit="m/s", doc="ż", whole="mean"),
+          Channel(name="BODY_z_accel", unit="m/s²", doc="z̈", whole="mean")),
 }
 
 #: Every nip's channels.

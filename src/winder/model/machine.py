@@ -16,7 +16,8 @@ rolls, riders, ...) and force elements (:mod:`winder.forces`), which the scene g
   prescribed has no ``θ`` state;
 - every scene number the dynamics reads is a named run-time parameter
   (:attr:`Machine.param_names`), so one compiled model serves every value of them;
-- every result channel has a unit (:attr:`Machine.channel_units`);
+- every result channel has a unit (:attr:`Machine.channel_units`); a flexible body keeps
+  the body-level channels of its rigid self (:mod:`winder.model.whole_body`);
 - :meth:`Machine.evaluate` is the dynamics: the bodies' kinematics and the nips', the
   force elements in the order their declarations give (:mod:`winder.model.element_order`),
   the variable-mass ``−Ẏv``, and Pinocchio's ABA (and RNEA for the drive torques) through a
@@ -40,6 +41,7 @@ from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, W
 from winder.model.element_order import order_elements
 from winder.model.locked_modes import FREE, ModeKind, ModeSlot
 from winder.model.slices import assemble_nips, entry_slice, entry_slices
+from winder.model.whole_body import declare_wholes, write_wholes
 
 __all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState"]
 
@@ -132,6 +134,8 @@ class Machine:
         self.state_initial: list[float] = []
         self.channel_names: list[str] = []
         self.channel_units: dict[str, str] = {}
+        #: every channel's declaration and owner (:meth:`channel`), by its name
+        self.channel_owners: dict[str, tuple[Channel, str]] = {}
         self.modes: list[ModeSlot] = []
         self.mode_names: list[str] = []
         self.switch_names: list[str] = []
@@ -139,6 +143,8 @@ class Machine:
         self.forces = order_elements(list(forces))
         for f in self.forces:
             f.declare(self)
+        #: the flexible bodies as wholes: their rigid selves' channels
+        self.wholes = declare_wholes(self)
         self._index = {n: i for i, n in enumerate(self.state_names)}
         self._pindex = {n: i for i, n in enumerate(self.param_names)}
 
@@ -209,6 +215,7 @@ class Machine:
         if name not in self.channel_names:
             self.channel_names.append(name)
             self.channel_units[name] = declared.unit
+            self.channel_owners[name] = (declared, owner)
         return name
 
     def mode(self, name: str, switches: tuple[str, ...], kind: ModeKind, *, owner: str,
@@ -570,3 +577,4 @@ class Evaluation:
         for w in mach.webs:
             a = self.bodies[w.entry.a.name]
             out(WEB_SPEED, w.channel, a.omega * a.r)
+        write_wholes(self, mach.wholes)

@@ -7,6 +7,7 @@ and its :class:`BodyElement`, registered in :data:`PARTS`), nips and the web wit
 type in ``scene.bodies``), and ``nips``, ``webs``."""
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 from winder.parts._base import BodyElement, Drawing, RigidDisc, SubTable, TableReader
@@ -30,7 +31,7 @@ __all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "RollPart", "ROLL_KIN
            "NipPart", "ContactLaw", "FrictionLaw", "CONTACT_LAWS", "WebPart", "SpanPart",
            "BodyElement", "RigidDisc", "SubTable", "TableReader", "Drawing", "DrumBody",
            "RollBody", "RiderBody", "PARTS", "NAME", "CENTRE", "MAX_COORD", "body_elements",
-           "body_types"]
+           "body_types", "whole_elements"]
 
 #: The body types by the scene attribute that lists their parts (``scene.drums``), in the
 #: order the machine builds them (a body may rest on one built before it) and the scene
@@ -48,13 +49,23 @@ def body_types() -> dict[str, type[BodyElement]]:
     return {cls.table: cls for cls in PARTS.values()}
 
 
-def body_elements(scene: Any) -> list[BodyElement]:
-    """The body elements of ``scene``'s parts (:data:`PARTS` order, then the scene's)."""
+def body_elements(scene: Any, *, whole: bool = False) -> list[BodyElement]:
+    """The body elements of ``scene``'s parts (:data:`PARTS` order, then the scene's); a
+    flexible part's are its segments."""
     bodies: Mapping[str, Any] = getattr(scene, "bodies", None) or {}
     placed: dict[str, BodyElement] = {}
     for attr, cls in PARTS.items():
         parts = bodies.get(attr) if attr in bodies else getattr(scene, attr, None)
         for part in parts or ():
+            if whole and getattr(part, "flex", None) is not None:
+                part = replace(part, flex=None)
             for element in cls.elements(part, placed):
                 placed[element.name] = element
     return list(placed.values())
+
+
+def whole_elements(scene: Any) -> list[BodyElement]:
+    """One body element per part of ``scene``: a flexible part's rigid self, whose
+    body-level channels the flexible body keeps (:mod:`winder.model.whole_body`), for the
+    figures and summaries that show a part as one body."""
+    return body_elements(scene, whole=True)

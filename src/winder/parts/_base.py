@@ -133,7 +133,8 @@ class BodyElement(ABC):
     5. Optional: :meth:`transverse_inertia` (default ``J/2``, a thin disc),
        :meth:`drive_torque` (an input torque [N·m], operation sense),
        :meth:`outputs` (its channels, ``ev.set_channel``), :meth:`fixed_at_rest`
-       (coordinates the static balance does not solve for), :meth:`breakpoints` (times
+       (coordinates the static balance does not solve for), :attr:`bearing_axes` (those
+       it solves for even without contact), :meth:`breakpoints` (times
        [s] where its prescribed motion has a kink), :meth:`operating_speed` and
        :meth:`hold_operating_speed` (a prescribed drive at a given web speed, for the
        resonance map), :meth:`structure_tag`
@@ -204,6 +205,10 @@ class BodyElement(ABC):
     radius_state: ClassVar[bool] = False
     #: its mass properties change in time (the ``variable_mass`` effect applies)
     variable_mass: ClassVar[bool] = False
+    #: the free axes an elastic support holds it along (a flexible body's bearings, a
+    #: roll's chucks, a rider's arms): the static balance solves them whether or not
+    #: anything rests on it (:func:`~winder.solve.equilibrium.balance_unknowns`)
+    bearing_axes: tuple[str, ...] = ()
 
     def __init__(self, part: Any) -> None:
         self.part = part
@@ -222,6 +227,9 @@ class BodyElement(ABC):
         self.com_offset: float | None = None
         #: a segment of a flexible body: that body's name (its nips are sliced), else None
         self.segment_of: str | None = None
+        #: a segment: the axes its whole body's rigid self is free along, whose ``x``, ``z``
+        #: channels the whole body keeps (:mod:`winder.model.whole_body`); None: :attr:`free`
+        self.whole_free: tuple[str, ...] | None = None
         #: Pinocchio joint ids by coordinate (``x``, ``z``, ``theta``), set by the machine
         self.joints: dict[str, int] = {}
 

@@ -165,8 +165,8 @@ class DrumBody(RigidDisc):
             machine.parameter(f"{n}.web_speed", vw)
             machine.parameter(f"{n}.ratio", dr.ratio)
             machine.parameter(f"{n}.ramp_time", vw / aw if aw > 0 else 0.0)
-        else:
-            machine.parameter(f"{n}.torque", dr.torque)
+        else:  # named by its input: a flexible drum's is the drum's, not its segment's
+            machine.parameter(self.torque_inputs[0], dr.torque)
 
     def initial_rate(self, coord: str) -> float:
         """Spec §7: ``θ̇ = s · web_speed / R`` (a torque drive's initial web speed)."""
@@ -205,7 +205,7 @@ class DrumBody(RigidDisc):
         super().kinematics(ev, bs)
 
     def drive_torque(self, ev: Evaluation) -> Any:
-        return None if self.prescribed else ev.p(f"{self.name}.torque")
+        return None if self.prescribed else ev.p(self.torque_inputs[0])
 
     # ---- for the analyses ---------------------------------------------------------------
     def drive_web_speed(self) -> float | None:
@@ -232,9 +232,9 @@ class DrumSegment(DrumBody):
     and ``z`` (its deflection from the drum's ``centre``, the line of its bearings) that
     turns about ``+y``, of mass ``m/N`` [kg], polar inertia ``J/N`` [kg·m²] and the drum's
     radius [m]; segment 0 is the drive end and carries the drive (a speed profile
-    prescribes its rotation alone; a torque drive acts on it alone). The beam and the
-    torsion between the segments are the force element ``flex_beam``, which every segment
-    calls for (:attr:`drives`)."""
+    prescribes its rotation alone; a torque drive acts on it alone, its input the drum's
+    ``NAME.torque`` as the rigid drum's). The beam and the torsion between the segments
+    are the force element ``flex_beam``, which every segment calls for (:attr:`drives`)."""
 
     #: the axes its bearings hold (the beam's supports)
     bearing_axes = ("x", "z")
@@ -248,9 +248,11 @@ class DrumSegment(DrumBody):
         self.flex, self.length = flex, float(part.length)
         self.name = f"{part.name}_s{index}"
         self.segment_of = part.name
+        self.whole_free = self.free  # the rigid drum's: none
         self.free = ("x", "z")
         self.prescribed = index == 0 and part.drive.kind == "speed_profile"
-        self.torque_inputs = (f"{self.name}.torque",) \
+        # the drum's input, as the rigid drum's: DRUM.torque (the FMU's DRUM_torque)
+        self.torque_inputs = (f"{part.name}.torque",) \
             if index == 0 and part.drive.kind == "torque" else ()
         self.drives = ("flex_beam",)
 
@@ -267,7 +269,7 @@ class DrumSegment(DrumBody):
             self._declare_drive(machine)
 
     def drive_torque(self, ev: Evaluation) -> Any:
-        return ev.p(f"{self.name}.torque") if self.torque_inputs else None
+        return ev.p(self.torque_inputs[0]) if self.torque_inputs else None
 
     def drive_web_speed(self) -> float | None:
         """Its drive's ``web_speed`` [m/s] (segment 0 only)."""

@@ -138,6 +138,7 @@ class RiderSegment(RiderBody):
         self.length = float(part.length)
         self.name = f"{part.name}_s{index}"
         self.segment_of = part.name
+        self.whole_free = self.free  # the rigid rider's: z
         self.free = ("x", "z")
         self.drives = ("flex_beam",)
 

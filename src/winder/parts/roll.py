@@ -218,11 +218,13 @@ class RollBody(BodyElement):
                                    heading="flex (wound rolls)")}
     part_cls = RollPart
     CHANNELS = (
-        Channel(name="ROLL_radius", unit="m", doc="radius r of a paper roll"),
-        Channel(name="ROLL_mass", unit="kg", doc="mass m(r)"),
-        Channel(name="ROLL_inertia", unit="kg·m²", doc="polar inertia J(r) about its axis"),
-        Channel(name="ROLL_mass_rate", unit="kg/s", doc="ṁ (negative for an unwinding roll)"),
-        Channel(name="ROLL_inertia_rate", unit="kg·m²/s", doc="J̇"),
+        Channel(name="ROLL_radius", unit="m", doc="radius r of a paper roll", whole="shared"),
+        Channel(name="ROLL_mass", unit="kg", doc="mass m(r)", whole="sum"),
+        Channel(name="ROLL_inertia", unit="kg·m²", doc="polar inertia J(r) about its axis",
+                whole="sum"),
+        Channel(name="ROLL_mass_rate", unit="kg/s", doc="ṁ (negative for an unwinding roll)",
+                whole="sum"),
+        Channel(name="ROLL_inertia_rate", unit="kg·m²/s", doc="J̇", whole="sum"),
     )
     radius_state = True
     variable_mass = True

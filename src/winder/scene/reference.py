@@ -22,7 +22,7 @@ import sys
 from collections.abc import Iterable
 from pathlib import Path
 
-from winder._schema import NO_DEFAULT, Channel, Key, Table
+from winder._schema import NO_DEFAULT, WHOLE_RULES, Channel, Key, Table
 from winder._schema import format_number as _num
 from winder.forces import DRIVES, FORCES
 from winder.model.channels import GENERIC_CHANNELS, TIME
@@ -265,9 +265,15 @@ def reference() -> str:
               "`WEB_web_speed` and `WEB_web_force` (`WEB` the web's name); with several "
               "spans, `span_tension` and `tension_error` are `WEB_span_tension` and "
               "`WEB_tension_error`.", "",
-              "| channel | unit | meaning |", "|---|---|---|"]
+              "A flexible body `NAME` (`flex`) has every channel of a body for each of its "
+              "segments `NAME_s{i}` (0 at the drive end) and keeps the body-level channels "
+              "of its rigid self, with the same names, units and meanings, formed from its "
+              "segments' as the column *flexible body* says (a driven body: one with a "
+              "drive on segment 0; its `x`, `z` only where the rigid body is free).", "",
+              "| channel | unit | meaning | flexible body |", "|---|---|---|---|"]
     for decl in _declarations():
-        lines.append(f"| `{decl.name}` | {decl.unit} | {_cell(decl.doc)} |")
+        whole = WHOLE_RULES[decl.whole] if decl.whole else ""
+        lines.append(f"| `{decl.name}` | {decl.unit} | {_cell(decl.doc)} | {whole} |")
     return "\n".join(lines) + "\n"
 
 

@@ -2,7 +2,10 @@
 
 Angles 0, translational velocities 0, speeds from the scene; each free ``x``/``z`` solves
 the force balance of its body (gravity, rider load, the nips' normal forces at ``δ̇ = 0``
-and friction at ``F_t(0)``, the web forces at ``T(0)``).
+and friction at ``F_t(0)``, the web forces at ``T(0)``). With the ``contact`` effect off
+the coordinates an elastic support holds (a flexible body's bearings, a roll's chucks, a
+rider's arms: :func:`balance_unknowns`) are still balanced, so a flexible drum on its
+bearings starts in its sag; the others start at the scene's ``centre``.
 
 The solve starts where it almost ends (:func:`resting_state`): each free body resting on
 the bodies below it, every nip compressed by the static penetration of its law under the
@@ -35,7 +38,8 @@ from winder.parts import BodyElement as Body
 from winder.scene.naming import naming_of
 
 __all__ = ["static_state", "cached_static_state", "resting_state", "Resting", "Equilibrium",
-           "EquilibriumError", "RESIDUAL_LIMIT", "balance_keys", "body_key", "nip_key"]
+           "EquilibriumError", "RESIDUAL_LIMIT", "balance_keys", "body_key", "nip_key",
+           "balance_unknowns"]
 
 #: Largest accepted residual of the static balance, relative to the largest force in it.
 RESIDUAL_LIMIT = 1e-6
@@ -137,7 +141,7 @@ def resting_state(machine: Machine, x: np.ndarray, p: np.ndarray, movable: set[s
     # a body held along all its free axes by bearings (a roll on chucks) is not placed on
     # the bodies below it: it starts on its bearings' line, the balance finds its sag
     order = [b for b in machine.bodies if b.name in movable and b.free
-             and not set(b.free) <= set(getattr(b, "bearing_axes", ()))]
+             and not set(b.free) <= set(b.bearing_axes)]
     rank = {b.name: i for i, b in enumerate(machine.bodies)}
     placed0 = {b.name for b in machine.bodies if b.name not in movable or not b.free}
     supports = {b.name: [n for n in machine.nips if n.b is b and _whole(machine, n) and
@@ -278,6 +282,24 @@ def _split(b: Body, sup: list[Nip], w: np.ndarray, normal: dict[str, np.ndarray]
 
 
 # ---- the static balance -----------------------------------------------------------------
+def balance_unknowns(machine: Machine) -> list[tuple[str, str, int]]:
+    """The free coordinates the static balance solves for, ``(body, coordinate, state
+    index)``: with the ``contact`` effect every free coordinate not fixed at rest
+    (:meth:`~winder.parts.BodyElement.fixed_at_rest`); without it those held by an elastic
+    support (:attr:`~winder.parts.BodyElement.bearing_axes`: a flexible body's bearings, a
+    roll's chucks, a rider's arms), which start in their static balance whether or not
+    anything rests on the body. The others start where the scene puts them (§7: a free
+    body with no contact beneath it at its ``centre``)."""
+    contact = bool(machine.scene.effects.contact)
+    out = []
+    for b in machine.bodies:
+        fixed = b.fixed_at_rest()
+        for c in b.free:
+            if c not in fixed and (contact or c in b.bearing_axes):
+                out.append((b.name, c, machine.index(f"{b.name}.{c}")))
+    return out
+
+
 def static_state(machine: Machine, p: np.ndarray | None = None) -> Equilibrium:
     """The initial state of ``machine`` (spec §7) for parameters ``p`` (default: the
     scene's).
@@ -296,22 +318,16 @@ def static_state(machine: Machine, p: np.ndarray | None = None) -> Equilibrium:
     contact = machine.mode_slots(ModeKind.CONTACT)
     modes = np.full(len(machine.mode_names), float(CORE_AUTO))
     modes[contact] = IN_CONTACT
-    unknowns = []
-    resting = bool(machine.scene.effects.contact)  # without contact, free bodies start
-    movable = set()
-    for b in machine.bodies:  # at their centres (§7)
-        fixed = b.fixed_at_rest()
-        for c in b.free:
-            if c in fixed:
-                x[machine.index(f"{b.name}.{c}")] = fixed[c]
-            elif resting:
-                unknowns.append((b.name, c, machine.index(f"{b.name}.{c}")))
-                movable.add(b.name)
+    for b in machine.bodies:
+        for c, value in b.fixed_at_rest().items():
+            x[machine.index(f"{b.name}.{c}")] = value
+    unknowns = balance_unknowns(machine)
     be = NumericBackend(machine.model)
     if not unknowns:
         return Equilibrium(x, 0.0, 0.0)
     idx = [i for _, _, i in unknowns]
-    x = resting_state(machine, x, p, movable, be=be).state
+    if machine.scene.effects.contact:  # the first guess: each body resting on its nips
+        x = resting_state(machine, x, p, {b for b, _, _ in unknowns}, be=be).state
 
     def residual(u: np.ndarray) -> np.ndarray:
         x[idx] = u
