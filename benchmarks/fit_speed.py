@@ -63,7 +63,7 @@ def main() -> None:
         lo, hi = res.ci95[j]
         print(f"  {k}: truth {v:.6g}, estimate {res[k]:.6g} ({res[k] / v - 1:+.2e}), "
               f"95 % [{lo:.6g}, {hi:.6g}] {'holds' if lo <= v <= hi else 'MISSES'} it")
-    print(f"sigma estimated: " + ", ".join(f"{c} {s:.3g}" for c, s in res.sigma.items()))
+    print("sigma estimated: " + ", ".join(f"{c} {s:.3g}" for c, s in res.sigma.items()))
     print(f"fit: {wall:.1f} s wall ({res.evaluations} evaluations with sensitivities, "
           f"{res.iterations} iterations), target 30 s: {'met' if wall < 30 else 'MISSED'}")
 
