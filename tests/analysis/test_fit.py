@@ -161,5 +161,6 @@ def test_event_in_the_window_is_named(paper):
     X = np.zeros((6, 150))
     X[:, :] = np.asarray(fm.system.initial_state())[:, None]
     X[0, 100:] += 0.1  # the roll lifted 10 cm off the drum
-    with pytest.raises(FitEventError, match=r"nip 'nip' lifts off .* t = 0\.2 s and 0\.202 s.*t_end < 0\.2 s"):
+    with pytest.raises(FitEventError,
+                       match=r"nip 'nip' lifts off .* t = 0\.2 s and 0\.202 s.*t_end < 0\.2 s"):
         fm.check_events(X, fm.machine_at(fm.theta0))

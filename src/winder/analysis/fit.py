@@ -257,6 +257,10 @@ def fit(scene: Scene | str | os.PathLike, data: Any, params: Any, *,
                       1e-12 * max(float(np.max(np.abs(measured[i]))), 1e-300))
                   for i, n in enumerate(names)])
     cache[(theta0 / scale).tobytes()] = first
+    report(f"fit: evaluation 1: cost "
+           f"{0.5 * float(np.sum(((first.y - measured) / w[:, None]) ** 2)):.6g} at the "
+           "first guess " + ", ".join(f"{n}={v:.6g}" for n, v in zip(keys, theta0,
+                                                                     strict=True)))
     seen = np.sqrt(np.sum((first.S / w[:, None, None]) ** 2, axis=(0, 1))) * scale
     for j, k in enumerate(keys):
         if not seen[j] > 1e-12 * max(float(np.max(seen)), 1e-300) or seen[j] == 0.0:

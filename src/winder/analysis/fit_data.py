@@ -45,11 +45,11 @@ class Table:
         bad = np.flatnonzero(~np.isfinite(t))
         if len(bad):
             raise ArgumentError(f"data ({self.source}): column 't' row {bad[0]} is "
-                                f"{t[bad[0]]!r}, not finite")
+                                f"{float(t[bad[0]])!r}, not finite")
         back = np.flatnonzero(np.diff(t) <= 0)
         if len(back):
             raise ArgumentError(f"data ({self.source}): column 't' is not increasing at row "
-                                f"{back[0] + 1} ({t[back[0]]!r}, {t[back[0] + 1]!r})")
+                                f"{back[0] + 1} ({float(t[back[0]])!r}, {float(t[back[0] + 1])!r})")
         for name, v in self.columns.items():
             v = np.asarray(v, dtype=float)
             if v.shape != t.shape:
@@ -58,7 +58,7 @@ class Table:
             bad = np.flatnonzero(~np.isfinite(v))
             if len(bad):
                 raise ArgumentError(f"data ({self.source}): column {name!r} row {bad[0]} "
-                                    f"is {v[bad[0]]!r}, not finite")
+                                    f"is {float(v[bad[0]])!r}, not finite")
 
 
 def _split(name: str) -> tuple[str, str | None]:
