@@ -41,7 +41,7 @@ from winder.scene.keys import key_unit
 from winder.scene.load import Scene
 from winder.solve.simulate import _as_scene
 
-__all__ = ["fit", "FitResult", "IDENTIFIABLE", "DEFAULT_RTOL"]
+__all__ = ["fit", "FitResult", "IDENTIFIABLE", "DEFAULT_RTOL", "statistics"]
 
 #: Smallest ratio of the least to the largest scaled singular value of an identifiable fit.
 IDENTIFIABLE = 1e-6
@@ -158,6 +158,36 @@ def _bounds(spec: ParamSpec, v0: float) -> tuple[float, float]:
     return lo, hi
 
 
+def statistics(J: np.ndarray, scale: np.ndarray, *, dof: float | None) -> dict[str, Any]:
+    """The statistics of a weighted least-squares optimum (module docstring) from its
+    weighted Jacobian ``J`` (residuals × parameters, per parameter unit) and the
+    parameters' scales: ``covariance``, ``std``, ``correlation``, ``quantile`` (Student's
+    t with ``dof`` degrees of freedom, the normal one for ``None``), the scaled
+    ``singular_values``, the ``weakest`` direction (unit norm, its largest weight
+    positive) and whether the fit is ``identifiable``."""
+    from scipy.stats import t as student
+
+    Js = J * scale[None, :]
+    _, sv, vt = np.linalg.svd(Js, full_matrices=False)
+    weak = vt[-1] / np.linalg.norm(vt[-1])
+    weak = weak * np.sign(weak[np.argmax(np.abs(weak))])
+    identifiable = bool(sv[-1] > IDENTIFIABLE * sv[0])
+    if identifiable:
+        cov_s = np.linalg.inv(Js.T @ Js)
+    else:
+        cov_s = np.linalg.pinv(Js.T @ Js)
+        for j in np.flatnonzero(np.abs(weak) > 1e-3):
+            cov_s[j, :] = cov_s[:, j] = np.nan
+            cov_s[j, j] = np.inf
+    cov = cov_s * np.outer(scale, scale)
+    std = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(std, std)
+    q = float(student.ppf(0.975, dof)) if dof is not None else 1.959963984540054
+    return {"covariance": cov, "std": std, "correlation": corr, "quantile": q,
+            "singular_values": sv, "weakest": weak, "identifiable": identifiable}
+
+
 def fit(scene: Scene | str | os.PathLike, data: Any, params: Any, *,
         channels: Any = None, sigma: Any = None, t_start: float | None = None,
         t_end: float | None = None, rtol: float | None = None,
@@ -192,7 +222,6 @@ def fit(scene: Scene | str | os.PathLike, data: Any, params: Any, *,
         window, naming it and a window without it.
     """
     from scipy.optimize import least_squares
-    from scipy.stats import t as student
 
     start = time.perf_counter()
     scene = _as_scene(scene, "fit")
@@ -297,34 +326,21 @@ def fit(scene: Scene | str | os.PathLike, data: Any, params: Any, *,
     ev = evaluate(z)
     J = (ev.S / w[:, None, None]).reshape(-1, n_th)  # weighted, per key unit
     r = ((ev.y - measured) / w[:, None]).ravel()
-    Js = J * scale[None, :]
-    _, sv, vt = np.linalg.svd(Js, full_matrices=False)
-    weak = vt[-1] / np.linalg.norm(vt[-1])
-    weak = weak * np.sign(weak[np.argmax(np.abs(weak))])
-    identifiable = bool(sv[-1] > IDENTIFIABLE * sv[0])
-    if identifiable:
-        cov_s = np.linalg.inv(Js.T @ Js)
-    else:
-        cov_s = np.linalg.pinv(Js.T @ Js)
-        for j in np.flatnonzero(np.abs(weak) > 1e-3):
-            cov_s[j, :] = cov_s[:, j] = np.nan
-            cov_s[j, j] = np.inf
-    cov = cov_s * np.outer(scale, scale)
-    std = np.sqrt(np.diag(cov))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(std, std)
-    q = float(student.ppf(0.975, n_all - n_th)) if estimated else 1.959963984540054
+    stats = statistics(J, scale, dof=n_all - n_th if estimated else None)
+    std = stats["std"]
+    q = stats["quantile"]
     units = {k: key_unit(k, scene.to_dict()) for k in keys}
     return FitResult(
         scene=scene, keys=tuple(keys), units=units, initial=theta0, estimates=theta,
         std=std, ci95=np.column_stack([theta - q * std, theta + q * std]),
-        covariance=cov, correlation=corr, channels=tuple(names),
+        covariance=stats["covariance"], correlation=stats["correlation"],
+        channels=tuple(names),
         channel_units={n: outputs[n][1] for n in names},
         sigma=dict(zip(names, map(float, w), strict=True)),
         sigma_estimated={n: given[n] is None for n in names}, t=t,
         measured=dict(zip(names, measured, strict=True)),
         fitted=dict(zip(names, ev.y, strict=True)), cost=0.5 * float(r @ r),
         iterations=iterations, evaluations=model.evaluations, converged=converged,
-        message=message, singular_values=sv,
-        weakest=dict(zip(keys, map(float, weak), strict=True)),
-        identifiable=identifiable, quantile=q, wall_time=time.perf_counter() - start)
+        message=message, singular_values=stats["singular_values"],
+        weakest=dict(zip(keys, map(float, stats["weakest"]), strict=True)),
+        identifiable=stats["identifiable"], quantile=q, wall_time=time.perf_counter() - start)
