@@ -25,6 +25,7 @@ _LAZY = {
     **dict.fromkeys(("linearise",), ".analysis.plant"),
     **dict.fromkeys(("fit", "FitResult"), ".analysis.fit"),
     **dict.fromkeys(("FitEventError",), ".analysis.fit_model"),
+    **dict.fromkeys(("fit_modes",), ".analysis.fit_modes"),
     **dict.fromkeys(("FunctionMassLaw", "MassLaw", "MassProperties", "PaperRollLaw"),
                     ".model.mass_law"),
     **dict.fromkeys(("Mode", "ModeMap", "mode_map", "modes_at"), ".analysis.modes"),
@@ -46,6 +47,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from winder.analysis.control import CasadiModel, casadi_model
     from winder.analysis.fit import FitResult, fit
     from winder.analysis.fit_model import FitEventError
+    from winder.analysis.fit_modes import fit_modes
     from winder.analysis.linearise import jacobian
     from winder.analysis.modes import Mode, ModeMap, mode_map, modes_at
     from winder.analysis.plant import linearise
@@ -101,6 +103,7 @@ __all__ = [
     "fit",
     "FitResult",
     "FitEventError",
+    "fit_modes",
     "jacobian",
     "linearise",
     "load_result",

@@ -62,6 +62,8 @@ class FitResult:
     quantile: float
     wall_time: float
     extra: dict[str, Any] = field(default_factory=dict)
+    #: what ``t`` holds: the samples' times, or (:func:`winder.fit_modes`) the radii
+    abscissa: tuple[str, str] = ("t", "s")
 
     def __post_init__(self) -> None:
         n = len(self.keys)
@@ -89,7 +91,7 @@ class FitResult:
     @property
     def rms_residuals(self) -> dict[str, float]:
         """Per channel, the RMS of its residuals [channel unit]."""
-        return {n: float(np.sqrt(np.mean(r ** 2))) for n, r in self.residuals.items()}
+        return {n: float(np.sqrt(np.nanmean(r ** 2))) for n, r in self.residuals.items()}
 
     def not_identifiable(self) -> list[str]:
         """The keys of the weakest direction (weight above 1e-3) when the fit is not
@@ -125,7 +127,7 @@ class FitResult:
                                 "weakest": dict(self.weakest),
                                 "identifiable": bool(self.identifiable),
                                 "not_identifiable": self.not_identifiable()},
-            "window": [float(self.t[0]), float(self.t[-1])],
+            "window": [float(np.min(self.t)), float(np.max(self.t))],
             "wall_time": self.wall_time,
         }
 
@@ -178,7 +180,7 @@ class FitResult:
             ax.plot(self.t, self.residuals[c], ".", ms=2, color="C0")
             ax.axhline(0.0, color="k", lw=0.5)
             ax.set_ylabel(f"residual [{unit}]")
-            ax.set_xlabel("t [s]")
+            ax.set_xlabel(f"{self.abscissa[0]} [{self.abscissa[1]}]")
         title = ", ".join(f"{k} = {v:.5g} ± {s:.2g}" for k, v, s in
                           zip(self.keys, self.estimates, self.std, strict=True))
         fig.suptitle(title, fontsize=9)
