@@ -201,14 +201,20 @@ class ForwardModel:
                                                         np.ndarray, Machine]:
         """``(p, ∂p/∂θ, x_initial, ∂x_initial/∂θ, machine)`` at ``theta``: central
         differences of the key → parameter map with steps ``h`` and ``h/2`` combined by
-        Richardson extrapolation (exact for a linear map)."""
+        Richardson extrapolation (exact for a linear map). A key whose two differences
+        agree to 1e-10 (a linear map: the usual identity) keeps its column: its map is
+        not differenced again."""
         theta = np.asarray(theta, dtype=float)
         m = self.machine_at(theta)
         p = np.asarray(m.parameters(), dtype=float)[self._porder]
         xi = np.asarray(m.state_initial, dtype=float)
         D = np.zeros((len(p), len(theta)))
         E = np.zeros((len(xi), len(theta)))
+        linear = self.__dict__.setdefault("_linear", {})
         for j in range(len(theta)):
+            if j in linear:
+                D[:, j], E[:, j] = linear[j]
+                continue
             h = 1e-4 * max(abs(theta[j]), 1e-300) if theta[j] != 0 else 1e-6
 
             def diff(step: float, j: int = j) -> tuple[np.ndarray, np.ndarray]:
@@ -222,7 +228,12 @@ class ForwardModel:
             d2, e2 = diff(h / 2)
             D[:, j] = (4 * d2 - d1) / 3
             E[:, j] = (4 * e2 - e1) / 3
-        # round-off of an identity map: snap ratios within 1e-9 of 0 or 1
+            size = max(float(np.max(np.abs(D[:, j]), initial=0.0)),
+                       float(np.max(np.abs(E[:, j]), initial=0.0)), 1e-300)
+            if max(float(np.max(np.abs(d1 - d2), initial=0.0)),
+                   float(np.max(np.abs(e1 - e2), initial=0.0))) <= 1e-10 * size:
+                linear[j] = (D[:, j].copy(), E[:, j].copy())
+        # round-off of the differences: entries below 1e-9 of the column's largest are 0
         D[np.abs(D) < 1e-9 * np.max(np.abs(D), axis=0, initial=0.0)] = 0.0
         return p, D, xi, E, m
 
