@@ -70,6 +70,8 @@ def test_writes_the_fit_and_the_fitted_scene(tmp_path, models_dir, record, capsy
     (["--param", "drum.mass", "--channel", "drum_torque"],
      "--param: drum.mass: no fitted channel sees it"),
     (["--param", "drum.inertia=1:2"], "outside the bounds"),
+    (["--param", "drum.inertia", "--t-end", "nan"],
+     "argument --t-end: 'nan' is out of range; valid: a finite time >= 0 s"),
 ])
 def test_bad_input_is_one_line(tmp_path, models_dir, record, capsys, monkeypatch, args,
                                message):

@@ -5,6 +5,7 @@ progress on stderr, the estimates with their intervals printed as a table, ``FIT
 from __future__ import annotations
 
 import argparse
+import math
 import re
 import sys
 from collections.abc import Callable
@@ -19,6 +20,19 @@ __all__ = ["add_parser", "cmd_fit"]
 _OPTIONS = {"params": "--param", "channels": "--channel", "sigma": "--channel NAME:STD",
             "data": "--data", "t_start": "--t-start", "t_end": "--t-end", "rtol": "--rtol",
             "t_start, t_end": "--t-start, --t-end"}
+
+
+def _time(text: str) -> float:
+    """An argparse type: a time [s], finite and >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; valid: a finite time "
+                                         ">= 0 s") from None
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"{text!r} is out of range; valid: a finite time "
+                                         ">= 0 s")
+    return value
 
 
 def add_parser(sub: Any, positive: Callable[[str], Any], rtol: Callable[[str], Any]) -> None:
@@ -36,8 +50,8 @@ def add_parser(sub: Any, positive: Callable[[str], Any], rtol: Callable[[str], A
     p.add_argument("--channel", action="append", metavar="NAME[:STD]",
                    help="a channel to fit (repeat; default every data column), with its "
                    "measurement noise STD in its unit (default: estimated)")
-    p.add_argument("--t-start", type=float, metavar="T", help="start of the window [s]")
-    p.add_argument("--t-end", type=float, metavar="T", help="end of the window [s]")
+    p.add_argument("--t-start", type=_time, metavar="T", help="start of the window [s]")
+    p.add_argument("--t-end", type=_time, metavar="T", help="end of the window [s]")
     p.add_argument("--rtol", type=rtol, help="the integrator's relative tolerance "
                    "(default 1e-8)")
     p.add_argument("--out", required=True, metavar="FIT.json",
