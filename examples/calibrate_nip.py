@@ -11,7 +11,8 @@ fitted machine's resonance map (``winder.mode_map``) is drawn against the true o
 the guess's: the bounce frequency the calibration moves, the band where 1× crosses it.
 
 Writes ``calibrate_nip_fit.png`` (measured against fitted channels, residuals),
-``calibrate_nip_modes.png`` (the resonance maps), ``calibrate_nip.json`` (the fit) to
+``calibrate_nip_modes.png`` (the resonance maps), ``calibrate_nip.json`` (the fit) and the
+record ``calibrate_nip_record.csv`` (units in its header, for ``winder fit --data``) to
 ``--out``.
 
     python examples/calibrate_nip.py [--out out]
@@ -63,6 +64,9 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     true = winder.load_scene(SCENE)
     data = record(true)
+    header = ",".join(data)
+    np.savetxt(args.out / "calibrate_nip_record.csv", np.column_stack(list(data.values())),
+               delimiter=",", header=header, comments="", fmt="%.17g")
     guess = scene_with(true, GUESS)
     start = time.perf_counter()
     res = winder.fit(guess, data, list(TRUTH))
@@ -97,7 +101,7 @@ def main() -> None:
           f"{err:.2e} over the radii (the guess's: "
           f"{np.max(np.abs(maps['guess'].bounce_frequency / mm.bounce_frequency - 1)):.2e})")
     print(f"written to {args.out}/: calibrate_nip_fit.png, calibrate_nip_modes.png, "
-          "calibrate_nip.json")
+          "calibrate_nip.json, calibrate_nip_record.csv")
 
 
 if __name__ == "__main__":
