@@ -2,10 +2,11 @@
 exact sensitivities of the simulated channels to scene keys.
 
 The residuals ``(y_model(θ) − y_measured) / σ`` of every fitted channel at every sample
-in the window are minimised by scipy's trust-region reflective method (bounds; the
-Jacobian is the weighted sensitivity matrix of :class:`~winder.analysis.fit_model.
-ForwardModel`: CVODES's forward sensitivities of the one symbolic definition, no finite
-differences), in parameters scaled by their first guesses. One simulation with
+in the window are minimised by Levenberg–Marquardt with bounds
+(:mod:`winder.analysis.fit_lm`; the Jacobian is the weighted sensitivity matrix of
+:class:`~winder.analysis.fit_model.ForwardModel`: CVODES's forward sensitivities of the
+one symbolic definition, no finite differences), in parameters scaled by their first
+guesses; it stops where the step is below 1e-6 of every standard error. One simulation with
 sensitivities serves the residual and the Jacobian of each step (``evaluations`` counts
 them).
 
@@ -35,6 +36,7 @@ import numpy as np
 
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.fit_data import ParamSpec, Table, parse_params, read_table
+from winder.analysis.fit_lm import levenberg_marquardt
 from winder.analysis.fit_model import ForwardModel, key_value
 from winder.analysis.fit_result import FitResult
 from winder.scene.keys import key_unit
@@ -221,8 +223,6 @@ def fit(scene: Scene | str | os.PathLike, data: Any, params: Any, *,
         that no fitted channel sees. FitEventError: an event (lift-off, core) inside the
         window, naming it and a window without it.
     """
-    from scipy.optimize import least_squares
-
     start = time.perf_counter()
     scene = _as_scene(scene, "fit")
     specs = parse_params(params)
@@ -301,15 +301,15 @@ def fit(scene: Scene | str | os.PathLike, data: Any, params: Any, *,
     counts = np.array([measured.shape[1]] * len(names), dtype=float)
     n_all = float(measured.size)
     converged, message = False, ""
-    for _ in range(_REWEIGHTS):
-        sol = least_squares(residual, z, jac=jacobian, bounds=(lims[:, 0] / scale,
-                                                               lims[:, 1] / scale),
-                            method="trf", x_scale=1.0, xtol=1e-9, ftol=1e-12, gtol=1e-12,
-                            max_nfev=max(1, max_evaluations - model.evaluations))
-        iterations += int(sol.njev or 0)
+    for passes in range(_REWEIGHTS):
+        sol = levenberg_marquardt(lambda v: (residual(v), jacobian(v)), z,
+                                  lims[:, 0] / scale, lims[:, 1] / scale,
+                                  max_evaluations=max(2, max_evaluations
+                                                      - model.evaluations + 1))
+        iterations += sol.iterations
         z = sol.x
-        converged, message = sol.status > 0, str(sol.message)
-        if not estimated:
+        converged, message = sol.converged, sol.message
+        if not estimated or (sol.iterations == 0 and passes > 0):
             break
         ev = evaluate(z)
         rss = np.sum((ev.y - measured) ** 2, axis=1)
@@ -318,8 +318,7 @@ def fit(scene: Scene | str | os.PathLike, data: Any, params: Any, *,
         for i in estimated:
             new[i] = max(math.sqrt(rss[i] / dof[i]), 1e-300)
         change = np.max(np.abs(new[estimated] / w[estimated] - 1.0))
-        w = new
-        cache.clear()
+        w = new  # the cached simulation stays valid: only the weights change
         if len(names) == 1 or change < 2e-2 or model.evaluations >= max_evaluations:
             break
     theta = z * scale
