@@ -55,7 +55,7 @@ def main() -> None:
     print(f"build {build:.2f} s; one simulation with sensitivities {with_s:.2f} s, "
           f"without {without:.2f} s (rtol {args.rtol:g})")
     start = time.perf_counter()
-    res = winder.fit(guess, data, list(TRUE), rtol=args.rtol, progress=print)
+    res = winder.fit(guess, data, list(TRUE), rtol=args.rtol)
     wall = time.perf_counter() - start
     print(res.table())
     for k, v in TRUE.items():

@@ -13,7 +13,8 @@ dp/dθ)`` and ``dy*/dθ`` the implicit function theorem on the operating point's
 speed). A mode's frequency is its damped one ``|Im λ|/2π`` [Hz], as ``winder modes``
 reports it; its damping ratio ``−Re λ/|λ|``.
 
-The least squares and the statistics are :func:`winder.fit`'s; the result is a
+The least squares (:mod:`winder.analysis.fit_lm`) and the statistics are
+:func:`winder.fit`'s; the result is a
 :class:`~winder.FitResult` whose ``t`` holds the radii (``abscissa``), channels
 ``frequency`` [Hz] and ``damping`` [-] (NaN where not measured).
 """
@@ -32,6 +33,7 @@ import numpy as np
 from winder._errors import ArgumentError, ArgumentTypeError
 from winder.analysis.fit import IDENTIFIABLE, statistics
 from winder.analysis.fit_data import parse_params
+from winder.analysis.fit_lm import levenberg_marquardt
 from winder.analysis.fit_model import key_value, scene_with
 from winder.analysis.fit_result import FitResult
 from winder.analysis.operating_point import _linearisation, _web_speed
@@ -229,8 +231,6 @@ def fit_modes(scene: Scene | str | os.PathLike, modes_data: Any, params: Any, *,
     Raises ArgumentError for an unknown key, a label that is not a mode of the scene, a
     radius outside the roll's range, non-finite values.
     """
-    from scipy.optimize import least_squares
-
     start = time.perf_counter()
     scene = _as_scene(scene, _WHERE)
     specs = parse_params(params)
@@ -278,12 +278,10 @@ def fit_modes(scene: Scene | str | os.PathLike, modes_data: Any, params: Any, *,
     iterations, converged, message = 0, False, ""
     for _ in range(4):
         weights = dict(w)
-        sol = least_squares(lambda v, ws=weights: rows(v, ws)[0], zv,
-                            jac=lambda v, ws=weights: rows(v, ws)[1],
-                            bounds=(lo / scale, hi / scale), method="trf", xtol=1e-12,
-                            ftol=1e-14, gtol=1e-14, max_nfev=max_evaluations)
-        zv, iterations = sol.x, iterations + int(sol.njev or 0)
-        converged, message = sol.status > 0, str(sol.message)
+        sol = levenberg_marquardt(lambda v, ws=weights: rows(v, ws), zv, lo / scale,
+                                  hi / scale, max_evaluations=max_evaluations)
+        zv, iterations = sol.x, iterations + sol.iterations
+        converged, message = sol.converged, sol.message
         est = [n for n in names if given[n] is None]
         if not est:
             break
