@@ -46,3 +46,16 @@ def test_budget_stops_unconverged():
     sol = levenberg_marquardt(rosenbrock, np.array([-1.2, 1.0]), -INF, INF,
                               max_evaluations=3)
     assert not sol.converged and sol.evaluations == 3 and "max_evaluations" in sol.message
+
+
+def test_a_failing_trial_is_a_rejected_step():
+    """The simulation fails beyond x = 2 (the optimum of the cost, 3, lies there): the
+    steps into it are rejected and the fit stops at the edge instead of raising."""
+    def fun(x):
+        if x[0] > 2.0:
+            raise RuntimeError("no solution there")
+        return np.array([x[0] - 3.0]), np.array([[1.0]])
+
+    sol = levenberg_marquardt(fun, np.array([0.0]), np.array([-np.inf]), np.array([np.inf]),
+                              failures=(RuntimeError,))
+    assert sol.converged and 1.9 < sol.x[0] <= 2.0

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from winder._errors import ArgumentError, ArgumentTypeError
+from winder._errors import ArgumentError, ArgumentTypeError, SimulationError
 from winder.analysis.fit_data import ParamSpec, Table, parse_params, read_table
 from winder.analysis.fit_lm import levenberg_marquardt
 from winder.analysis.fit_model import ForwardModel, key_value
@@ -305,7 +305,8 @@ def fit(scene: Scene | str | os.PathLike, data: Any, params: Any, *,
         sol = levenberg_marquardt(lambda v: (residual(v), jacobian(v)), z,
                                   lims[:, 0] / scale, lims[:, 1] / scale,
                                   max_evaluations=max(2, max_evaluations
-                                                      - model.evaluations + 1))
+                                                      - model.evaluations + 1),
+                                  failures=(SimulationError, ArgumentError))
         iterations += sol.iterations
         z = sol.x
         converged, message = sol.converged, sol.message

@@ -37,9 +37,12 @@ class LMResult:
 def levenberg_marquardt(fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
                         x0: np.ndarray, lo: np.ndarray, hi: np.ndarray, *,
                         max_evaluations: int = 100, step_tol: float = 1e-6,
-                        rel_tol: float = 1e-10) -> LMResult:
+                        rel_tol: float = 1e-10,
+                        failures: tuple[type[BaseException], ...] = ()) -> LMResult:
     """Minimise ``½|r(x)|²`` with ``lo <= x <= hi``; ``fun(x) → (r, J)`` (module
-    docstring)."""
+    docstring). An exception of a type in ``failures`` at a trial point (the simulation
+    failed there, or an event entered the window) rejects the step, as a higher cost
+    would; at ``x0`` it is raised."""
     x = np.clip(np.asarray(x0, dtype=float), lo, hi)
     r, J = fun(x)
     evaluations, iterations, lam = 1, 0, 1e-6
@@ -65,9 +68,12 @@ def levenberg_marquardt(fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray
             if evaluations >= max_evaluations:
                 return LMResult(x, r, J, iterations, evaluations, False,
                                 f"stopped after {evaluations} evaluations (max_evaluations)")
-            r_new, J_new = fun(trial)
             evaluations += 1
-            new = 0.5 * float(r_new @ r_new)
+            try:
+                r_new, J_new = fun(trial)
+                new = 0.5 * float(r_new @ r_new)
+            except failures:
+                new = np.inf
             if new < cost:
                 x, r, J, cost = trial, r_new, J_new, new
                 lam = max(lam / 3.0, 1e-12)
