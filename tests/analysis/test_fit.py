@@ -38,7 +38,7 @@ def _table(run: winder.Result, channels: list[str], noise: dict[str, float] | No
 
 def test_noise_free_recovery_from_the_simulation(paper):
     """Data from ``winder.simulate`` (DOP853, the other path) of the true scene; the fit
-    starts 30 % off and recovers both nip parameters (measured: 7e-12 and 1.4e-7)."""
+    starts 30 % off and recovers both nip parameters (measured: 2.9e-12 and 7.6e-8)."""
     run = winder.simulate(paper, t_end=1.0, rtol=1e-12, atol=1e-14, output_step=0.004,
                           method="DOP853")
     guess = scene_with(paper, {"contact.stiffness": 2.6e7, "contact.damping": 1.5e4})
