@@ -167,9 +167,9 @@ def _symbolic(system: MachineSystem, input_params: Sequence[str],
               modes: Any = None) -> tuple[Any, Any, Any, Any, Any, list[str]]:
     """``(x, u, p, ẋ, y, parameter names)`` as CasADi SX: the machine's dynamics on
     symbols as :func:`winder.model.codegen` builds them, with the contact-closed modes
-    substituted (or ``modes``: an SX of the locked modes, which may depend on the time
-    ``p[-1]``) and the parameters split into inputs ``u`` and the rest ``p`` (time
-    last)."""
+    substituted (or ``modes(t)``: a function of the time symbol ``p[-1]`` giving the
+    locked modes as an SX, e.g. a roll held at its core until a time) and the parameters
+    split into inputs ``u`` and the rest ``p`` (time last)."""
     import casadi as ca
 
     from winder.model.backends import SymbolicBackend, default_route
