@@ -79,6 +79,8 @@ demo: $(STAMP)
 	$(PY) examples/speed_control_fmu.py --out $(OUT)
 	$(PY) examples/tension_loop_design.py --out $(OUT)
 	$(PY) examples/tension_mpc.py --out $(OUT)
+	$(PY) examples/calibrate_nip.py --out $(OUT)
+	$(PY) -m winder fit models/paper_winding.toml --data $(OUT)/calibrate_nip_record.csv --param contact.stiffness --param contact.damping --out $(OUT)/fit.json --plot $(OUT)/plots/fit.png --scene-out $(OUT)/paper_winding_fitted.toml
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/two_drum_winder.npz --html $(OUT)/two_drum_winder.html --snapshots $(OUT)/snapshots_two_drum --every 100
 	$(PY) -m winder modes models/two_drum_winder.toml --plot $(OUT)/plots/two_drum_modes.png --csv $(OUT)/two_drum_modes.csv

@@ -23,6 +23,9 @@ _LAZY = {
     **dict.fromkeys(("jacobian",), ".analysis.linearise"),
     **dict.fromkeys(("casadi_model", "CasadiModel"), ".analysis.control"),
     **dict.fromkeys(("linearise",), ".analysis.plant"),
+    **dict.fromkeys(("fit", "FitResult"), ".analysis.fit"),
+    **dict.fromkeys(("FitEventError",), ".analysis.fit_model"),
+    **dict.fromkeys(("fit_modes",), ".analysis.fit_modes"),
     **dict.fromkeys(("FunctionMassLaw", "MassLaw", "MassProperties", "PaperRollLaw"),
                     ".model.mass_law"),
     **dict.fromkeys(("Mode", "ModeMap", "mode_map", "modes_at"), ".analysis.modes"),
@@ -42,6 +45,9 @@ _LAZY = {
 
 if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from winder.analysis.control import CasadiModel, casadi_model
+    from winder.analysis.fit import FitResult, fit
+    from winder.analysis.fit_model import FitEventError
+    from winder.analysis.fit_modes import fit_modes
     from winder.analysis.linearise import jacobian
     from winder.analysis.modes import Mode, ModeMap, mode_map, modes_at
     from winder.analysis.plant import linearise
@@ -94,6 +100,10 @@ __all__ = [
     "build_fmu",
     "CasadiModel",
     "casadi_model",
+    "fit",
+    "FitResult",
+    "FitEventError",
+    "fit_modes",
     "jacobian",
     "linearise",
     "load_result",

@@ -163,12 +163,13 @@ class CasadiModel:
 
 
 def _symbolic(system: MachineSystem, input_params: Sequence[str],
-              channels: Sequence[str], *, route: str | None = None
-              ) -> tuple[Any, Any, Any, Any, Any, list[str]]:
+              channels: Sequence[str], *, route: str | None = None,
+              modes: Any = None) -> tuple[Any, Any, Any, Any, Any, list[str]]:
     """``(x, u, p, ẋ, y, parameter names)`` as CasADi SX: the machine's dynamics on
     symbols as :func:`winder.model.codegen` builds them, with the contact-closed modes
-    substituted and the parameters split into inputs ``u`` and the rest ``p`` (time
-    last)."""
+    substituted (or ``modes(t)``: a function of the time symbol ``p[-1]`` giving the
+    locked modes as an SX, e.g. a roll held at its core until a time) and the parameters
+    split into inputs ``u`` and the rest ``p`` (time last)."""
     import casadi as ca
 
     from winder.model.backends import SymbolicBackend, default_route
@@ -189,7 +190,7 @@ def _symbolic(system: MachineSystem, input_params: Sequence[str],
     xdot = ca.vertcat(*[ev.rates[n] for n in machine.state_names])
     # a channel the machine lacks (an effect off) is zero, as in the result
     y = ca.vertcat(*[ev.channels[c] if c in ev.channels else ca.SX(0.0) for c in channels])
-    modes = ca.DM(contact_closed_modes(system))
+    modes = ca.DM(contact_closed_modes(system)) if modes is None else modes(t)
     xdot, y = ca.substitute([xdot, y], [m], [modes])
     return x, u, p, xdot, y, [*rest, TIME_PARAMETER]
 

@@ -1,6 +1,6 @@
-"""Command-line interface: ``winder run|view|fmu|modes|sweep|linearise`` (also ``python -m
-winder``); ``winder sweep`` and ``winder linearise`` in their modules (:mod:`winder.cli.sweep`,
-:mod:`winder.cli.linearise`).
+"""Command-line interface: ``winder run|view|fmu|modes|sweep|linearise|fit`` (also ``python
+-m winder``); ``winder sweep``, ``winder linearise`` and ``winder fit`` in their modules
+(:mod:`winder.cli.sweep`, :mod:`winder.cli.linearise`, :mod:`winder.cli.fit`).
 
 Exit status
 -----------
@@ -364,6 +364,12 @@ def _version() -> str:
         return __version__
 
 
+def _add_fit(sub: Any) -> None:
+    from winder.cli.fit import add_parser
+
+    add_parser(sub, _POSITIVE, _RTOL)
+
+
 def _build_parser() -> argparse.ArgumentParser:
     from winder.scene.schema import BACKENDS, METHODS  # the scene's [solver] choices: one list
 
@@ -482,6 +488,7 @@ def _build_parser() -> argparse.ArgumentParser:
                        "whole lines every 5 s on a log or pipe)")
     sweep.set_defaults(func=_cmd_sweep)
     _add_linearise(sub)
+    _add_fit(sub)
     return parser
 
 
