@@ -12,7 +12,7 @@ $(STAMP): pyproject.toml
 	@echo "creating $(VENV) and installing winder with its dependencies (pip; about 2 min the first time)"
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test,fmu,peers]'
+	$(PY) -m pip install --progress-bar off -e '.[test,fmu,peers]'
 	touch $(STAMP)
 
 # The pin_casadi generator (Pinocchio's C++ headers on casadi::SX, winder/model/_pin_casadi.cpp):
@@ -62,15 +62,23 @@ libtbb:
 	    || echo "warning: could not install libtbb12; the ecospy host test will be skipped"; \
 	else echo "warning: libtbb12 not found and not root; the ecospy host test will be skipped"; fi
 
-# The first result comes first; Chromium (for the snapshots) is installed before the first view.
+# make demo: the first result first (the paper's winding cycle), then the rest in five
+# groups, two at a time (-j2: the machine's two cores; the longest first); Chromium (for the snapshots) is
+# installed before the first group that draws them. Each group's commands name their scene.
+DEMO_GROUPS := demo-flexible demo-control demo-paper demo-two-drum demo-paper-maps
+
 demo: $(STAMP)
 	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
+	@$(MAKE) --no-print-directory -j2 $(DEMO_GROUPS)
+	@echo "demo outputs in $(OUT)/"
+
+.PHONY: $(DEMO_GROUPS)
+demo-paper: $(STAMP)
 	$(PY) -m winder run models/paper_winding_no_web.toml --out $(OUT)/paper_winding_no_web.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/free_spin.toml --out $(OUT)/free_spin.csv --plots $(OUT)/plots
-	@$(MAKE) --no-print-directory chromium
-	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
-	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
-	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
+
+# the native FMUs (FMI 2.0 and 3.0) and the control examples through them
+demo-control: $(STAMP)
 	$(PY) -m winder fmu models/paper_winding.toml -o $(OUT)/fmu/paper_winding.fmu
 	$(PY) -m winder fmu models/two_drum_winder.toml -o $(OUT)/fmu/two_drum_winder.fmu
 	$(PY) -m winder fmu models/winder_line_fmu.toml -o $(OUT)/fmu/winder_line_fmu.fmu
@@ -81,18 +89,26 @@ demo: $(STAMP)
 	$(PY) examples/tension_mpc.py --out $(OUT)
 	$(PY) examples/calibrate_nip.py --out $(OUT)
 	$(PY) -m winder fit models/paper_winding.toml --data $(OUT)/calibrate_nip_record.csv --param contact.stiffness --param contact.damping --out $(OUT)/fit.json --plot $(OUT)/plots/fit.png --scene-out $(OUT)/paper_winding_fitted.toml
+
+demo-paper-maps: $(STAMP) chromium
+	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
+	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
+	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --workers 1 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
+
+demo-two-drum: $(STAMP) chromium
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/two_drum_winder.npz --html $(OUT)/two_drum_winder.html --snapshots $(OUT)/snapshots_two_drum --every 100
 	$(PY) -m winder modes models/two_drum_winder.toml --plot $(OUT)/plots/two_drum_modes.png --csv $(OUT)/two_drum_modes.csv
 	$(PY) -m winder run models/winder_line.toml --out $(OUT)/winder_line.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/winder_line.npz --html $(OUT)/winder_line.html --snapshots $(OUT)/snapshots_line --every 100
+
 # the flexible two-drum winder (issue #25): its first 5 s with the deflection, line-load
 # and twist figures, the animation, and its modes over the whole cycle's radii (0.05-0.6 m;
-# about 1.5 min here, plus 80 s compiling the machine's code the first time)
+# about 1.5 min here, plus about a minute compiling the machine's code the first time)
+demo-flexible: $(STAMP) chromium
 	$(PY) -m winder run models/two_drum_winder_flexible.toml --out $(OUT)/two_drum_winder_flexible.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder view $(OUT)/two_drum_winder_flexible.npz --html $(OUT)/two_drum_winder_flexible.html --snapshots $(OUT)/snapshots_flexible --every 1
 	$(PY) -m winder modes models/two_drum_winder_flexible.toml --radius-max 0.6 --points 40 --no-simulate --plot $(OUT)/plots/two_drum_flexible_modes.png --csv $(OUT)/two_drum_flexible_modes.csv
-	@echo "demo outputs in $(OUT)/"
 
 test: $(STAMP) pin-casadi chromium libtbb
 	$(PY) -m ruff check src viewer tests examples benchmarks tools
