@@ -63,8 +63,9 @@ libtbb:
 	else echo "warning: libtbb12 not found and not root; the ecospy host test will be skipped"; fi
 
 # make demo: the first result first (the paper's winding cycle), then the rest in five
-# groups, two at a time (-j2: the machine's two cores; the longest first); Chromium (for the snapshots) is
-# installed before the first group that draws them. Each group's commands name their scene.
+# groups, two at a time (-j2: the machine's two cores; the longest first); Chromium (for
+# the snapshots) is installed before the first group that draws them. Each group's
+# commands name their scene.
 DEMO_GROUPS := demo-flexible demo-control demo-paper demo-two-drum demo-paper-maps
 
 demo: $(STAMP)
