@@ -60,16 +60,18 @@ class TensionController(ForceElement):
 
     @staticmethod
     def _control(ev: Evaluation, w: Web) -> None:
-        b, k = w.unwind, w.span_key
+        span = w.spans[0]  # the first span's (machines.md §11: its downstream body's speed)
+        b, k = w.unwind, span.key
         n = b.name
-        u, a = ev.bodies[n], ev.bodies[w.entry.a.name]
-        T = ev.x(f"{k}span.tension")
+        u = ev.bodies[n]
+        a = ev.bodies[(span.downstream or w.entry.a).name]
+        T = ev.x(f"{k}tension")
         T_set = ev.p(f"{n}.tension_setpoint")
         wc = ev.p(f"{n}.bandwidth")
         e = T_set - T
         ev.set_rate(f"{n}.tension_integral", e)
         r, J = u.r, u.inertia
-        g = ev.p(f"{k}span.EA") * r / (ev.p(f"{k}span.length") * J)
+        g = ev.p(f"{k}EA") * r / (ev.p(f"{k}length") * J)
         kd, kp, ki = 3.0 * wc / g, 3.0 * wc * wc / g - r, wc ** 3 / g
         v2 = a.omega * a.r * a.body.sense
         a_dot = a.alpha_prescribed if a.alpha_prescribed is not None else 0.0

@@ -9,9 +9,20 @@ type in ``scene.bodies``), and ``nips``, ``webs``."""
 from collections.abc import Mapping
 from typing import Any
 
-from winder.parts._base import BodyElement, Drawing, RigidDisc, SubTable, TableReader
+from winder.parts._base import (
+    NIP_ROLES,
+    WEB_ROLES,
+    BodyElement,
+    Drawing,
+    RigidDisc,
+    Roles,
+    Segment,
+    SubTable,
+    TableReader,
+)
 from winder.parts._keys import CENTRE, MAX_COORD, NAME
 from winder.parts.drum import DrumBody, DrumPart, SpeedProfileDrive, TorqueDrive
+from winder.parts.idler import IdlerBody
 from winder.parts.nip import CONTACT_LAWS, ContactLaw, FrictionLaw, NipPart
 from winder.parts.rider import RiderBody, RiderPart
 from winder.parts.roll import (
@@ -30,7 +41,7 @@ __all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "RollPart", "ROLL_KIN
            "NipPart", "ContactLaw", "FrictionLaw", "CONTACT_LAWS", "WebPart", "SpanPart",
            "BodyElement", "RigidDisc", "SubTable", "TableReader", "Drawing", "DrumBody",
            "RollBody", "RiderBody", "PARTS", "NAME", "CENTRE", "MAX_COORD", "body_elements",
-           "body_types"]
+           "body_types", "Roles", "Segment", "WEB_ROLES", "NIP_ROLES"]
 
 #: The body types by the scene attribute that lists their parts (``scene.drums``), in the
 #: order the machine builds them (a body may rest on one built before it) and the scene
@@ -39,6 +50,7 @@ PARTS: dict[str, type[BodyElement]] = {
     "drums": DrumBody,
     "rolls": RollBody,
     "riders": RiderBody,
+    "idlers": IdlerBody,
 }
 
 

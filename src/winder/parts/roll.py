@@ -16,7 +16,14 @@ from winder._args import show
 from winder._schema import Channel, Key, Table
 from winder.model.locked_modes import AT_CORE, CORE_AUTO, ModeKind
 from winder.model.paper_roll import max_com_offset, paper_roll_mass
-from winder.parts._base import BodyElement, Drawing, SubTable, TableReader
+from winder.parts._base import (
+    BodyElement,
+    Drawing,
+    Roles,
+    SubTable,
+    TableReader,
+    segment_count,
+)
 from winder.parts._keys import CENTRE, NAME
 from winder.parts.flex import ROLL_FLEX_KEYS, RollFlexPart, parse_roll_flex
 
@@ -276,6 +283,14 @@ class RollBody(BodyElement):
         if getattr(part, "flex", None) is None:
             return [cls(part, placed)]
         return [RollSegment(part, i, placed) for i in range(part.flex.segments)]
+
+    @classmethod
+    def roles_of(cls, part: Any) -> Roles:
+        """A paper roll that winds its web on (``wound``) or pays it off (``unwinding``),
+        free to move where it has ``free`` axes; sliced where flexible."""
+        return Roles(web="unwinds" if part.kind == "unwinding" else "winds",
+                     nip="free" if tuple(part.free) else "fixed", paper=True,
+                     segments=segment_count(part))
 
     @classmethod
     def initial_circle(cls, part: Any) -> tuple[tuple[float, float], float]:

@@ -264,7 +264,10 @@ def reference() -> str:
               "`tension_control`. With several webs, `web_speed` and `web_force` are "
               "`WEB_web_speed` and `WEB_web_force` (`WEB` the web's name); with several "
               "spans, `span_tension` and `tension_error` are `WEB_span_tension` and "
-              "`WEB_tension_error`.", "",
+              "`WEB_tension_error`. A web line (`[[web.span]]`, several spans over idler "
+              "rollers) has `span{i}_tension` for its spans `i = 0, 1, …` from the "
+              "unwinding roll (`WEB_span{i}_tension` among several webs spanned); "
+              "`BODY_load_cell` and `BODY_traction` are an idler's.", "",
               "| channel | unit | meaning |", "|---|---|---|"]
     for decl in _declarations():
         lines.append(f"| `{decl.name}` | {decl.unit} | {_cell(decl.doc)} |")

@@ -187,9 +187,16 @@ def _web_dict(web: WebPart, *, named: bool = False) -> dict[str, Any]:
     out = _table_dict(web)
     if not named and web.name == web.entry_nip:
         del out["name"]
+    spans = out.pop("spans", [])
+    if web.mu == WebPart.mu:
+        del out["mu"]
     if web.span is not None:
         del out["tension"]
-        out["span"] = {"from": out["span"].pop("source"), **out["span"]}
+        tables = [{**({"from": s.pop("source")} if "source" in s else {}), **s}
+                  for s in spans]
+        for later in tables[1:]:  # only the first span has T_in (machines.md §11)
+            later.pop("T_in", None)
+        out["span"] = tables[0] if len(tables) == 1 else tables
     return out
 
 
