@@ -336,3 +336,66 @@ def test_dancer_refusals(case: str, change: Any, message: str, tmp_path, capsys)
     assert main(["run", str(path), "--out", str(tmp_path / "r.csv")]) == 2
     err = capsys.readouterr().err
     assert str(path) in err and "Traceback" not in err and "idler 'dancer'" in err
+
+
+def _dancer_controlled(offset: float, bandwidth: float) -> dict[str, Any]:
+    """Parent → span 0 → dancer → span 1 → entry drum at ``V``, the unwind under dancer
+    control; the carriage's load puts ``d(0)`` at ``offset`` [m] under the initial 1000 N."""
+    roller = {"name": "dancer", "radius": 0.1, "inertia": 0.5, "mass": M_R,
+              "centre": [3.0, -2.0], "wrap": math.pi, "initial_speed": V / 0.1,
+              "dancer": {"stiffness": K_D, "damping": 500.0, "mass": M_D,
+                         "load": 2 * T_SET + K_D * offset, "travel": [-0.2, 0.2]}}
+    spans = [{"from": "parent", "length": L, "EA": EA, "T_in": T_SET,
+              "initial_tension": T_SET, "to": "dancer"},
+             {"length": L, "EA": EA, "initial_tension": T_SET}]
+    data = _data(rollers=[roller], spans=spans)
+    data["roll"][1]["drive"] = {"kind": "dancer_control", "dancer": "dancer",
+                                "bandwidth": bandwidth}
+    return data
+
+
+def test_dancer_control_holds_the_dancer_at_its_centre() -> None:
+    """Started 20 mm out, the unwind brings the carriage to ``d = 0`` (integral action)
+    where it balances its load: both spans at ``F_load / 2``; the error decays at about
+    the design's ``ω_c`` (three poles at ``−ω_c`` of the double-integrator model: ``|d|
+    t⁻² ∝ exp(−ω_c t)``)."""
+    wc, d0 = 5.0, 0.02
+    r = _run(_dancer_controlled(d0, wc), 8.0)
+    d = r["dancer_position"]
+    np.testing.assert_array_equal(d, r["dancer_error"])
+    assert d[0] == d0
+    # measured 7e-12 m at 8 s
+    assert abs(d[-1]) < 1e-9 * d0
+    balance = (2 * T_SET + K_D * d0) / 2
+    for name in ("span0_tension", "span1_tension"):  # measured 4.5e-9
+        assert r[name][-1] == pytest.approx(balance, rel=5e-8)
+    k = (r.t > 2.0) & (r.t < 5.0)
+    rate = np.polyfit(r.t[k], np.log(np.abs(d[k])) - 2.0 * np.log(r.t[k]), 1)[0]
+    # measured −4.67: the model leaves out the carriage's spring and the spans' strain
+    assert rate == pytest.approx(-wc, rel=0.15)
+
+
+DRIVE_REFUSALS = [
+    ("dancer control of a fixed roller",
+     lambda d: d["idler"][0].pop("dancer") and d["idler"][0].update(wrap=1.0),
+     r"\[roll 'parent'.drive\] dancer: 'dancer' is idler 'dancer', not a dancer on its "
+     r"web; valid names: dancers \[web\] wraps: \(none\)"),
+    ("dancer control of nothing",
+     lambda d: d["roll"][1]["drive"].update(dancer="nowhere"),
+     r"\[roll 'parent'.drive\] dancer: 'nowhere' is not a part of the scene"),
+]
+
+
+@pytest.mark.parametrize("case, change, message", DRIVE_REFUSALS,
+                         ids=[c[0] for c in DRIVE_REFUSALS])
+def test_unwind_drive_refusals(case: str, change: Any, message: str, tmp_path,
+                               capsys) -> None:
+    data = _dancer_controlled(0.0, 5.0)
+    change(data)
+    with pytest.raises(winder.SceneError, match=message):
+        winder.scene_from_dict(data, source="<drive>")
+    path = tmp_path / "drive.toml"
+    path.write_text(tomli_w.dumps(data), encoding="utf-8")
+    assert main(["run", str(path), "--out", str(tmp_path / "r.csv")]) == 2
+    err = capsys.readouterr().err
+    assert str(path) in err and "Traceback" not in err and "drive] " in err

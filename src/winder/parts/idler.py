@@ -119,7 +119,7 @@ class IdlerPart:
 
 
 #: Its own channels (``BODY`` its name).
-CHANNELS = (
+ROLLER_CHANNELS = (
     Channel(name="BODY_load_cell", unit="N",
             doc="bearing force of the two span tensions over the wrap, "
                 "sqrt(T_up² + T_down² − 2 T_up T_down cos β)"),
@@ -152,7 +152,7 @@ class IdlerBody(DrumBody):
                                     heading="drive (pull rolls)"),
                   "dancer": SubTable(DANCER_KEYS, (DancerPart,), heading="dancer")}
     part_cls = IdlerPart
-    CHANNELS = CHANNELS
+    CHANNELS = ROLLER_CHANNELS
 
     @classmethod
     def parse(cls, reader: TableReader, label: str, raw: Any) -> IdlerPart:
@@ -227,8 +227,8 @@ class IdlerBody(DrumBody):
         """Its load cell and traction from the tensions its web line provides (none: 0)."""
         up, down, mu = ev.provided("roller_tensions", self.name, (0.0, 0.0, 0.3))
         load, traction = roller_channels(ev.mathns, up, down, ev.p(f"{self.name}.wrap"), mu)
-        ev.output(CHANNELS[0], self.name, load)
-        ev.output(CHANNELS[1], self.name, traction)
+        ev.output(ROLLER_CHANNELS[0], self.name, load)
+        ev.output(ROLLER_CHANNELS[1], self.name, traction)
 
     def drive_web_speed(self) -> float | None:
         return None if self.part.drive is None else super().drive_web_speed()
@@ -270,7 +270,7 @@ class DancerBody(IdlerBody):
     long; the run ends where ``d`` reaches an end of its travel (modes ``NAME.travel_lo``,
     ``NAME.travel_hi``)."""
 
-    CHANNELS = (*CHANNELS, *DANCER_CHANNELS)
+    CHANNELS = (*ROLLER_CHANNELS, *DANCER_CHANNELS)
 
     def declare(self, machine: Machine) -> None:
         super().declare(machine)

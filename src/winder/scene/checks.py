@@ -90,6 +90,7 @@ def check_references(source: str, bodies: Bodies, nips: list[NipPart],
     check_webs(source, parts)
     check_spans(source, parts)
     check_line(source, parts)
+    check_unwind_drives(source, bodies, parts)
     check_wound_fed(source, parts)
 
 
@@ -366,6 +367,27 @@ def _check_travel(source: str, parts: _Parts, web: WebPart, i: int) -> None:
                    f"carriage's balance (load − T_up − T_down) / stiffness at the initial "
                    f"tensions {t_up:g} N and {t_down:g} N; valid: lo < {d0:.6g} < hi, or "
                    "a load that balances the tensions inside the travel")
+
+
+def check_unwind_drives(source: str, bodies: Bodies, parts: _Parts) -> None:
+    """An unwind's dancer control holds a dancer its web wraps (machines.md §11)."""
+    web_of = {w.span.source: (label, w) for label, w in parts.webs if w.span is not None}
+    for cls, group in _types(bodies):
+        for p in group:
+            drive = getattr(p, "drive", None)
+            if p.name not in web_of or drive is None:
+                continue
+            label, web = web_of[p.name]
+            dlabel = f"{cls.table} {p.name!r}.drive"
+            dancer = getattr(drive, "dancer", None)
+            if dancer is not None:
+                dancers = [r for r in web.rollers if parts.roles[r].dancer is not None]
+                if dancer not in dancers:
+                    what = f"is {parts.kinds[dancer]} {dancer!r}, not a dancer on its web" \
+                        if dancer in parts.kinds else "is not a part of the scene"
+                    raise fail(source, dlabel, "dancer",
+                               f"{show(dancer)} {what}; valid names: dancers [{label}] "
+                               f"wraps: {', '.join(dancers) or '(none)'}")
 
 
 def check_wound_fed(source: str, parts: _Parts) -> None:
