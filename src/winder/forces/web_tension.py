@@ -59,7 +59,13 @@ class WebTension(ForceElement):
     doc = ("the web tension's pull on the wound roll at its entry nip (and on the unwinding "
            "roll)")
     CHANNELS = (Channel(name="span_tension", unit="N",
-                        doc="web span tension T (a state; the forces use max(T, 0))"),)
+                        doc="web span tension T (a state; the forces use max(T, 0)); "
+                            "span{i}_tension of a line's spans"),
+                Channel(name="BODY_position", unit="m",
+                        doc="a dancer's carriage position d (0 at its centre; both spans "
+                            "lengthen with d)"),
+                Channel(name="BODY_position_dot", unit="m/s",
+                        doc="a dancer's carriage speed ḋ"))
     provides = frozenset({"span_rate", "roller_tensions"})
 
     def declare(self, machine: Machine) -> None:
@@ -84,6 +90,10 @@ class WebTension(ForceElement):
                                     w.span_channel)
             if len(w.spans) > 1:
                 machine.parameter(f"{w.key}web.mu", w.part.mu)
+            for s in w.spans[1:]:
+                if s.upstream.roles.dancer is not None:
+                    for ch in self.CHANNELS[1:]:
+                        machine.channel(ch, s.upstream.name)
 
     def apply(self, ev: Evaluation) -> None:
         for w in ev.machine.webs:
@@ -149,6 +159,8 @@ class WebTension(ForceElement):
                 if roller.roles.dancer is not None:  # m_d d̈ = F − k d − c ḋ − (T_up + T_down)
                     n = roller.name
                     d, d_dot = ev.x(f"{n}.position"), ev.x(f"{n}.position_dot")
+                    ev.output(WebTension.CHANNELS[1], n, d)
+                    ev.output(WebTension.CHANNELS[2], n, d_dot)
                     ev.set_rate(f"{n}.position_dot",
                                 (ev.p(f"{n}.dancer_load") - ev.p(f"{n}.dancer_stiffness") * d
                                  - ev.p(f"{n}.dancer_damping") * d_dot - (t_up + t_down))

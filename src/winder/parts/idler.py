@@ -254,23 +254,13 @@ def _parse_dancer(reader: TableReader, label: str, raw: Any, wrap: float | None
     return DancerPart(**kw)
 
 
-#: A dancer's own channels (``BODY`` its name).
-DANCER_CHANNELS = (
-    Channel(name="BODY_position", unit="m",
-            doc="a dancer's carriage position d (0 at its centre; both spans lengthen "
-                "with d)"),
-    Channel(name="BODY_position_dot", unit="m/s", doc="a dancer's carriage speed ḋ"),
-)
-
-
 class DancerBody(IdlerBody):
     """An idler on a dancer's carriage (machines.md §11): states ``NAME.position`` [m]
     and ``NAME.position_dot`` [m/s] (their rates: its own and the web line's,
     ``m_d d̈ = F_load − k d − c ḋ − (T_up + T_down)``), both adjacent spans ``length + d``
     long; the run ends where ``d`` reaches an end of its travel (modes ``NAME.travel_lo``,
-    ``NAME.travel_hi``)."""
-
-    CHANNELS = (*ROLLER_CHANNELS, *DANCER_CHANNELS)
+    ``NAME.travel_hi``). Its channels ``NAME_position``, ``NAME_position_dot`` are the web
+    line's (``web_tension``), which moves the carriage."""
 
     def declare(self, machine: Machine) -> None:
         super().declare(machine)
@@ -305,8 +295,3 @@ class DancerBody(IdlerBody):
         ev.set_rate(f"{n}.position", ev.x(f"{n}.position_dot"))
         ev.switches[f"{n}.beyond_lo"] = ev.p(f"{n}.travel_lo") - d
         ev.switches[f"{n}.beyond_hi"] = d - ev.p(f"{n}.travel_hi")
-
-    def outputs(self, ev: Evaluation, bs: BodyState) -> None:
-        super().outputs(ev, bs)
-        ev.output(DANCER_CHANNELS[0], self.name, ev.x(f"{self.name}.position"))
-        ev.output(DANCER_CHANNELS[1], self.name, ev.x(f"{self.name}.position_dot"))

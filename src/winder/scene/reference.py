@@ -281,6 +281,7 @@ def channel_declarations(name: str, parts: dict[str, str], webs: Iterable[str] =
     after the name of one of ``webs`` (``WEB_web_speed``); ``parts`` maps every part name
     to its kind (``drum``, ``roll``, ``rider``, ``nip``)."""
     out = []
+    name = re.sub(r"(^|_)span\d+_tension$", r"\1span_tension", name)  # a line's spans
     for decl in _declarations():
         if decl.placeholder:
             owners = [p for p, k in parts.items() if k in _placeholder_kinds(decl.placeholder)]
