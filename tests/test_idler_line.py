@@ -434,3 +434,18 @@ def test_dancer_at_speed_follows_the_linearised_transport_equation() -> None:
     carriage = max(np.linalg.eigvals(A), key=lambda s: abs(s.imag))
     assert abs(carriage.imag) / (2 * math.pi) == pytest.approx(31.08, abs=0.01)
     assert -carriage.real / abs(carriage) == pytest.approx(4.2e-3, rel=0.01)
+
+
+def test_sweeps_reach_the_line_keys() -> None:
+    """``Scene.replace`` (the sweeps' path) reaches an idler's keys, its dancer's, the
+    web's ``mu`` and a line's span by its index (spans have no names)."""
+    s = winder.scene_from_dict(_dancer_line(), source="<dancer>")
+    t = s.replace(idler={"dancer": {"bearing_viscous": 0.1, "dancer": {"stiffness": 3e4}}},
+                  web={"mu": 0.5, "span": {"1": {"length": 2.0}, 2: {"EA": 2e6}}})
+    assert t.idlers[1].bearing_viscous == 0.1 and t.idlers[1].dancer.stiffness == 3e4
+    assert t.web.mu == 0.5
+    assert [sp.length for sp in t.web.spans] == [L, 2.0, L]
+    assert [sp.EA for sp in t.web.spans] == [EA, EA, 2e6]
+    with pytest.raises(winder.ArgumentError, match=r"no element named '3'; valid names: "
+                                                   r"0, 1, 2"):
+        s.replace(web={"span": {"3": {"EA": 1.0}}})

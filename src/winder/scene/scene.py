@@ -229,9 +229,10 @@ def _merge(node: Any, values: Any, table: str, path: tuple[str, ...]) -> None:
         raise ArgumentTypeError(
             f"Scene.replace: {where} must be a mapping of {what} to values, e.g. "
             f"{table}={example}; got {show(values)} ({type(values).__name__})")
-    if isinstance(node, list):
-        names = [str(e.get("name")) for e in node]
+    if isinstance(node, list):  # unnamed elements (a line's spans) by their index
+        names = [str(e.get("name", i)) for i, e in enumerate(node)]
         for name, sub in values.items():
+            name = str(name)
             if name not in names:
                 raise ArgumentError(f"Scene.replace: {where} has no element named "
                                     f"{show(name)}; valid names: {', '.join(names)}")
