@@ -449,3 +449,21 @@ def test_sweeps_reach_the_line_keys() -> None:
     with pytest.raises(winder.ArgumentError, match=r"no element named '3'; valid names: "
                                                    r"0, 1, 2"):
         s.replace(web={"span": {"3": {"EA": 1.0}}})
+
+
+def test_fmu_interface_of_a_line() -> None:
+    """The FMU of a line (its interface, nothing compiled): a pull roll's torque is an
+    input (beside the unwind's tension set-point); every span's tension, every roller's load cell and the dancer's position are
+    outputs, in the machine's units."""
+    from winder.fmu.interface import native_interface
+
+    data = _dancer_line()
+    data["idler"][0]["drive"] = {"kind": "torque", "torque": 0.0, "web_speed": 0.0}
+    ni = native_interface(winder.scene_from_dict(data, source="<dancer>"))
+    assert [v.name for v in ni.inputs] == ["pull_torque", "parent_tension_setpoint"]
+    units = {v.name: v.unit for v in ni.outputs}
+    for name, unit in (("span0_tension", "N"), ("span1_tension", "N"),
+                       ("span2_tension", "N"), ("pull_load_cell", "N"),
+                       ("dancer_load_cell", "N"), ("dancer_position", "m"),
+                       ("dancer_position_dot", "m/s"), ("dancer_traction", None)):
+        assert name in units and (unit is None or units[name] == unit), name
