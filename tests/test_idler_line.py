@@ -15,6 +15,7 @@ pull roll's drive holds ``−R (T_1 − T_0)``; every §11 refusal through the A
 
 from __future__ import annotations
 
+import copy
 import math
 from typing import Any
 
@@ -175,7 +176,22 @@ def _two(to: str = "idler") -> list[dict[str, Any]]:
     return _spans(to)
 
 
+def _second_web(d: dict[str, Any]) -> None:
+    """A second station (drum, wound roll, nip, parent) whose web also ends a span at the
+    idler."""
+    d["drum"].append({**d["drum"][0], "name": "entry2", "centre": [20.0, 0.0]})
+    d["roll"].append({**d["roll"][0], "name": "set2", "centre": [20.0, 0.6]})
+    d["roll"].append({**d["roll"][1], "name": "parent2", "centre": [26.0, 0.0]})
+    d["nip"].append({**d["nip"][0], "name": "entry2_nip", "a": "entry2", "b": "set2"})
+    second = {"entry_nip": "entry2_nip", "span": copy.deepcopy(d["web"]["span"])}
+    second["span"][0]["from"] = "parent2"
+    d["web"] = [d["web"], second]
+
+
 REFUSALS = [
+    ("a roller in two webs", _second_web,
+     r"\[web #2.span #1\] to: 'idler': \[web #1.span #1\] already ends at it: a roller "
+     r"carries one web, once"),
     ("to on the last span",
      lambda d: d["web"]["span"][1].update(to="idler"),
      r"\[web.span #2\] to: 'idler': the last span ends at the entry nip's drum"),
@@ -453,8 +469,8 @@ def test_sweeps_reach_the_line_keys() -> None:
 
 def test_fmu_interface_of_a_line() -> None:
     """The FMU of a line (its interface, nothing compiled): a pull roll's torque is an
-    input (beside the unwind's tension set-point); every span's tension, every roller's load cell and the dancer's position are
-    outputs, in the machine's units."""
+    input (beside the unwind's tension set-point); every span's tension, every roller's
+    load cell and the dancer's position are outputs, in the machine's units."""
     from winder.fmu.interface import native_interface
 
     data = _dancer_line()
