@@ -15,16 +15,15 @@ from collections.abc import Iterable
 from types import SimpleNamespace as NS
 from typing import Any
 
-from winder.forces import force_elements
+from winder.forces import FORCES, force_elements
 from winder.parts import body_elements
 
 __all__ = ["EFFECTS", "effects", "contact", "friction", "speed_profile", "torque_drive",
            "drum", "wound_roll", "rider", "nip", "machine_scene", "override", "two_drum",
            "single_drum", "free_roll"]
 
-#: The ``[effects]`` keys, in the order of the scene schema.
-EFFECTS = ("variable_mass", "web_momentum", "web_tension", "gravity", "imbalance",
-           "contact", "slip_relaxation", "rider_load")
+#: The ``[effects]`` keys, in the order of the scene schema: the registry's.
+EFFECTS = tuple(FORCES)
 
 
 def effects(**flags: bool) -> NS:

@@ -289,7 +289,9 @@ def exit_points(machine: Machine, bodies: dict[str, BodyMotion], web: Web | None
 
     if web is None:
         web = next(w for w in machine.webs if w.unwind is not None)
-    u, a = web.unwind, web.entry.a
+    u = web.unwind
+    first = web.spans[0].downstream if web.spans else None  # a line's first roller
+    a = first if first is not None else web.entry.a
     ev = SimpleNamespace(machine=machine, mathns=np, bodies={
         u.name: kin(bodies[u.name], u), a.name: kin(bodies[a.name], a)})
     _, _, ox, oz = exit_point(ev, web)

@@ -28,6 +28,7 @@ import winder
 from winder.analysis.sweep_grid import build_grid
 from winder.cli import main
 from winder.scene.load import scene_from_dict
+from winder.scene.schema import ARRAYS
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 V = 5.0  # [m/s] the web speed of every station, from t = 0
@@ -48,7 +49,7 @@ def _station(data: dict[str, Any], suffix: str, dx: float, web: str | None = Non
     along x; its web named ``web``; drums at the web speed ``V`` from t = 0 and every roll
     turning with them (so that no core event splits a step of the fixed-step run)."""
     d = copy.deepcopy(data)
-    for array in ("drum", "roll", "rider", "nip"):
+    for array in ARRAYS:
         for p in d.get(array, []):
             p["name"] += suffix
             if "centre" in p:
@@ -74,7 +75,7 @@ def _station(data: dict[str, Any], suffix: str, dx: float, web: str | None = Non
 def _together(*stations: dict[str, Any]) -> dict[str, Any]:
     """One scene of the stations' parts, one ``[[web]]`` per station."""
     out = copy.deepcopy(stations[0])
-    for array in ("drum", "roll", "rider", "nip"):
+    for array in ARRAYS:
         out[array] = [p for s in stations for p in copy.deepcopy(s.get(array, []))]
     out["web"] = [copy.deepcopy(s["web"]) for s in stations]
     out["scene"]["name"] = "stations"
@@ -234,7 +235,7 @@ BAD = [
     ("bad web name", lambda d: _webs(d, {"entry_nip": "far_nip", "name": "a web"}),
      r"\[web #2\] name: 'a web' is not a part name"),
     ("unknown web key", lambda d: _webs(d, {"entry_nip": "far_nip", "speed": 3.0}),
-     r"\[web #2\] speed: unknown key; valid keys: name, entry_nip, tension, span"),
+     r"\[web #2\] speed: unknown key; valid keys: name, entry_nip, tension, span, mu"),
     ("web tension negative", lambda d: _webs(d, {"entry_nip": "far_nip", "tension": -1.0}),
      r"\[web #2\] tension: must be >= 0"),
     ("web not a table", lambda d: _webs(d, 5),

@@ -179,8 +179,10 @@ def test_new_body_type_rejects_bad_keys(discs: None) -> None:
 def test_new_body_type_is_documented(discs: None) -> None:
     """The reference lists ``[[disc]]`` with its keys, after the built-in bodies."""
     text = reference()
-    assert "`[[drum]]`, `[[roll]]`, `[[rider]]`, `[[disc]]`, `[[nip]]`" in text
-    assert "`BODY` is the name of any drum, roll, rider or disc" in text
+    tables = [cls.table for cls in PARTS.values()]
+    assert tables[-1] == "disc"
+    assert ", ".join(f"`[[{t}]]`" for t in (*tables, "nip")) in text
+    assert f"`BODY` is the name of any {', '.join(tables[:-1])} or disc" in text
     section = text[text.index("### `[[disc]]`"):text.index("### `[[nip]]`")]
     assert "| `torque` | number | N·m | \\|x\\| ≤ 1e8 | 0 | the drive torque" in section
     assert "| `radius` | number | m | (0, 10] | required | disc radius |" in section

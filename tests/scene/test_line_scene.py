@@ -272,8 +272,11 @@ BAD = [
      r"\[web.span\] initial_tension: must be >= 0 and <= 1e\+07, got -5.0"),
     ("span initial nan", lambda d: d["web"]["span"].update(initial_tension=math.nan),
      r"\[web.span\] initial_tension: must be finite, got nan"),
-    ("span unknown key", lambda d: d["web"]["span"].update(to="set"),
-     r"\[web.span\] to: unknown key; valid keys: from, length, EA, T_in, initial_tension"),
+    ("span unknown key", lambda d: d["web"]["span"].update(width=5.0),
+     r"\[web.span\] width: unknown key; valid keys: from, to, length, EA, T_in, "
+     r"initial_tension"),
+    ("span to on the only span", lambda d: d["web"]["span"].update(to="set"),
+     r"\[web.span\] to: 'set': the last span ends at the entry nip's drum"),
     ("span not a table", lambda d: d["web"].update(span=3.0),
      r"\[web.span\] must be a table of keys, got 3.0"),
     ("span from a number", lambda d: d["web"]["span"].update({"from": 1}),

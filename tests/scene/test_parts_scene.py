@@ -17,6 +17,7 @@ import tomli_w
 import winder
 from winder.analysis.sweep_grid import build_grid
 from winder.parts import (
+    PARTS,
     ContactLaw,
     DrumPart,
     FrictionLaw,
@@ -250,7 +251,7 @@ BAD = [
      r"\[web #2\] entry_nip: 'rear_nip' enters wound roll 'set', which \[web #1\] already "
      r"feeds: two webs into one roll; every wound roll is fed by exactly one web; valid "
      r"names: nips into the other wound rolls: \(none\)"),
-    ("no body", lambda d: [d.pop(k) for k in ("drum", "roll", "rider", "web")] and
+    ("no body", lambda d: [d.pop(c.table, None) for c in PARTS.values()] and d.pop("web") and
      d.update(nip=[]), r"a scene of parts needs at least one body"),
     # keys and values
     ("unknown drum key", lambda d: d["drum"][0].update(colour="red"),
@@ -300,8 +301,8 @@ BAD = [
      r"\[nip\] must be an array of tables \(\[\[nip\]\]"),
     ("mixed formats", lambda d: d.update(contact={"stiffness": 1e7}),
      r"\[contact\]: a table of the single-drum format in a scene of parts; each \[\[nip\]\] "
-     r"has its own contact and friction; valid tables: scene, effects, paper, drum, roll, "
-     r"rider, nip, web, solver"),
+     r"has its own contact and friction; valid tables: scene, effects, paper, "
+     + ", ".join(c.table for c in PARTS.values()) + ", nip, web, solver"),
     ("single drum table", lambda d: d.update(drum=d["drum"][0]),
      r"\[rider\]: a table of scenes of parts in a scene of the single-drum format"),
     ("unknown table", lambda d: d.update(span={}), r"\[span\]: unknown table; valid tables: "),

@@ -11,6 +11,7 @@ import pytest
 
 import winder
 from winder._schema import format_number as _num
+from winder.parts import PARTS
 from winder.scene.keys import ALL_TABLES
 from winder.scene.legacy import COLUMNS
 from winder.scene.reference import (
@@ -180,8 +181,8 @@ def test_every_channel_of_a_shipped_scene_is_declared_once_with_its_unit(model):
     scene = winder.load_scene(ROOT / "models" / f"{model}.toml")
     system = MachineSystem(scene, backend="pinocchio")
     units = system.channel_units
-    parts = {p.name: k for k, group in (("drum", scene.drums), ("roll", scene.rolls),
-                                        ("rider", scene.riders), ("nip", scene.nips))
+    parts = {p.name: k for k, group in (*((c.table, scene.bodies[a]) for a, c in PARTS.items()),
+                                        ("nip", scene.nips))
              for p in group}
     # a flexible body's segments NAME_s{i} are bodies of its kind, its nips' slices nips
     parts |= {b.name: b.table for b in system.machine.bodies if b.segment_of}

@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import re
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +18,7 @@ from winder._schema import NO_DEFAULT, Key, Table
 from winder.cli import main
 from winder.fmu.parameters import FMU_PARAMETERS, fmu_parameters, parameter_units
 from winder.forces import FORCES
-from winder.parts import drum, flex, nip, rider, roll, web
+from winder.parts import PARTS, flex, nip, roll, web
 from winder.scene import key_doc, key_unit
 from winder.scene.keys import ALL_TABLES, find_key
 from winder.scene.legacy import LEGACY_TABLES
@@ -27,9 +28,11 @@ from winder.scene.schema import PAPER_KEYS, TABLES, effect_settings
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "models"
 #: The parts' own declarations, by module.
-PART_TABLES = {drum: (drum.KEYS, drum.DRIVE_KEYS), flex: (flex.FLEX_KEYS, flex.ROLL_FLEX_KEYS),
-               roll: (roll.KEYS, roll.DRIVE_KEYS),
-               rider: (rider.KEYS,), nip: (nip.KEYS, nip.CONTACT_KEYS, nip.FRICTION_KEYS),
+PART_TABLES = {**{sys.modules[cls.__module__]: (cls.KEYS, *(st.keys for st in
+                                                            cls.SUB_TABLES.values()))
+                  for cls in PARTS.values()},  # every registered body type's tables
+               flex: (flex.FLEX_KEYS, flex.ROLL_FLEX_KEYS),
+               nip: (nip.KEYS, nip.CONTACT_KEYS, nip.FRICTION_KEYS),
                web: (web.KEYS, web.SPAN_KEYS)}
 #: A range written out: (0, 10], [0, 1e5], (0, ∞) ...; or a magnitude bound <= 1e8.
 RANGE = re.compile(r"[\[(]-?[\d.]+(e-?\d+)?, ?(-?[\d.]+(e-?\d+)?|∞)[\])]|<= ?1e\d|<= ?\d{3,}")

@@ -258,7 +258,7 @@ def test_exhausted_parent(request, short_parent) -> None:
 
 #: Shipped scenes added after the numba kernels were deleted: no numba trace exists to
 #: compare with (their runs are checked by tests/test_shipped_references.py).
-NO_NUMBA_TRACE = {"two_drum_winder_flexible"}
+NO_NUMBA_TRACE = {"two_drum_winder_flexible", "winder_line_dancer"}
 
 
 @pytest.mark.parametrize("name", sorted(p.stem for p in MODELS.glob("*.toml")

@@ -29,6 +29,7 @@ import math
 import os
 import sys
 import traceback
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
@@ -131,14 +132,16 @@ def _cmd_run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)  # a bad scene stops here, before the solver is imported
     from winder._errors import BudgetExceeded
     from winder.solve.equilibrium import EquilibriumError
-    from winder.solve.simulate import simulate
+    from winder.solve.simulate import WebSlipWarning, simulate
 
     progress = sys.stderr.isatty() if args.progress is None else args.progress
     try:
-        result = simulate(scene, t_end=args.t_end, method=args.method, rtol=args.rtol,
-                          atol=args.atol, max_step=args.max_step, progress=progress,
-                          backend=args.backend,
-                          max_rhs=args.max_evals, max_wall=args.max_wall)
+        with warnings.catch_warnings():  # printed with the run's summary (meta slips)
+            warnings.simplefilter("ignore", WebSlipWarning)
+            result = simulate(scene, t_end=args.t_end, method=args.method, rtol=args.rtol,
+                              atol=args.atol, max_step=args.max_step, progress=progress,
+                              backend=args.backend,
+                              max_rhs=args.max_evals, max_wall=args.max_wall)
     except EquilibriumError as exc:  # machines.md §7: no initial balance, a scene error
         raise WinderError(f"{args.scene}: {exc}") from None
     except BudgetExceeded as exc:
@@ -174,6 +177,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         print("  " + _balance_text(m["static_residual"], m["static_scale"]))
     if m.get("ended"):
         print(f"  {m['ended']}")
+    for text in m.get("slips") or ():
+        print(f"  warning: {text}")
     for p in figures:
         print(f"  figure {p}")
     return 0

@@ -13,7 +13,8 @@ set, under which names and units, and the scene with the host's values applied.
   ``NIP_contact_stiffness``, ``NIP_contact_damping``, ``NIP_mu``,
   ``NIP_slip_reference_velocity``, ``NIP_relaxation_length``, and ``web_tension``.
   A winder line (``[web.span]``, machines.md §5) has ``span_length``, ``span_EA`` and
-  ``span_T_in`` instead of ``web_tension`` (the tension is the span's state).
+  ``span_T_in`` instead of ``web_tension`` (the tension is the span's state); a web line
+  of several spans (``[[web.span]]``, §11) has none of these yet.
 
 Descriptions and units are the scene keys' declarations: a key newly declared with
 ``fmu=...`` is a parameter at once.
@@ -25,6 +26,7 @@ from typing import Any
 
 from winder._errors import WinderError
 from winder._schema import Key
+from winder.parts import PARTS
 from winder.scene import naming_of
 from winder.scene.keys import find_key
 from winder.scene.load import Scene
@@ -59,8 +61,12 @@ ParameterPath = tuple[str, "str | None", tuple[str, ...]]
 
 def _elements(scene: Scene, table: str) -> Any:
     """The parts of the scene's array of tables ``table`` (:data:`~winder.scene.schema.ARRAYS`:
-    the scene's field ``TABLEs``)."""
-    return getattr(scene, f"{table}s")
+    a body type's, listed in ``scene.bodies`` under its :data:`~winder.parts.PARTS`
+    attribute, or ``nip``)."""
+    if table == "nip":
+        return scene.nips
+    attr = next(a for a, cls in PARTS.items() if cls.table == table)
+    return scene.bodies.get(attr, ())
 
 
 def _flagged(schema: str, obj: Any) -> list[tuple[tuple[str, ...], Key, str]]:
@@ -109,7 +115,7 @@ def _parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str, str]]:
                 out[f"{part.name}_{k.fmu}"] = ((table, part.name, path),
                                                f"{table} {part.name}: {k.doc} [{unit}]", unit)
     web = scene.web
-    if web is not None:
+    if web is not None and len(web.spans) <= 1:  # a web line's spans: not yet parameters
         sub = ("span",) if web.span is not None else ()
         for path, k, unit in _flagged(".".join(("web", *sub)),
                                       web.span if sub else web):

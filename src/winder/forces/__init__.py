@@ -4,7 +4,9 @@ from collections.abc import Iterable
 from typing import Any
 
 from winder.forces._base import ForceElement
+from winder.forces.bearing_friction import BearingFriction
 from winder.forces.contact import Contact
+from winder.forces.dancer_control import DancerController
 from winder.forces.flex_beam import FlexBeam
 from winder.forces.gravity import Gravity
 from winder.forces.imbalance import Imbalance
@@ -27,7 +29,9 @@ FORCES: dict[str, type[ForceElement]] = {
 #: Force elements a part calls for (not ``[effects]`` keys; a body lists them in its
 #: ``drives``): its drive's (by drive kind), a flexible body's beam (``flex_beam``).
 DRIVES: dict[str, type[ForceElement]] = {"tension_control": TensionController,
-                                         "flex_beam": FlexBeam}
+                                         "flex_beam": FlexBeam,
+                                         "bearing_friction": BearingFriction,
+                                         "dancer_control": DancerController}
 
 #: The order in which the built-in effects' force elements run where their declarations
 #: (``provides``/``requires``/``uses``) leave it open: the order their forces are summed,

@@ -109,13 +109,14 @@ class FlexBeam(ForceElement):
 
         self.groups = {}
         for b in machine.bodies:
-            if self.name in b.drives:
-                self.groups.setdefault(b.segment_of, []).append(b)
+            seg = b.segment
+            if self.name in b.drives and seg is not None:
+                self.groups.setdefault(seg.segment_of, []).append(seg)
         for body, segs in self.groups.items():
             segs.sort(key=lambda s: s.index)
             first = segs[0]
             flex, part, n = first.flex, first.part, len(segs)
-            if hasattr(flex, "core_EI"):  # a paper roll: EI(r), no bearings or chucks
+            if first.roles.paper:  # a paper roll: EI(r), no bearings or chucks
                 unit = beam_matrices(n, first.length, float(n), 1.0, None, 0.0, 0.0, 0.0,
                                      flex.GJ)
                 K1, mu1 = unit.K, unit.omega1 ** 2
@@ -240,7 +241,7 @@ class FlexBeam(ForceElement):
             def entry(kind: str, i: int, j: int, body: str = body) -> Any:
                 return ev.p(f"{body}.flex.{kind}_{min(i, j)}_{max(i, j)}")
 
-            if hasattr(segs[0].flex, "core_EI"):
+            if segs[0].roles.paper:
                 kt, ct = self._roll_bending(ev, body, segs, states, ux, uz)
             else:
                 for i, seg in enumerate(segs):

@@ -48,7 +48,8 @@ class RiderLoad(ForceElement):
                 machine.parameter(f"{b.name}.load_radius_{i}", r)
                 machine.parameter(f"{b.name}.line_load_{i}", q * scale)
             machine.channel(self.CHANNELS[0], b.name)
-            self.ridden[b.name] = groups[b.rides][0].name if b.rides in groups else b.rides
+            ridden = b.roles.rides
+            self.ridden[b.name] = groups[ridden][0].name if ridden in groups else ridden
 
     def apply(self, ev: Evaluation) -> None:
         for b in _riders(ev.machine):
@@ -56,13 +57,15 @@ class RiderLoad(ForceElement):
             pts = [(ev.p(f"{n}.load_radius_{i}"), ev.p(f"{n}.line_load_{i}"))
                    for i in range(len(b.load))]
             roll = ev.bodies[self.ridden[n]]
-            f = ev.p(f"{b.rides}.width") * line_load(ev.mathns, roll.r, pts) if pts else 0.0
-            if b.segment_of is not None:  # a flexible rider's segment: its share
-                f = f / b.segments
+            f = ev.p(f"{b.roles.rides}.width") * line_load(ev.mathns, roll.r, pts) \
+                if pts else 0.0
+            seg = b.segment
+            if seg is not None:  # a flexible rider's segment: its share
+                f = f / seg.segments
             ev.add_force(n, 0.0, -f)
             ev.set_channel(f"{n}_load", f)
 
 
 def _riders(machine: Machine) -> list[Any]:
     """The bodies that ride another under a line-load schedule (``rides``, ``load``)."""
-    return [b for b in machine.bodies if getattr(b, "rides", None) is not None]
+    return [b for b in machine.bodies if b.roles.rides is not None]

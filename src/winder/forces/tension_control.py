@@ -17,7 +17,9 @@ gains
 
 put the three closed-loop poles at ``−ω_c``, for any radius (``ω_c`` is the scene's
 ``bandwidth`` [rad/s]). The model has no bearing friction, so its feed-forward is zero.
-Channels: ``tension_error`` [N] (``e``) and the roll's ``NAME_torque`` [N·m].
+Channels: ``tension_error`` [N] (``e``) and the roll's ``NAME_torque`` [N·m]. On a web
+line (machines.md §11) it holds the first span (the load cell's between the unwind and
+its first roller), its feed-forward from the speed of the body the unwind feeds.
 """
 
 from __future__ import annotations
@@ -60,22 +62,24 @@ class TensionController(ForceElement):
 
     @staticmethod
     def _control(ev: Evaluation, w: Web) -> None:
-        b, k = w.unwind, w.span_key
-        n = b.name
-        u, a = ev.bodies[n], ev.bodies[w.entry.a.name]
-        T = ev.x(f"{k}span.tension")
+        b, first = w.unwind, w.spans[0]  # it holds the first span (machines.md §11)
+        k, n = first.key, b.name
+        u = ev.bodies[n]
+        a = ev.bodies[(first.downstream or w.entry.a).name]  # the speed the unwind feeds
+        T = ev.x(f"{k}tension")
         T_set = ev.p(f"{n}.tension_setpoint")
         wc = ev.p(f"{n}.bandwidth")
         e = T_set - T
         ev.set_rate(f"{n}.tension_integral", e)
         r, J = u.r, u.inertia
-        g = ev.p(f"{k}span.EA") * r / (ev.p(f"{k}span.length") * J)
+        g = ev.p(f"{k}EA") * r / (ev.p(f"{k}length") * J)
         kd, kp, ki = 3.0 * wc / g, 3.0 * wc * wc / g - r, wc ** 3 / g
         v2 = a.omega * a.r * a.body.sense
         a_dot = a.alpha_prescribed if a.alpha_prescribed is not None else 0.0
         v2_dot = a_dot * a.r * a.body.sense
         w_ref_dot = (v2_dot * r - v2 * u.r_dot) / (r * r)
         tau = (J * w_ref_dot - r * T_set - kp * e
-               - ki * ev.x(f"{n}.tension_integral") + kd * ev.provided("span_rate", w.name))
+               - ki * ev.x(f"{n}.tension_integral")
+               + kd * ev.provided("span_rate", w.name))
         ev.provide("drive_torque", n, tau)
         ev.set_channel(f"{w.span_channel}tension_error", e)

@@ -41,6 +41,7 @@ from winder.model.channels import BODY_CHANNELS, COORD_CHANNELS, NIP_CHANNELS, W
 from winder.model.element_order import order_elements
 from winder.model.locked_modes import FREE, ModeKind, ModeSlot
 from winder.model.slices import assemble_nips, entry_slice, entry_slices
+from winder.model.spans import Span, line_spans
 from winder.model.whole_body import declare_wholes, write_wholes
 
 __all__ = ["Machine", "Nip", "Web", "Evaluation", "BodyState", "NipState"]
@@ -85,10 +86,17 @@ class Web:
     span_channel: str = ""
     #: the nips its forces act at: ``[entry]``, or every slice into a flexible roll
     entries: list[Nip] = field(default_factory=list)
+    #: its spans in order from the unwinding roll (:class:`Span`; none without a span)
+    spans: list[Span] = field(default_factory=list)
+    #: the bodies by name, for the rollers its spans end at (given by the machine)
+    rollers: dict[str, Any] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         if not self.entries:
             self.entries = [self.entry]
+        if not self.spans and self.span is not None:
+            self.spans = line_spans(self.part, self.unwind, self.rollers, self.span_key,
+                                    self.span_channel)
 
 
 class Machine:
@@ -161,7 +169,7 @@ class Machine:
                                  self.body[span.source] if span is not None else None,
                                  f"{name}." if several else "", f"{name}_" if several else "",
                                  f"{name}." if spanned else "", f"{name}_" if spanned else "",
-                                 entry_slices(self.nips, w.entry_nip)))
+                                 entry_slices(self.nips, w.entry_nip), rollers=self.body))
         first = self.webs[0] if self.webs else None
         self.web = first.part if first is not None else None
         self.entry = first.entry if first is not None else None
@@ -415,6 +423,12 @@ class Evaluation:
         bs.fx = bs.fx + fx
         bs.fz = bs.fz + fz
         bs.ty = bs.ty + (pz * fx - px * fz)
+
+    def add_torque(self, body: str, ty: Any) -> None:
+        """Torque ``ty`` [N·m] about ``+y`` on ``body`` (a force couple: part of its
+        ``NAME_torque`` channel, as :meth:`add_force`'s moments are)."""
+        bs = self.bodies[body]
+        bs.ty = bs.ty + ty
 
     def add_spatial_force(self, body: str, f: list[Any]) -> None:
         """Add to the ``"spatial_force"`` of ``body``: ``[f; τ]`` in its joint frame (e.g.

@@ -16,15 +16,19 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from winder.model.roles import Segment
+
 __all__ = ["segments_of", "assemble_nips", "entry_slice", "entry_slices"]
 
 
-def segments_of(bodies: Sequence[Any]) -> dict[str, list[Any]]:
-    """The segment elements of each flexible body, by the body's name, drive end first."""
-    groups: dict[str, list[Any]] = {}
+def segments_of(bodies: Sequence[Any]) -> dict[str, list[Segment]]:
+    """The segment elements of each flexible body (their
+    :attr:`~winder.parts.BodyElement.segment`), by the body's name, drive end first."""
+    groups: dict[str, list[Segment]] = {}
     for b in bodies:
-        if getattr(b, "segment_of", None):
-            groups.setdefault(b.segment_of, []).append(b)
+        seg = b.segment
+        if seg is not None:
+            groups.setdefault(seg.segment_of, []).append(seg)
     for segs in groups.values():
         segs.sort(key=lambda s: s.index)
     return groups

@@ -10,9 +10,20 @@ from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
 
-from winder.parts._base import BodyElement, Drawing, RigidDisc, SubTable, TableReader
+from winder.parts._base import (
+    NIP_ROLES,
+    WEB_ROLES,
+    BodyElement,
+    Drawing,
+    RigidDisc,
+    Roles,
+    Segment,
+    SubTable,
+    TableReader,
+)
 from winder.parts._keys import CENTRE, MAX_COORD, NAME
 from winder.parts.drum import DrumBody, DrumPart, SpeedProfileDrive, TorqueDrive
+from winder.parts.idler import IdlerBody
 from winder.parts.nip import CONTACT_LAWS, ContactLaw, FrictionLaw, NipPart
 from winder.parts.rider import RiderBody, RiderPart
 from winder.parts.roll import (
@@ -31,7 +42,7 @@ __all__ = ["DrumPart", "SpeedProfileDrive", "TorqueDrive", "RollPart", "ROLL_KIN
            "NipPart", "ContactLaw", "FrictionLaw", "CONTACT_LAWS", "WebPart", "SpanPart",
            "BodyElement", "RigidDisc", "SubTable", "TableReader", "Drawing", "DrumBody",
            "RollBody", "RiderBody", "PARTS", "NAME", "CENTRE", "MAX_COORD", "body_elements",
-           "body_types", "whole_elements"]
+           "body_types", "whole_elements", "Roles", "Segment", "WEB_ROLES", "NIP_ROLES"]
 
 #: The body types by the scene attribute that lists their parts (``scene.drums``), in the
 #: order the machine builds them (a body may rest on one built before it) and the scene
@@ -40,6 +51,7 @@ PARTS: dict[str, type[BodyElement]] = {
     "drums": DrumBody,
     "rolls": RollBody,
     "riders": RiderBody,
+    "idlers": IdlerBody,
 }
 
 

@@ -20,12 +20,19 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 from winder._schema import Channel, Table
+from winder.model.roles import NIP_ROLES, WEB_ROLES, Roles, Segment
 
 if TYPE_CHECKING:
     from winder.model.machine import BodyState, Evaluation, Machine
 
-__all__ = ["BodyElement", "RigidDisc", "SubTable", "TableReader", "Drawing"]
+__all__ = ["BodyElement", "RigidDisc", "SubTable", "TableReader", "Drawing", "Roles", "Segment",
+           "WEB_ROLES", "NIP_ROLES", "segment_count"]
 
+
+def segment_count(part: Any) -> int | None:
+    """The number of segments of a part with a ``flex`` sub-table (None: rigid)."""
+    flex = getattr(part, "flex", None)
+    return None if flex is None else int(flex.segments)
 
 @dataclass(frozen=True)
 class SubTable:
@@ -90,11 +97,11 @@ class BodyElement(ABC):
     [m], ...) and the dynamics (Pinocchio's ABA). The element says everything else.
 
     To add a body type: the machine, the solvers, the generated code, the static balance,
-    the scene (its tables, parsing, checks, ``to_dict``), the generated reference and the
-    viewer's scene graph read it from here. Not yet generic: the figures draw a body by
-    :attr:`role` (``drum``: a driven body, else a turning one), and the FMU's tunable
-    parameters are listed per table in :mod:`winder.fmu.parameters` (a new type has its
-    co-simulation inputs, :attr:`torque_inputs`, but no tunable parameters there).
+    the scene (its tables, parsing, checks, ``to_dict``), the generated reference, the FMU's
+    parameters and the viewer's scene graph read it from here. The scene's checks and the
+    effects ask its declared roles (:meth:`roles_of`, :class:`~winder.model.roles.Roles`:
+    how it carries a web, bears on a nip, whether it is a paper roll or a flexible body of
+    segments), never its table's name; the figures draw a body by :attr:`role`.
 
     1. Subclass :class:`BodyElement` (or :class:`RigidDisc` for a body of constant radius,
        mass and inertia) in the part's module under ``winder/parts/``; set the class
@@ -143,9 +150,10 @@ class BodyElement(ABC):
        :meth:`drive_web_speed`, :meth:`surface_speed` and :meth:`web_length`.
     6. Scene side, where the defaults do not do: :meth:`parse` (its part from its raw
        table: the default checks :attr:`KEYS` and builds :attr:`part_cls`; sub-tables and
-       checks across keys need their own), :meth:`fixed_centre` and
-       :meth:`initial_circle` (the scene's nip and overlap checks), :meth:`drawing`
-       (the viewer's shape and colour).
+       checks across keys need their own), :meth:`roles_of` (its roles:
+       the scene's reference, nip and web checks and the effects read them) and
+       :meth:`initial_circle` (the overlap check), :meth:`drawing` (the viewer's shape and
+       colour).
     7. Register it: one line in :data:`winder.parts.PARTS` (scene attribute → class);
        the scene then reads ``[[TABLE]]`` and lists its parts as ``scene.ATTRIBUTE``.
 
@@ -210,9 +218,15 @@ class BodyElement(ABC):
     #: anything rests on it (:func:`~winder.solve.equilibrium.balance_unknowns`)
     bearing_axes: tuple[str, ...] = ()
 
+    #: the axes its bearings hold against a beam's deflection (a flexible body's segment;
+    #: rigid bodies: none)
+    bearing_axes: tuple[str, ...] = ()
+
     def __init__(self, part: Any) -> None:
         self.part = part
         self.name: str = part.name
+        #: what it is to the rest of the machine (:meth:`roles_of` its part)
+        self.roles: Roles = type(self).roles_of(part)
         self.sense: int = int(getattr(part, "sense", 1))
         self.free: tuple[str, ...] = ()
         self.centre: tuple[float, float] = (0.0, 0.0)
@@ -248,10 +262,22 @@ class BodyElement(ABC):
         return [cls(part, placed)]
 
     @classmethod
+    def roles_of(cls, part: Any) -> Roles:
+        """Its roles for the part ``part`` (:class:`Roles`): default none beyond a fixed
+        centre (a body that carries no web, bears on a nip with a fixed centre, is rigid
+        and no paper roll)."""
+        return Roles()
+
+    @classmethod
     def fixed_centre(cls, part: Any) -> bool:
-        """Whether its centre is fixed (a nip needs one body free to move): default,
-        where the part has no ``free`` axes."""
-        return not tuple(getattr(part, "free", ()))
+        """Whether its centre is fixed (a nip needs one body free to move): its roles'
+        ``nip == "fixed"``."""
+        return cls.roles_of(part).fixed
+
+    @property
+    def segment(self) -> Segment | None:
+        """Itself as a segment of a flexible body (:class:`Segment`), or None (rigid)."""
+        return self if self.segment_of is not None else None  # type: ignore[return-value]
 
     @classmethod
     def initial_circle(cls, part: Any) -> tuple[tuple[float, float], float] | None:

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from winder._schema import Key, Table
-from winder.parts._base import Drawing, RigidDisc, SubTable, TableReader
+from winder.parts._base import Drawing, RigidDisc, Roles, SubTable, TableReader, segment_count
 from winder.parts._keys import CENTRE, NAME
 from winder.parts.flex import FLEX_KEYS, FlexPart, parse_flex
 
@@ -141,8 +141,10 @@ class DrumBody(RigidDisc):
         return [DrumSegment(part, i, placed) for i in range(part.flex.segments)]
 
     @classmethod
-    def fixed_centre(cls, part: Any) -> bool:
-        return True
+    def roles_of(cls, part: Any) -> Roles:
+        """The web wraps it (an entry drum); fixed centre; sliced where flexible."""
+        return Roles(web="wraps", nip="fixed",
+                     segments=segment_count(part))
 
     def drawing(self) -> Drawing:
         return Drawing(colour="drum")

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from winder._schema import Key, Table
-from winder.parts._base import Drawing, RigidDisc, SubTable, TableReader
+from winder.parts._base import Drawing, RigidDisc, Roles, SubTable, TableReader, segment_count
 from winder.parts._keys import MAX_COORD, NAME
 from winder.parts.flex import FLEX_KEYS, FlexPart, parse_flex
 
@@ -92,8 +92,10 @@ class RiderBody(RigidDisc):
         return [RiderSegment(part, i, placed) for i in range(part.flex.segments)]
 
     @classmethod
-    def fixed_centre(cls, part: Any) -> bool:
-        return False
+    def roles_of(cls, part: Any) -> Roles:
+        """It rides the paper roll ``rides`` (free along ``z``); sliced where flexible."""
+        return Roles(nip="riding", rides=part.rides,
+                     segments=segment_count(part))
 
     @classmethod
     def initial_circle(cls, part: Any) -> None:

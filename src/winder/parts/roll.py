@@ -16,7 +16,14 @@ from winder._args import show
 from winder._schema import Channel, Key, Table
 from winder.model.locked_modes import AT_CORE, CORE_AUTO, ModeKind
 from winder.model.paper_roll import max_com_offset, paper_roll_mass
-from winder.parts._base import BodyElement, Drawing, SubTable, TableReader
+from winder.parts._base import (
+    BodyElement,
+    Drawing,
+    Roles,
+    SubTable,
+    TableReader,
+    segment_count,
+)
 from winder.parts._keys import CENTRE, NAME
 from winder.parts.flex import ROLL_FLEX_KEYS, RollFlexPart, parse_roll_flex
 
@@ -24,14 +31,14 @@ if TYPE_CHECKING:
     from winder.model.machine import BodyState, Evaluation, Machine
 
 __all__ = ["RollPart", "RollBody", "RollSegment", "ROLL_KINDS", "AXES", "UnwindTorqueDrive",
-           "TensionControl", "UNWIND_DRIVE_KINDS", "KEYS", "DRIVE_KEYS", "check_core",
-           "winding_rate"]
+           "TensionControl", "DancerControl", "UNWIND_DRIVE_KINDS", "KEYS", "DRIVE_KEYS",
+           "check_core", "winding_rate"]
 
 #: Kinds of paper roll: ``wound`` (radius grows) and ``unwinding`` (radius shrinks; fixed
 #: centre, the start of a web span).
 ROLL_KINDS = ("wound", "unwinding")
 #: Drive kinds of an unwinding roll (no drive: it turns freely).
-UNWIND_DRIVE_KINDS = ("torque", "tension_control")
+UNWIND_DRIVE_KINDS = ("torque", "tension_control", "dancer_control")
 #: Translational axes a body can be free along, in this order.
 AXES = ("x", "z")
 
@@ -78,16 +85,21 @@ KEYS = Table((
 DRIVE_KEYS = Table((
     Key(name="kind", kind="str", required=True, choices=UNWIND_DRIVE_KINDS,
         doc="torque: a torque (negative brakes); tension_control: the unwind holds the "
-            "span tension by PI with inertia feed-forward, gains from bandwidth"),
+            "span tension by PI with inertia feed-forward, gains from bandwidth; "
+            "dancer_control: the unwind holds a dancer at its centre (d = 0) likewise"),
     Key(name="torque", unit="N·m", hi=1e8,
         doc="kind torque: the unwind torque (operation sense), constant or an input"),
     Key(name="tension", unit="N", **_POS, hi=1e7,
         default_text="required (kind tension_control)",
         doc="kind tension_control: the tension set-point T*"),
     Key(name="bandwidth", unit="rad/s", **_POS, hi=1e4, fmu="bandwidth",
-        doc="kind tension_control: the closed loop's bandwidth ω_c (its three poles at "
-            "−ω_c)"),
-), kinds={"torque": ("kind", "torque"), "tension_control": ("kind", "tension", "bandwidth")})
+        doc="kinds tension_control, dancer_control: the closed loop's bandwidth ω_c (its "
+            "three poles at −ω_c)"),
+    Key(name="dancer", kind="ref", default_text="required (kind dancer_control)",
+        doc="kind dancer_control: the idler on a dancer carriage it holds at d = 0"),
+), kinds={"torque": ("kind", "torque"),
+          "tension_control": ("kind", "tension", "bandwidth"),
+          "dancer_control": ("kind", "dancer", "bandwidth")})
 
 
 def winding_rate(ev: Evaluation, n: str, r: Any, rc: Any, speed: Any, *,
@@ -129,6 +141,18 @@ class TensionControl:
 
 
 @dataclass(frozen=True, kw_only=True)
+class DancerControl:
+    """``drive = { kind = "dancer_control" }`` of an unwinding roll: the unwind torque
+    holds the carriage of the idler ``dancer`` at its centre (``d = 0``); ``bandwidth``
+    ω_c [rad/s] is the closed loop's bandwidth (:mod:`winder.forces.dancer_control`);
+    bounds: :data:`DRIVE_KEYS`."""
+
+    kind: str = "dancer_control"
+    dancer: str
+    bandwidth: float = 10.0
+
+
+@dataclass(frozen=True, kw_only=True)
 class RollPart:
     """``[[roll]]``: a paper roll; keys, units, bounds and meanings: :data:`KEYS` (an
     unwinding roll's drive: :data:`DRIVE_KEYS`, None for a free one). density and caliper
@@ -151,7 +175,7 @@ class RollPart:
     density: float
     caliper: float
     held_z: float | None = None
-    drive: UnwindTorqueDrive | TensionControl | None = None
+    drive: UnwindTorqueDrive | TensionControl | DancerControl | None = None
     flex: RollFlexPart | None = None
 
 
@@ -177,7 +201,8 @@ def check_core(fail: Callable[[str, str, str], Exception], table: str,
 
 
 def _parse_drive(reader: TableReader, label: str, kw: Mapping[str, Any],
-                 raw: Mapping[str, Any]) -> UnwindTorqueDrive | TensionControl | None:
+                 raw: Mapping[str, Any]
+                 ) -> UnwindTorqueDrive | TensionControl | DancerControl | None:
     """The drive of a roll (spec §6): only an unwinding roll may have one."""
     if "drive" not in raw:
         return None
@@ -191,6 +216,11 @@ def _parse_drive(reader: TableReader, label: str, kw: Mapping[str, Any],
     reader.kinds(dlabel, d, DRIVE_KEYS)
     if d["kind"] == "torque":
         return UnwindTorqueDrive(**d)
+    if d["kind"] == "dancer_control":
+        if "dancer" not in d:
+            raise reader.fail(dlabel, "dancer", "missing required key (kind = "
+                                                "'dancer_control': the idler it holds)")
+        return DancerControl(**d)
     if "tension" not in d:
         raise reader.fail(dlabel, "tension",
                           "missing required key (kind = 'tension_control': the set-point [N])")
@@ -212,7 +242,8 @@ class RollBody(BodyElement):
     table = "roll"
     role = "roll"
     KEYS = KEYS
-    SUB_TABLES = {"drive": SubTable(DRIVE_KEYS, (UnwindTorqueDrive, TensionControl),
+    SUB_TABLES = {"drive": SubTable(DRIVE_KEYS, (UnwindTorqueDrive, TensionControl,
+                                                 DancerControl),
                                     heading="drive (unwinding rolls)"),
                   "flex": SubTable(ROLL_FLEX_KEYS, (RollFlexPart,),
                                    heading="flex (wound rolls)")}
@@ -240,8 +271,9 @@ class RollBody(BodyElement):
         self.unwinding = part.kind == "unwinding"
         self.winds = not self.unwinding
         self.torque_inputs = (f"{n}.torque",) if kind == "torque" else ()
-        self.drives = ("tension_control",) if kind == "tension_control" else ()
-        self.setpoint_inputs = (f"{n}.tension_setpoint",) if self.drives else ()
+        self.drives = (kind,) if kind in ("tension_control", "dancer_control") else ()
+        self.setpoint_inputs = (f"{n}.tension_setpoint",) \
+            if kind == "tension_control" else ()
         self.com_offset = part.com_offset
 
     @classmethod
@@ -278,6 +310,14 @@ class RollBody(BodyElement):
         if getattr(part, "flex", None) is None:
             return [cls(part, placed)]
         return [RollSegment(part, i, placed) for i in range(part.flex.segments)]
+
+    @classmethod
+    def roles_of(cls, part: Any) -> Roles:
+        """A paper roll that winds its web on (``wound``) or pays it off (``unwinding``),
+        free to move where it has ``free`` axes; sliced where flexible."""
+        return Roles(web="unwinds" if part.kind == "unwinding" else "winds",
+                     nip="free" if tuple(part.free) else "fixed", paper=True,
+                     segments=segment_count(part))
 
     @classmethod
     def initial_circle(cls, part: Any) -> tuple[tuple[float, float], float]:

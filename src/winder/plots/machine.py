@@ -170,7 +170,7 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     spans = [w for w in scene.webs if w.span is not None]
     for w in spans:  # one figure per span: STEM_span.png, or STEM_WEB_span.png
         pre = f"{w.name}_" if len(spans) > 1 else ""
-        if f"{pre}span_tension" in result:
+        if _tensions(result, w, pre):
             paths.append(_span_figure(result, scene, bodies, w, pre,
                                       out / f"{stem}_{pre}span.png", name))
     return paths + flex_figures(result, scene, out, stem, name, _f._save)
@@ -219,6 +219,13 @@ def _nip_forces(result: Result, forces: dict[str, np.ndarray],
     return _f._save(fig, path)
 
 
+def _tensions(result: Result, web: WebPart, pre: str) -> list[str]:
+    """The span-tension channels of ``web`` in ``result`` (one span, or each of a line's)."""
+    names = [f"{pre}span_tension"] if len(web.spans) == 1 else \
+        [f"{pre}span{i}_tension" for i in range(len(web.spans))]
+    return [n for n in names if n in result]
+
+
 def _drive(body: BodyElement) -> bool:
     """Whether ``body`` is a drive of constant radius (a drum: prescribed or on a torque
     input, its radius no state), drawn with its drive torque."""
@@ -255,8 +262,9 @@ def _span_figure(result: Result, scene: Scene, bodies: list[BodyElement], web: W
     wound = [body[entry.b]] if body[entry.b].radius_state else []
     error = f"{pre}tension_error"
     fig, ax = _rows(4 if error in result else 3)
-    unit = _f._in(result, f"{pre}span_tension")
-    _panel(ax[0], t, [("span tension", result[f"{pre}span_tension"])], "T" + unit,
+    unit = _f._in(result, _tensions(result, web, pre)[0])
+    _panel(ax[0], t, [(n[len(pre):].replace("_", " "), result[n])
+                      for n in _tensions(result, web, pre)], "T" + unit,
            f"{name}: web span tension{unit} (EA = {span.EA:.3g} N, L = {span.length:g} m)",
            lw=0.6)
     rows = 1

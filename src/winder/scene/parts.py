@@ -95,11 +95,35 @@ def _parse_webs(source: str, data: Mapping[str, Any]) -> list[tuple[str, WebPart
                             f"{show(raw['tension'])}: with [web.span] the tension is the "
                             "span's state, docs/model.md §6; valid: remove tension (the span's "
                             "initial_tension sets where it starts)")
-            slabel = f"{label}.span"
-            sp = parse_table(source, slabel, raw["span"], SPAN_KEYS)
-            kw["span"] = SpanPart(source=sp.pop("from"), **sp)
+            kw["spans"] = _parse_spans(source, label, raw["span"])
         webs.append((label, WebPart(**kw)))
     return webs
+
+
+def _parse_spans(source: str, label: str, raw: Any) -> tuple[SpanPart, ...]:
+    """``[web.span]`` (one span from the unwinding roll to the entry drum) or
+    ``[[web.span]]`` (several, in order, machines.md §11): the first names ``from``, every
+    one but the last ``to`` (checked with the rollers, :mod:`winder.scene.checks`)."""
+    several = isinstance(raw, list)
+    if several and not raw:
+        raise fail(source, label, "span", "[]: an empty array of spans; valid: one "
+                                          "[[web.span]] table per span, in order")
+    spans = []
+    for i, element in enumerate(raw if several else [raw]):
+        slabel = f"{label}.span #{i + 1}" if several else f"{label}.span"
+        sp = parse_table(source, slabel, element, SPAN_KEYS)
+        if i == 0 and "from" not in sp:
+            raise fail(source, slabel, "from", "missing required key (the unwinding roll "
+                                               "that feeds the web)")
+        if i > 0:
+            for key in ("from", "T_in"):
+                if key in sp:
+                    raise fail(source, slabel, key,
+                               f"{show(sp[key])}: only the first span has {key} (span "
+                               f"#{i + 1} starts at the roller span #{i} names in to); "
+                               f"valid: remove {key}")
+        spans.append(SpanPart(source=sp.pop("from", None), **sp))
+    return tuple(spans)
 
 
 def parse_parts(source: str, data: Mapping[str, Any], effects: Effects,

@@ -264,7 +264,10 @@ def reference() -> str:
               "`tension_control`. With several webs, `web_speed` and `web_force` are "
               "`WEB_web_speed` and `WEB_web_force` (`WEB` the web's name); with several "
               "spans, `span_tension` and `tension_error` are `WEB_span_tension` and "
-              "`WEB_tension_error`.", "",
+              "`WEB_tension_error`. A web line (`[[web.span]]`, several spans over idler "
+              "rollers) has `span{i}_tension` for its spans `i = 0, 1, …` from the "
+              "unwinding roll (`WEB_span{i}_tension` among several webs spanned); "
+              "`BODY_load_cell` and `BODY_traction` are an idler's.", "",
               "A flexible body `NAME` (`flex`) has every channel of a body for each of its "
               "segments `NAME_s{i}` (0 at the drive end) and keeps the body-level channels "
               "of its rigid self, with the same names, units and meanings, formed from its "
@@ -284,6 +287,7 @@ def channel_declarations(name: str, parts: dict[str, str], webs: Iterable[str] =
     after the name of one of ``webs`` (``WEB_web_speed``); ``parts`` maps every part name
     to its kind (``drum``, ``roll``, ``rider``, ``nip``)."""
     out = []
+    name = re.sub(r"(^|_)span\d+_tension$", r"\1span_tension", name)  # a line's spans
     for decl in _declarations():
         if decl.placeholder:
             owners = [p for p, k in parts.items() if k in _placeholder_kinds(decl.placeholder)]

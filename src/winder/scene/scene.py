@@ -187,9 +187,16 @@ def _web_dict(web: WebPart, *, named: bool = False) -> dict[str, Any]:
     out = _table_dict(web)
     if not named and web.name == web.entry_nip:
         del out["name"]
+    spans = out.pop("spans", [])
+    if web.mu == WebPart.mu:
+        del out["mu"]
     if web.span is not None:
         del out["tension"]
-        out["span"] = {"from": out["span"].pop("source"), **out["span"]}
+        tables = [{**({"from": s.pop("source")} if "source" in s else {}), **s}
+                  for s in spans]
+        for later in tables[1:]:  # only the first span has T_in (machines.md §11)
+            later.pop("T_in", None)
+        out["span"] = tables[0] if len(tables) == 1 else tables
     return out
 
 
@@ -222,9 +229,10 @@ def _merge(node: Any, values: Any, table: str, path: tuple[str, ...]) -> None:
         raise ArgumentTypeError(
             f"Scene.replace: {where} must be a mapping of {what} to values, e.g. "
             f"{table}={example}; got {show(values)} ({type(values).__name__})")
-    if isinstance(node, list):
-        names = [str(e.get("name")) for e in node]
+    if isinstance(node, list):  # unnamed elements (a line's spans) by their index
+        names = [str(e.get("name", i)) for i, e in enumerate(node)]
         for name, sub in values.items():
+            name = str(name)
             if name not in names:
                 raise ArgumentError(f"Scene.replace: {where} has no element named "
                                     f"{show(name)}; valid names: {', '.join(names)}")

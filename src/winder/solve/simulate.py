@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from types import MappingProxyType
 from typing import Any
 
@@ -257,9 +258,13 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
             raise ArgumentTypeError(f"initial_state must be {system.n_states} numbers, got "
                                     f"{initial_state!r:.200}") from None
         if y0.shape != (system.n_states,) or not np.all(np.isfinite(y0)) \
-                or any(y0[i] < rc for i, rc in system.radii):
+                or any(y0[i] < rc for i, rc in system.radii) \
+                or any(y0[i] > hi for i, hi in system.ceilings):
             given = ", ".join(f"{v:.9g}" for v in y0.ravel()[:20])
-            cores = ", ".join(f"{system.state_names[i]} >= {rc:g} m" for i, rc in system.radii)
+            cores = ", ".join([*(f"{system.state_names[i]} >= {rc:g} m"
+                                 for i, rc in system.radii),
+                               *(f"{system.state_names[i]} <= {hi:g} m"
+                                 for i, hi in system.ceilings)])
             raise ArgumentError(f"initial_state = [{given}] is not valid: valid are "
                                 f"{system.n_states} finite values "
                                 f"({', '.join(system.state_names)}) with radii at or above "
@@ -332,8 +337,35 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     bad = [k for k, v in channels.items() if not np.all(np.isfinite(v))]
     if bad:
         raise SimulationError(f"non-finite values in result channels {bad}")
-    return Result(channels, _meta(scene, system, meth, rtol, atol, wall, n_events, t_s, T),
-                  units=system.channel_units)
+    meta = _meta(scene, system, meth, rtol, atol, wall, n_events, t_s, T)
+    slips = web_slips(system, t_out, channels)
+    if slips:
+        meta["slips"] = slips
+    for text in slips:
+        warnings.warn(text, WebSlipWarning, stacklevel=2)
+    return Result(channels, meta, units=system.channel_units)
+
+
+class WebSlipWarning(UserWarning):
+    """A web would slip on a roller (its traction reached 1, machines.md §11)."""
+
+
+def web_slips(system: MachineSystem, t: np.ndarray, channels: dict[str, Any]) -> list[str]:
+    """One message per roller whose ``NAME_traction`` reaches 1 (the web would slip on it,
+    machines.md §11), naming the first output time where it does."""
+    out = []
+    for b in system.machine.bodies:
+        trace = channels.get(f"{b.name}_traction") if b.roles.roller else None
+        if trace is None:
+            continue
+        hits = np.flatnonzero(np.asarray(trace) >= 1.0)
+        if hits.size:
+            i = int(hits[0])
+            out.append(f"{b.table} {b.name!r}: the web would slip on it from t = {t[i]:.6g} s "
+                       f"(traction {float(trace[i]):.4g} >= 1: the tension difference "
+                       "exceeds the capstan limit (exp(mu wrap) - 1) min(T_up, T_down)); the "
+                       "run carries on without slip")
+    return out
 
 
 def _meta(scene: Scene, system: MachineSystem, meth: str, rtol: float, atol: float,

@@ -71,8 +71,11 @@ class MachineSystem:
         self.table = np.array(rows, dtype=np.int64).reshape(len(rows), 5)
         self.modes = np.array([mode.kind.automatic for mode in m.modes], dtype=float)
         #: ``(state index, least value [m])`` of every radius an event stops at its core
-        self.radii = [(m.index(mode.state), m.param_values[m.param_index(mode.param)])
-                      for mode in m.modes if mode.state is not None]
+        #: (and every dancer's lower end); ``ceilings`` the greatest values (its upper end)
+        stops = [(m.index(mode.state), m.param_values[m.param_index(mode.param)], mode)
+                 for mode in m.modes if mode.state is not None]
+        self.radii = [(i, v) for i, v, mode in stops if not mode.name.endswith("travel_hi")]
+        self.ceilings = [(i, v) for i, v, mode in stops if mode.name.endswith("travel_hi")]
         self.breakpoints = sorted({t for b in m.bodies for t in b.breakpoints()})
         self.nfev = 0
         self._tb = np.empty(1)
@@ -126,19 +129,27 @@ class MachineSystem:
         reached its parameter (the core radius, machines.md §1)."""
         m = self.machine
         ends = [mode for mode in m.modes if mode.kind is ModeKind.END]
-        spent = [mode.owner for mode in ends
-                 if y[m.index(mode.state)]
-                 <= self.params[m.param_index(mode.param)] * (1.0 + 1e-9)]
-        roll = spent[0] if spent else (ends[0].owner if ends else "?")
-        self.end = (float(t), np.array(y, dtype=float),
-                    f"the unwinding roll {roll!r} ran out of web (its radius reached the "
+        hit = [mode for mode in ends if _reached(mode, y[m.index(mode.state)],
+                                                 self.params[m.param_index(mode.param)])]
+        mode = hit[0] if hit else (ends[0] if ends else None)
+        if mode is not None and mode.name.endswith(("travel_lo", "travel_hi")):
+            end = "lower" if mode.name.endswith("lo") else "upper"
+            text = (f"the dancer {mode.owner!r} reached the {end} end of its travel (d = "
+                    f"{self.params[m.param_index(mode.param)]:.6g} m) at t = {t:.6g} s: the "
+                    "run ends there")
+        else:
+            roll = mode.owner if mode is not None else "?"
+            text = (f"the unwinding roll {roll!r} ran out of web (its radius reached the "
                     f"core) at t = {t:.6g} s: the run ends there")
+        self.end = (float(t), np.array(y, dtype=float), text)
 
     def clamp_radii(self, Y: np.ndarray) -> None:
         """Samples interpolated between a step's start and its core event may dip below
         ``r_c`` by round-off; the state never does."""
         for i, rc in self.radii:
             np.maximum(Y[i], rc, out=Y[i])
+        for i, hi in self.ceilings:
+            np.minimum(Y[i], hi, out=Y[i])
 
     # ---- evaluation -----------------------------------------------------------------------
     def evaluate_numeric(self, t: float, y: np.ndarray, modes: np.ndarray | None = None,
@@ -294,3 +305,11 @@ class MachineSystem:
         # a channel the machine lacks (an effect off) is zeros
         return {"t": t.copy(), **{name: ch[c] if c in ch else np.zeros(len(t))
                                   for name, (c, _) in self.outputs.items()}}
+
+
+def _reached(mode: Any, value: float, end: float) -> bool:
+    """Whether the state ``value`` of the END ``mode`` has reached its ``end``: an
+    unwinding roll's radius its core, a dancer's position an end of its travel (its
+    upper end from below)."""
+    tol = 1e-9 * max(abs(end), 1e-3)
+    return value >= end - tol if mode.name.endswith("travel_hi") else value <= end + tol
