@@ -126,7 +126,7 @@ test-slow: $(STAMP) chromium
 # core and the exhausted parent. libstdc++ is preloaded too: without it ASan's __cxa_throw
 # interceptor aborts in matplotlib's ft2font. A report aborts the run (exit status != 0).
 .PHONY: test-asan
-test-asan: $(STAMP)
+test-asan: $(STAMP) pin-casadi
 	WINDER_SANITIZE=1 ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  LD_PRELOAD="$$($${CC:-cc} -print-file-name=libasan.so) $$($${CC:-cc} -print-file-name=libstdc++.so.6)" \

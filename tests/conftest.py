@@ -151,3 +151,29 @@ def state_regions(system, states: list[tuple[float, np.ndarray]]) -> dict[str, i
               else prescribed_drum_speed(scene, t))
         out["slip+" if Om * R - w * r > 0 else "slip-"] += 1
     return out
+
+
+# ---- the generated code's route for bit-level records ---------------------------------------
+@pytest.fixture(scope="module")
+def route_cpp() -> Iterator[None]:
+    """Route ``cpp`` of the generated code for a module's tests (``pytestmark =
+    pytest.mark.usefixtures("route_cpp")``): the recorded traces and shipped references are
+    records of that route's code to the last bit, and an adaptive integrator turns the
+    routes' round-off (8e-16 of each output, tests/model/test_routes.py) into differences at
+    its tolerance. The default route ``py`` is the same expressions (that test)."""
+    from winder.model.backends import ROUTE_ENV
+    from winder.model.pin_casadi import generator_path, unavailable_reason
+
+    if generator_path(build=False) is None:
+        pytest.skip(f"route cpp: {unavailable_reason()} (make pin-casadi builds it)")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv(ROUTE_ENV, "cpp")
+        yield
+
+
+def without_build_lines(err: str) -> str:
+    """``err`` without the lines a first run prints while it builds a machine's code (they
+    depend on the cache, not on what a test checks)."""
+    import re
+
+    return re.sub(r"(?m)^winder: (building .*|.*'s code built in .*)\n", "", err)

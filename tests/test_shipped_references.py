@@ -20,6 +20,9 @@ import pytest
 
 import winder
 
+#: bit-level records of route cpp's code (conftest.route_cpp)
+pytestmark = pytest.mark.usefixtures("route_cpp")
+
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "data" / "shipped"
 #: Each shipped scene: (simulated time [s], output step [s]): every whole cycle (the

@@ -42,7 +42,9 @@ MACHINE = ("wall_time", "task_time", "worker")
 
 @pytest.fixture(scope="module")
 def base(paper_scene) -> winder.Scene:
-    return paper_scene.replace(drum={"drive": {"web_acceleration": 2.0}})
+    # max_rhs given: the CLI test's runs that vary it to 50 M are the grid's runs
+    return paper_scene.replace(drum={"drive": {"web_acceleration": 2.0}},
+                               solver={"max_rhs": 50_000_000})
 
 
 @pytest.fixture(scope="module")
@@ -360,7 +362,8 @@ def test_cli_sweep_with_failures_and_map(cluster, reference, tmp_path, capsys,
     _, lc = cluster
     scene = tmp_path / "scene.toml"
     text = (models_dir / "paper_winding.toml").read_text()
-    scene.write_text(text.replace("web_acceleration = 0.5", "web_acceleration = 2.0"))
+    scene.write_text(text.replace("web_acceleration = 0.5", "web_acceleration = 2.0")
+                     .replace("[solver]\n", "[solver]\nmax_rhs = 50000000\n"))
     png = tmp_path / "map.png"
     code = main(["sweep", str(scene), "--vary", "drum.drive.web_speed=12:24:4",
                  "--vary", "solver.max_rhs=3000,50000000", "--out", str(tmp_path / "c"),

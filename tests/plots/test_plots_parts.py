@@ -4,12 +4,11 @@ no static balance, and the sweep summary per nip (issue #14)."""
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import MODELS
+from conftest import MODELS, without_build_lines
 
 import winder
 import winder.plots.figures as _plots
@@ -213,8 +212,7 @@ def test_no_static_balance_names_the_body(tmp_path, capsys) -> None:
     out = tmp_path / "r.npz"
     assert main(["run", str(path), "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    # (a first run builds the machine's code and says so first: those lines are not the error)
-    err = re.sub(r"(?m)^winder: (building .*|.*'s code built in .*)\n", "", err)
+    err = without_build_lines(err)
     assert err.startswith(f"winder: error: {path}: no static balance for body 'set'")
     assert "Traceback" not in err and not out.exists()
 

@@ -27,6 +27,9 @@ import winder
 from winder.solve import integrators as integ
 from winder.solve.system import MachineSystem
 
+#: bit-level records of route cpp's code (conftest.route_cpp)
+pytestmark = pytest.mark.usefixtures("route_cpp")
+
 TRACES = Path(__file__).with_name("data") / "kernel_traces"
 RECORD = os.environ.get("WINDER_RECORD_NUMBA", "") not in ("", "0")
 

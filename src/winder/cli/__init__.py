@@ -358,15 +358,13 @@ def _add_linearise(sub: Any) -> None:
 
 
 def _version() -> str:
-    """The installed package's version (``winder.__version__`` where it is not installed)."""
+    """The installed package's version."""
     from importlib import metadata
 
     try:
         return metadata.version("winder")
-    except metadata.PackageNotFoundError:
-        from winder import __version__
-
-        return __version__
+    except metadata.PackageNotFoundError:  # a source tree on sys.path, not installed
+        return "(not installed)"
 
 
 def _add_fit(sub: Any) -> None:

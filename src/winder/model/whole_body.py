@@ -26,14 +26,14 @@ its ``whole``, is covered as it is.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from winder._schema import Channel
 from winder.model.channels import COORD_CHANNELS
 from winder.model.slices import segments_of
 
-if TYPE_CHECKING:
-    from winder.model.machine import Evaluation, Machine
+# (the machine and its evaluation are :class:`winder.model.machine.Machine` and
+# ``Evaluation``: typed Any here, since machine.py imports this module)
 
 __all__ = ["Whole", "declare_wholes", "write_wholes", "combine"]
 
@@ -48,7 +48,7 @@ class Whole:
     channels: tuple[tuple[Channel, str, tuple[str, ...]], ...]
 
 
-def declare_wholes(machine: Machine) -> list[Whole]:
+def declare_wholes(machine: Any) -> list[Whole]:
     """Register the body-level channels of every flexible body of ``machine`` (after every
     body and force element has registered its own: :attr:`Machine.channel_owners
     <winder.model.machine.Machine.channel_owners>`); return them."""
@@ -75,7 +75,7 @@ def combine(rule: str, values: list[Any], driven: bool) -> Any:
     return total if rule in ("sum", "drive_sum") else total / len(values)
 
 
-def write_wholes(ev: Evaluation, wholes: list[Whole]) -> None:
+def write_wholes(ev: Any, wholes: list[Whole]) -> None:
     """Write the channels of ``wholes`` from their segments' in ``ev`` (after those)."""
     for w in wholes:
         first = w.segments[0]
