@@ -103,11 +103,37 @@ class FlexBeam(ForceElement):
         self.groups: dict[str, list[Any]] = {}
         #: the slices of each sliced scene nip, by its name
         self.sliced: dict[str, list[Any]] = {}
+        #: whether each flexible drum or rider has its sections' rotary inertia
+        self.rotary: dict[str, bool] = {}
+
+    @staticmethod
+    def _declare_rotary(machine: Machine, body: str, segs: list[Any], axis: str,
+                        bm: Any) -> None:
+        """The parameters of a beam with its sections' rotary inertia along ``axis``
+        (:class:`~winder.model.beam.RotaryBeamMatrices`; the band ``|i − j| ≤ 1`` of
+        ``K̂``, ``C``) and each segment's states ``tilt_{axis}`` (``φ``) and
+        ``tilt_rate_{axis}`` (``s = ψ̇``), 0 at the start."""
+        n = len(segs)
+        for kind, matrix, sym, band in (("K", bm.K, True, False), ("T", bm.T, False, False),
+                                        ("Kwp", bm.K_wp, False, True),
+                                        ("Kpp", bm.K_pp, True, True),
+                                        ("Cww", bm.C_ww, True, True),
+                                        ("Cwp", bm.C_wp, False, True),
+                                        ("Cpp", bm.C_pp, True, True)):
+            for i in range(n):
+                for j in range(i if sym else 0, n):
+                    if not band or abs(i - j) <= 1:
+                        machine.parameter(f"{body}.flex.{kind}{axis}_{i}_{j}", matrix[i, j])
+        for seg in segs:
+            machine.state(f"{seg.name}.tilt_{axis}", 0.0)
+            machine.state(f"{seg.name}.tilt_rate_{axis}", 0.0)
 
     def declare(self, machine: Machine) -> None:
-        from winder.model.beam import beam_matrices  # NumPy: not for checking a scene
+        # NumPy: not for checking a scene
+        from winder.model.beam import beam_matrices, rotary_beam_matrices
 
         self.groups = {}
+        self.rotary = {}
         for b in machine.bodies:
             if self.name in b.drives:
                 self.groups.setdefault(b.segment_of, []).append(b)
@@ -137,13 +163,18 @@ class FlexBeam(ForceElement):
                 machine.parameter(f"{body}.flex.k_t", unit.k_t)
                 machine.channel(TWIST, body)
                 continue
+            self.rotary[body] = flex.rotary_inertia
             for axis in ("x", "z"):
                 held = axis in first.bearing_axes
-                bm = beam_matrices(n, first.length, part.mass, flex.EI,
-                                   flex.kGA if flex.shear else None,
-                                   flex.bearing_stiffness if held else 0.0,
-                                   flex.bearing_damping if held else 0.0,
-                                   flex.damping_ratio, flex.GJ)
+                args = (flex.EI, flex.kGA if flex.shear else None,
+                        flex.bearing_stiffness if held else 0.0,
+                        flex.bearing_damping if held else 0.0, flex.damping_ratio, flex.GJ)
+                if flex.rotary_inertia:
+                    bm = rotary_beam_matrices(n, first.length, part.mass, part.inertia,
+                                              *args)
+                    self._declare_rotary(machine, body, segs, axis, bm)
+                    continue
+                bm = beam_matrices(n, first.length, part.mass, *args)
                 for kind, matrix in (("K", bm.K), ("C", bm.C)):
                     for i in range(n):
                         for j in range(i, n):
@@ -211,6 +242,41 @@ class FlexBeam(ForceElement):
         return kt, beta * kt
 
     @staticmethod
+    def _rotary_bending(ev: Evaluation, body: str, segs: list[Any], axis: str,
+                        u: list[Any], v: list[Any]) -> list[Any]:
+        """Bending along ``axis`` with the sections' rotary inertia
+        (:func:`~winder.model.beam.rotary_beam_matrices`): the rates of the segments'
+        ``tilt_{axis}`` (``φ̇ = s − T ẇ``) and ``tilt_rate_{axis}`` (``ṡ = (−K_ψψ φ −
+        C_ψw ẇ − C_ψψ s)/j_r``, ``j_r`` half the segment's polar inertia); returns the
+        forces on the segments ``−K w − K_wψ φ − C_ww ẇ − C_wψ s`` [N]."""
+        p, n = ev.p, len(segs)
+
+        def par(kind: str, i: int, j: int, sym: bool = False) -> Any:
+            a, b = (min(i, j), max(i, j)) if sym else (i, j)
+            return p(f"{body}.flex.{kind}{axis}_{a}_{b}")
+
+        phi = [ev.x(f"{s.name}.tilt_{axis}") for s in segs]
+        rate = [ev.x(f"{s.name}.tilt_rate_{axis}") for s in segs]
+        forces = []
+        for i, seg in enumerate(segs):
+            f: Any = 0.0
+            for j in range(n):
+                f = f - par("K", i, j, True) * u[j]
+            g: Any = 0.0
+            for j in range(max(i - 1, 0), min(i + 2, n)):
+                f = f - par("Kwp", i, j) * phi[j] - par("Cww", i, j, True) * v[j] \
+                    - par("Cwp", i, j) * rate[j]
+                g = g - par("Kpp", i, j, True) * phi[j] - par("Cwp", j, i) * v[j] \
+                    - par("Cpp", i, j, True) * rate[j]
+            forces.append(f)
+            lag: Any = rate[i]
+            for j in range(n):
+                lag = lag - par("T", i, j) * v[j]
+            ev.set_rate(f"{seg.name}.tilt_{axis}", lag)
+            ev.set_rate(f"{seg.name}.tilt_rate_{axis}", 2.0 * g / p(f"{seg.name}.inertia"))
+        return forces
+
+    @staticmethod
     def _body_channels(ev: Evaluation, body: str, segs: list[Any], states: list[Any]
                        ) -> None:
         """The whole body's ``NAME_speed`` and ``NAME_angle`` (its segments' mean) and, for a
@@ -263,6 +329,12 @@ class FlexBeam(ForceElement):
 
             if hasattr(segs[0].flex, "core_EI"):
                 kt, ct = self._roll_bending(ev, body, segs, states, ux, uz)
+            elif self.rotary[body]:
+                fx = self._rotary_bending(ev, body, segs, "x", ux, [bs.vx for bs in states])
+                fz = self._rotary_bending(ev, body, segs, "z", uz, [bs.vz for bs in states])
+                for seg, f, g in zip(segs, fx, fz, strict=True):
+                    ev.add_force(seg.name, f, g)
+                kt, ct = ev.p(f"{body}.flex.k_t"), ev.p(f"{body}.flex.c_t")
             else:
                 for i, seg in enumerate(segs):
                     fx: Any = 0.0
