@@ -12,7 +12,12 @@ machine without flexible bodies never builds it. Per flexible body ``NAME`` with
 
 with the run-time parameters ``NAME.flex.Kx_i_j`` [N/m], ``NAME.flex.Cx_i_j`` [N·s/m]
 (``i ≤ j``, symmetric; ``Kz``, ``Cz`` likewise), ``NAME.flex.k_t`` [N·m/rad] and
-``NAME.flex.c_t`` [N·m·s/rad]. The bearings hold the axes a segment lists in
+``NAME.flex.c_t`` [N·m·s/rad]. With the sections' rotary inertia (``flex.rotary_inertia``,
+the default; issue #32) each segment has the states ``NAME_s{i}.tilt_x``, ``.tilt_z``
+[rad] and ``.tilt_rate_x``, ``.tilt_rate_z`` [rad/s] and the bending is that of
+:func:`~winder.model.beam.rotary_beam_matrices` (parameters ``Kx`` as above, ``Tx``,
+``Kwpx``, ``Kppx``, ``Cwwx``, ``Cwpx``, ``Cppx`` and their ``z``:
+:meth:`_rotary_bending`). The bearings hold the axes a segment lists in
 ``bearing_axes`` (a drum: ``x`` and ``z``; a rider: ``x``; a roll on chucks: its free
 axes); along the others the beam is free–free (it rests on its nip). A paper roll's
 ``EI(r)`` changes at run time: its stiffness is ``EI(r)`` times the unit beam's, on chucks
