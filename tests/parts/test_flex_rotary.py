@@ -256,3 +256,13 @@ def test_generated_code_matches_the_numeric_path() -> None:
             y[gen.index(f"front_s{i}.{k}")] += scale * rng.standard_normal()
     a, b = gen.rhs(0.0, y), num.rhs(0.0, y)
     assert np.max(np.abs(a - b) / (np.abs(b) + 1e-6)) < 1e-9
+
+
+def test_every_state_has_its_unit() -> None:
+    """The sections' states have their units for the plant and the CasADi model
+    (``tilt_*`` [rad], ``tilt_rate_*`` [rad/s]), as every other state of the machine."""
+    from winder.analysis.control import state_unit
+
+    names = MachineSystem(scene(3, bearings=1e9), backend="pinocchio").machine.state_names
+    assert {state_unit(n) for n in names if ".tilt_" in n} == {"rad", "rad/s"}
+    assert [n for n in names if not state_unit(n)] == []
