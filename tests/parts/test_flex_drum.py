@@ -38,8 +38,9 @@ G = 9.81  # [m/s²]
 
 def scene_text(n: int, *, shear: bool = True, bearings: float = 1e15, damping: float = 0.0,
                gravity: bool = False, contact: bool = False, extra: str = "",
-               drive: str = '{ kind = "torque", torque = 0.0 }') -> str:
+               drive: str = '{ kind = "torque", torque = 0.0 }', rotary: bool = True) -> str:
     kga = f", kGA = {KGA}" if shear else ""
+    kga += "" if rotary else ", rotary_inertia = false"
     return f"""
 [scene]
 name = "flex"
@@ -87,10 +88,38 @@ def block(sys: MachineSystem, coord: str, n: int, h: float = 1e-3) -> np.ndarray
     return out
 
 
+def state_matrix(sys: MachineSystem, names: list[str], h: float = 1e-6) -> np.ndarray:
+    """``∂ẏ/∂y`` over the states ``names`` at rest, by central differences."""
+    y0 = sys.initial_state()
+    idx = [sys.index(k) for k in names]
+    out = np.empty((len(idx), len(idx)))
+    for k, c in enumerate(idx):
+        a, b = y0.copy(), y0.copy()
+        a[c] += h
+        b[c] -= h
+        out[:, k] = (sys.rhs(0.0, a)[idx] - sys.rhs(0.0, b)[idx]) / (2 * h)
+    return out
+
+
+def bending_states(sys: MachineSystem, coord: str, n: int, body: str = "front") -> list[str]:
+    """The states of the bending along ``coord``: the segments' deflections and rates and,
+    with the rotary inertia, their sections' ``tilt_{coord}`` and ``tilt_rate_{coord}``."""
+    segs = [f"{body}_s{i}" for i in range(n)]
+    names = [f"{s}.{coord}" for s in segs] + [f"{s}.{coord}_dot" for s in segs]
+    tilt = [f"{s}.{k}_{coord}" for s in segs for k in ("tilt", "tilt_rate")]
+    return names + [k for k in tilt if k in sys.machine.state_names]
+
+
 def frequencies(sys: MachineSystem, coord: str, n: int) -> np.ndarray:
-    """The machine's ``ω`` [rad/s] of ``coord`` (``x``, ``z`` or ``theta``), ascending."""
-    w2 = np.linalg.eigvals(-block(sys, coord, n)).real
-    return np.sqrt(np.clip(np.sort(w2), 0.0, None))
+    """The machine's ``ω`` [rad/s] of ``coord`` (``x``, ``z`` or ``theta``), ascending: the
+    eigenvalues ``±iω`` of the undamped motion's state matrix (bending: with the sections'
+    rotations where the rotary inertia is on), ``ω² = −λ²`` once per pair."""
+    if coord == "theta":
+        w2 = np.linalg.eigvals(-block(sys, coord, n)).real
+        return np.sqrt(np.clip(np.sort(w2), 0.0, None))
+    lam = np.linalg.eigvals(state_matrix(sys, bending_states(sys, coord, n)))
+    w2 = np.sort(-(lam * lam).real)[::2]
+    return np.sqrt(np.clip(w2, 0.0, None))
 
 
 def closed_form(n: int, kga: float | None, bearings: float) -> np.ndarray:
@@ -173,8 +202,9 @@ def test_bad_flex_values_name_the_file_and_key(change: Any, where: str, what: st
 @pytest.mark.parametrize("n", [4, 10])
 def test_simply_supported_drum_matches_the_chains_closed_form(n: int, shear: bool) -> None:
     """First two bending frequencies, in x and in z, against the discrete closed form of the
-    chain: bearings 1e10 N/m (finite, in the closed form too); measured error ≤ 4e-14."""
-    sys = system(n, shear=shear, bearings=1e10)
+    chain: bearings 1e10 N/m (finite, in the closed form too); measured error ≤ 4e-14.
+    Without the rotary inertia (the chain's masses are the segments')."""
+    sys = system(n, shear=shear, bearings=1e10, rotary=False)
     want = closed_form(n, KGA if shear else None, 1e10)[:2]
     for coord in ("x", "z"):
         got = frequencies(sys, coord, n)[:2]
@@ -190,7 +220,7 @@ def test_bending_converges_to_euler_bernoulli(n: int) -> None:
     """Stiff bearings, no shear: within 2 % of ``(kπ)² √(EI/(m′L⁴))`` for k = 1, 2 at
     N ≥ 10 (issue #25), and the error falls with N as ``N⁻⁴`` (the stiffness is exact, the
     mass lumping is not; measured at N = 10: 7e-6 and 1.2e-4, bound 1e-3 · (10/N)⁴)."""
-    got = frequencies(system(n, shear=False), "z", n)[:2]
+    got = frequencies(system(n, shear=False, rotary=False), "z", n)[:2]
     err = [got[k] / euler_bernoulli(k + 1) - 1 for k in range(2)]
     CONVERGENCE[n] = err
     assert max(abs(e) for e in err) < 0.02, (n, err)
@@ -203,10 +233,11 @@ def test_bending_converges_to_euler_bernoulli(n: int) -> None:
 
 @pytest.mark.parametrize("n", [12, 24])
 def test_shear_follows_the_timoshenko_frequency_equation(n: int) -> None:
-    """Shear on: within 2 % of the Timoshenko frequencies (no rotary inertia) at N = 12,
-    converging as ``N⁻²`` (measured 0.025 % and 0.32 % at N = 12; bound 2 % · (12/N)²);
-    they lie 4.4 % and 15 % below Euler–Bernoulli's for this drum."""
-    got = frequencies(system(n, shear=True), "x", n)[:2]
+    """Shear on, ``rotary_inertia = false``: within 2 % of the Timoshenko frequencies
+    without rotary inertia at N = 12, converging as ``N⁻²`` (measured 0.025 % and 0.32 % at
+    N = 12; bound 2 % · (12/N)²); they lie 4.4 % and 15 % below Euler–Bernoulli's for this
+    drum. With the rotary inertia: tests/parts/test_flex_rotary.py."""
+    got = frequencies(system(n, shear=True, rotary=False), "x", n)[:2]
     for k in range(2):
         assert abs(got[k] / timoshenko(k + 1) - 1) < 0.02 * (12 / n) ** 2, \
             (k, got[k], timoshenko(k + 1))
@@ -217,7 +248,7 @@ def test_free_free_drum() -> None:
     """No bearings: two rigid-body modes, then ``βL = 4.730, 7.853`` within 3 % at N = 12
     (issue #25; measured +1.09 % and +1.85 %)."""
     n = 12
-    w = frequencies(system(n, shear=False, bearings=0.0), "z", n)
+    w = frequencies(system(n, shear=False, bearings=0.0, rotary=False), "z", n)
     assert np.all(w[:2] < 1e-3 * w[2])
     for k, bl in enumerate((4.730, 7.853)):
         want = bl ** 2 * math.sqrt(EI / (MPL * L ** 4))
@@ -262,22 +293,14 @@ def test_torsion_chain_of_disks(n: int) -> None:
 
 
 def test_damping_ratio_of_the_first_bending_mode() -> None:
-    """``damping_ratio`` ζ: the first bending mode of the machine decays with ζ."""
+    """``damping_ratio`` ζ: the first bending mode of the machine decays with ζ (with the
+    sections' rotary inertia, the default, and without)."""
     n, zeta = 8, 0.02
-    sys = system(n, shear=True, bearings=1e10, damping=zeta)
-    y0 = sys.initial_state()
-    idx = [sys.index(f"front_s{i}.x") for i in range(n)]
-    idv = [sys.index(f"front_s{i}.x_dot") for i in range(n)]
-    A = np.zeros((2 * n, 2 * n))
-    h = 1e-3
-    for k, c in enumerate(idx + idv):
-        a, b = y0.copy(), y0.copy()
-        a[c] += h
-        b[c] -= h
-        A[:, k] = (sys.rhs(0.0, a)[idx + idv] - sys.rhs(0.0, b)[idx + idv]) / (2 * h)
-    lam = np.linalg.eigvals(A)
-    first = min(lam, key=lambda s: abs(s))
-    assert abs(-first.real / abs(first) - zeta) < 1e-6
+    for rotary in (True, False):
+        sys = system(n, shear=True, bearings=1e10, damping=zeta, rotary=rotary)
+        lam = np.linalg.eigvals(state_matrix(sys, bending_states(sys, "x", n)))
+        first = min(lam, key=lambda s: abs(s))
+        assert abs(-first.real / abs(first) - zeta) < 1e-6, (rotary, first)
 
 
 def test_a_speed_profile_drum_drives_segment_zero_and_twists() -> None:

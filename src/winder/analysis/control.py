@@ -44,7 +44,8 @@ INPUT_KINDS = {
 #: The unit of a state, by its name after the body's (``set.z_dot`` → ``z_dot``).
 STATE_UNITS = {"x": "m", "z": "m", "theta": "rad", "x_dot": "m/s", "z_dot": "m/s",
                "theta_dot": "rad/s", "radius": "m", "friction": "N", "tension": "N",
-               "tension_integral": "N·s"}
+               "tension_integral": "N·s", "tilt_x": "rad", "tilt_z": "rad",
+               "tilt_rate_x": "rad/s", "tilt_rate_z": "rad/s"}
 #: The time, the last parameter of ``p``.
 TIME_PARAMETER = "t"
 

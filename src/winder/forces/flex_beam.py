@@ -12,7 +12,12 @@ machine without flexible bodies never builds it. Per flexible body ``NAME`` with
 
 with the run-time parameters ``NAME.flex.Kx_i_j`` [N/m], ``NAME.flex.Cx_i_j`` [N·s/m]
 (``i ≤ j``, symmetric; ``Kz``, ``Cz`` likewise), ``NAME.flex.k_t`` [N·m/rad] and
-``NAME.flex.c_t`` [N·m·s/rad]. The bearings hold the axes a segment lists in
+``NAME.flex.c_t`` [N·m·s/rad]. With the sections' rotary inertia (``flex.rotary_inertia``,
+the default; issue #32) each segment has the states ``NAME_s{i}.tilt_x``, ``.tilt_z``
+[rad] and ``.tilt_rate_x``, ``.tilt_rate_z`` [rad/s] and the bending is that of
+:func:`~winder.model.beam.rotary_beam_matrices` (parameters ``Kx`` as above, ``Tx``,
+``Kwpx``, ``Kppx``, ``Cwwx``, ``Cwpx``, ``Cppx`` and their ``z``:
+:meth:`_rotary_bending`). The bearings hold the axes a segment lists in
 ``bearing_axes`` (a drum: ``x`` and ``z``; a rider: ``x``; a roll on chucks: its free
 axes); along the others the beam is free–free (it rests on its nip). A paper roll's
 ``EI(r)`` changes at run time: its stiffness is ``EI(r)`` times the unit beam's, on chucks
@@ -103,11 +108,37 @@ class FlexBeam(ForceElement):
         self.groups: dict[str, list[Any]] = {}
         #: the slices of each sliced scene nip, by its name
         self.sliced: dict[str, list[Any]] = {}
+        #: whether each flexible drum or rider has its sections' rotary inertia
+        self.rotary: dict[str, bool] = {}
+
+    @staticmethod
+    def _declare_rotary(machine: Machine, body: str, segs: list[Any], axis: str,
+                        bm: Any) -> None:
+        """The parameters of a beam with its sections' rotary inertia along ``axis``
+        (:class:`~winder.model.beam.RotaryBeamMatrices`; the band ``|i − j| ≤ 1`` of
+        ``K̂``, ``C``) and each segment's states ``tilt_{axis}`` (``φ``) and
+        ``tilt_rate_{axis}`` (``s = ψ̇``), 0 at the start."""
+        n = len(segs)
+        for kind, matrix, sym, band in (("K", bm.K, True, False), ("T", bm.T, False, False),
+                                        ("Kwp", bm.K_wp, False, True),
+                                        ("Kpp", bm.K_pp, True, True),
+                                        ("Cww", bm.C_ww, True, True),
+                                        ("Cwp", bm.C_wp, False, True),
+                                        ("Cpp", bm.C_pp, True, True)):
+            for i in range(n):
+                for j in range(i if sym else 0, n):
+                    if not band or abs(i - j) <= 1:
+                        machine.parameter(f"{body}.flex.{kind}{axis}_{i}_{j}", matrix[i, j])
+        for seg in segs:
+            machine.state(f"{seg.name}.tilt_{axis}", 0.0)
+            machine.state(f"{seg.name}.tilt_rate_{axis}", 0.0)
 
     def declare(self, machine: Machine) -> None:
-        from winder.model.beam import beam_matrices  # NumPy: not for checking a scene
+        # NumPy: not for checking a scene
+        from winder.model.beam import beam_matrices, rotary_beam_matrices
 
         self.groups = {}
+        self.rotary = {}
         for b in machine.bodies:
             seg = b.segment
             if self.name in b.drives and seg is not None:
@@ -138,13 +169,18 @@ class FlexBeam(ForceElement):
                 machine.parameter(f"{body}.flex.k_t", unit.k_t)
                 machine.channel(TWIST, body)
                 continue
+            self.rotary[body] = flex.rotary_inertia
             for axis in ("x", "z"):
                 held = axis in first.bearing_axes
-                bm = beam_matrices(n, first.length, part.mass, flex.EI,
-                                   flex.kGA if flex.shear else None,
-                                   flex.bearing_stiffness if held else 0.0,
-                                   flex.bearing_damping if held else 0.0,
-                                   flex.damping_ratio, flex.GJ)
+                args = (flex.EI, flex.kGA if flex.shear else None,
+                        flex.bearing_stiffness if held else 0.0,
+                        flex.bearing_damping if held else 0.0, flex.damping_ratio, flex.GJ)
+                if flex.rotary_inertia:
+                    bm = rotary_beam_matrices(n, first.length, part.mass, part.inertia,
+                                              *args)
+                    self._declare_rotary(machine, body, segs, axis, bm)
+                    continue
+                bm = beam_matrices(n, first.length, part.mass, *args)
                 for kind, matrix in (("K", bm.K), ("C", bm.C)):
                     for i in range(n):
                         for j in range(i, n):
@@ -207,6 +243,41 @@ class FlexBeam(ForceElement):
         kt = p(f"{body}.flex.k_t")
         return kt, beta * kt
 
+    @staticmethod
+    def _rotary_bending(ev: Evaluation, body: str, segs: list[Any], axis: str,
+                        u: list[Any], v: list[Any]) -> list[Any]:
+        """Bending along ``axis`` with the sections' rotary inertia
+        (:func:`~winder.model.beam.rotary_beam_matrices`): the rates of the segments'
+        ``tilt_{axis}`` (``φ̇ = s − T ẇ``) and ``tilt_rate_{axis}`` (``ṡ = (−K_ψψ φ −
+        C_ψw ẇ − C_ψψ s)/j_r``, ``j_r`` half the segment's polar inertia); returns the
+        forces on the segments ``−K w − K_wψ φ − C_ww ẇ − C_wψ s`` [N]."""
+        p, n = ev.p, len(segs)
+
+        def par(kind: str, i: int, j: int, sym: bool = False) -> Any:
+            a, b = (min(i, j), max(i, j)) if sym else (i, j)
+            return p(f"{body}.flex.{kind}{axis}_{a}_{b}")
+
+        phi = [ev.x(f"{s.name}.tilt_{axis}") for s in segs]
+        rate = [ev.x(f"{s.name}.tilt_rate_{axis}") for s in segs]
+        forces = []
+        for i, seg in enumerate(segs):
+            f: Any = 0.0
+            for j in range(n):
+                f = f - par("K", i, j, True) * u[j]
+            g: Any = 0.0
+            for j in range(max(i - 1, 0), min(i + 2, n)):
+                f = f - par("Kwp", i, j) * phi[j] - par("Cww", i, j, True) * v[j] \
+                    - par("Cwp", i, j) * rate[j]
+                g = g - par("Kpp", i, j, True) * phi[j] - par("Cwp", j, i) * v[j] \
+                    - par("Cpp", i, j, True) * rate[j]
+            forces.append(f)
+            lag: Any = rate[i]
+            for j in range(n):
+                lag = lag - par("T", i, j) * v[j]
+            ev.set_rate(f"{seg.name}.tilt_{axis}", lag)
+            ev.set_rate(f"{seg.name}.tilt_rate_{axis}", 2.0 * g / p(f"{seg.name}.inertia"))
+        return forces
+
     def _nip_channels(self, ev: Evaluation) -> None:
         """The sliced scene nips' own channels (see the module text)."""
         mathns = ev.mathns
@@ -243,6 +314,12 @@ class FlexBeam(ForceElement):
 
             if segs[0].roles.paper:
                 kt, ct = self._roll_bending(ev, body, segs, states, ux, uz)
+            elif self.rotary[body]:
+                fx = self._rotary_bending(ev, body, segs, "x", ux, [bs.vx for bs in states])
+                fz = self._rotary_bending(ev, body, segs, "z", uz, [bs.vz for bs in states])
+                for seg, f, g in zip(segs, fx, fz, strict=True):
+                    ev.add_force(seg.name, f, g)
+                kt, ct = ev.p(f"{body}.flex.k_t"), ev.p(f"{body}.flex.c_t")
             else:
                 for i, seg in enumerate(segs):
                     fx: Any = 0.0

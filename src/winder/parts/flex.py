@@ -35,6 +35,11 @@ FLEX_KEYS = Table((
         doc="bending stiffness E·I of the beam"),
     Key(name="shear", kind="bool",
         doc="true: Timoshenko beam (shear stiffness kGA); false: Euler–Bernoulli"),
+    Key(name="rotary_inertia", kind="bool",
+        doc="true: the sections' rotary inertia about the bending axes, J/(2N) per segment "
+            "(half its polar inertia), on the section's rotation, a degree of freedom of "
+            "its own (the full Timoshenko beam; with shear = false, Rayleigh's); false: "
+            "the deflections alone carry mass"),
     Key(name="kGA", unit="N", lo=0.0, lo_open=True, hi=1e18,
         default_text="required when shear = true",
         doc="shear stiffness k·G·A of the beam (Timoshenko)"),
@@ -61,6 +66,7 @@ class FlexPart:
     GJ: float
     shear: bool = True
     kGA: float | None = None
+    rotary_inertia: bool = True
     bearing_stiffness: float = 1e9
     bearing_damping: float = 0.0
     damping_ratio: float = 0.01
