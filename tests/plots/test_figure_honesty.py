@@ -15,6 +15,7 @@ import winder
 import winder.plots.figures as _plots
 from winder.cli import main
 from winder.plots.campbell import campbell_figure
+from winder.plots.machine import machine_figures
 
 
 def test_torque_panels_full_range_and_clipped_share() -> None:
@@ -69,7 +70,7 @@ def test_a_nip_has_one_colour_in_run_figures_and_resonance_map(tmp_path, monkeyp
     scene = winder.load_scene(MODELS / "two_drum_winder.toml")
     short = winder.simulate(scene, t_end=0.5, output_step=0.005)
     seen = _colours(monkeypatch)
-    _plots.machine_figures(short, tmp_path, scene=scene)
+    machine_figures(short, tmp_path, scene=scene)
     # the resonance map of the command line, its envelope from the same short run
     import winder.solve.simulate as sim
 

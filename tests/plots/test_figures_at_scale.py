@@ -20,6 +20,7 @@ from winder.parts import body_elements
 from winder.plots.campbell import campbell_figure
 from winder.plots.flex import deflection, flexible_bodies
 from winder.plots.layout import DPI, MAX_HEIGHT_PX, line_styles
+from winder.plots.machine import machine_figures
 from winder.plots.positions import positions_figures
 from winder.plots.smooth import bounce, centred_mean, dirichlet_gain, window_samples
 
@@ -98,7 +99,7 @@ def test_run_figures_of_the_flexible_machine(flex_run, tmp_path, monkeypatch) ->
     values are the channels' deflections, exactly), not a row per segment."""
     scene, res = flex_run
     seen = _capture(monkeypatch)
-    paths = _plots.machine_figures(res, tmp_path, scene=scene)
+    paths = machine_figures(res, tmp_path, scene=scene)
     assert len(seen) == len(paths) >= 12
     for p in paths:  # the PNGs as written
         assert mimage.imread(p).shape[0] <= MAX_HEIGHT_PX, p.name

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 
 import winder
-import winder.plots.figures as _plots
 from winder.parts import whole_elements
 from winder.plots.flex import deflection, flexible_bodies, line_load_map
+from winder.plots.machine import machine_figures
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "parts"))
 import test_flex_roll as roll  # noqa: E402
@@ -23,7 +23,7 @@ def test_flexible_parts_have_their_figures(tmp_path: Path) -> None:
         "bearing_stiffness = 1e10, damping_ratio = 0.02 }"
     scene = roll.scene(3, drum=drum, damping=0.05)
     res = winder.simulate(scene, t_end=0.05)
-    paths = _plots.machine_figures(res, tmp_path, scene=scene)
+    paths = machine_figures(res, tmp_path, scene=scene)
     names = {p.name for p in paths}
     assert {"flexroll_flex_drum.png", "flexroll_flex_roll.png",
             "flexroll_line_load_nip.png"} <= names

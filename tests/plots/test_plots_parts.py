@@ -21,6 +21,8 @@ from winder.analysis.sweep_summary import (
     summarise,
 )
 from winder.cli import main
+from winder.plots.machine import machine_figures
+from winder.plots.run import run_figures
 from winder.solve.equilibrium import EquilibriumError
 
 TWO_DRUM = MODELS / "two_drum_winder.toml"
@@ -59,7 +61,7 @@ def _drawn(monkeypatch: pytest.MonkeyPatch) -> dict[str, list[tuple[str, dict]]]
 # ---- figures --------------------------------------------------------------------------------
 def test_parts_figures_draw_the_channels(short_run, two_drum, tmp_path, monkeypatch) -> None:
     drawn = _drawn(monkeypatch)
-    paths = _plots.paper_figures(short_run, tmp_path, scene=two_drum)
+    paths = run_figures(short_run, tmp_path, scene=two_drum)
     stem = "two_drum_winder"
     names = [f"{stem}_{k}.png" for k in ("drums", "rolls", "nip_forces", "positions", "slip")]
     assert [p.name for p in paths] == names
@@ -128,7 +130,7 @@ def test_parts_figures_find_their_scene_in_the_result(short_run, tmp_path) -> No
     name never leaves the directory."""
     res = winder.Result(dict(short_run) , dict(short_run.meta, scene="../../x\0y"))
     out = tmp_path / "plots"
-    paths = _plots.paper_figures(res, out)
+    paths = run_figures(res, out)
     assert len(paths) == 5 and [p.parent for p in paths] == [out] * 5
     assert sorted(tmp_path.rglob("*")) == [out, *sorted(paths)]
 
@@ -312,7 +314,7 @@ def test_closeup_shows_the_first_opening(short_run, two_drum, tmp_path, monkeypa
     res = winder.Result(dict(short_run) | {"rear_nip_normal_force": rear,
                                            "rider_nip_normal_force": rider}, short_run.meta)
     drawn = _drawn(monkeypatch)
-    _plots.machine_figures(res, tmp_path, scene=two_drum)
+    machine_figures(res, tmp_path, scene=two_drum)
     *_, (title, lines) = drawn["two_drum_winder_nip_forces.png"]
     assert title.startswith("close-up: first opening, nip rear_nip (rear–set) at t ≈ 0.50 s")
     w = (t >= 0.2) & (t <= 1.5)
@@ -334,7 +336,7 @@ def test_axis_labels_come_from_the_result_units(short_run, two_drum, tmp_path,
         return save(fig, path)
 
     monkeypatch.setattr(_plots, "_save", capture)
-    _plots.machine_figures(short_run, tmp_path, scene=two_drum)
+    machine_figures(short_run, tmp_path, scene=two_drum)
     stem = "two_drum_winder"
     drums, nips = labels[f"{stem}_drums.png"], labels[f"{stem}_nip_forces.png"]
     assert drums[0][0] == "speed Ω [rad/s]" and drums[1][0] == "torque [kN·m]"
@@ -346,12 +348,12 @@ def test_axis_labels_come_from_the_result_units(short_run, two_drum, tmp_path,
     other = winder.Result(dict(short_run), short_run.meta,
                           units={**short_run.units, "front_speed": "rev/min", "t": "min",
                                  "front_torque": "lbf·ft"})
-    _plots.machine_figures(other, tmp_path, scene=two_drum)
+    machine_figures(other, tmp_path, scene=two_drum)
     drums = labels[f"{stem}_drums.png"]
     assert drums[0][0] == "speed Ω [rev/min]" and drums[1][0] == "torque [klbf·ft]"
     assert drums[-1][1] == "t [min]"
     labels.clear()
-    _plots.machine_figures(winder.Result(dict(short_run), short_run.meta), tmp_path,
+    machine_figures(winder.Result(dict(short_run), short_run.meta), tmp_path,
                            scene=two_drum)
     assert labels[f"{stem}_drums.png"][0][0] == "speed Ω"
     assert not any("[" in y + x for rows in labels.values() for y, x in rows)

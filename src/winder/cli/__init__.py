@@ -160,12 +160,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     items: list[tuple[Path, Callable[[Path], object]]] = [
         (f, result._writer(f)) for f in files]
     if plots is not None:  # rendered first, then written with the result: all or nothing
-        from winder.plots.figures import CLOSEUP_STEP, closeup_end, collected, paper_figures
+        from winder.plots.figures import CLOSEUP_STEP, closeup_end, collected
+        from winder.plots.run import run_figures
 
         end = closeup_end(result)  # Fig. 8's close-up of the first lift-off, finely sampled
         closeup = None if end is None else simulate(scene, t_end=end, output_step=CLOSEUP_STEP)
         with collected() as pngs:
-            figures = paper_figures(result, plots, scene=scene, closeup=closeup)
+            figures = run_figures(result, plots, scene=scene, closeup=closeup)
         items += [(p, lambda tmp, data=data: tmp.write_bytes(data)) for p, data in pngs]
     from winder.io.files import atomic_write_all
 

@@ -25,7 +25,7 @@ from winder.plots.layout import DPI  # noqa: E402
 from winder.plots.smooth import centred_mean  # noqa: E402
 from winder.scene.load import Scene  # noqa: E402
 
-__all__ = ["paper_figures", "closeup_end", "CLOSEUP_STEP", "machine_figures",
+__all__ = ["paper_figures", "closeup_end", "CLOSEUP_STEP",
            "normal_force_envelope", "window_mean", "nip_colours", "NIP_COLOURS",
            "MODE_COLOURS", "collected"]
 
@@ -104,11 +104,9 @@ def paper_figures(result: Result, out_dir: str | Path, *, scene: Scene | None = 
     close-up of the first lift-off (Fig. 8; ``closeup`` is a finely sampled result of
     that window, up to :func:`closeup_end`; without it the panel shows the first 60 s of
     ``result``). Without contact: the free
-    spin ω with the conserved ``J ω`` (Fig. 2). A result of a scene of parts gets
-    :func:`machine_figures` instead.
+    spin ω with the conserved ``J ω`` (Fig. 2). A result of a scene of parts:
+    :func:`winder.plots.run.run_figures` draws :func:`winder.plots.machine.machine_figures`.
     """
-    if "normal_force" not in result:  # a scene of parts: channels of machines.md §9
-        return machine_figures(result, out_dir, scene=scene)
     out = Path(out_dir)
     name = _label(result.meta.get("scene", "result"))  # for titles
     stem = safe_stem(result.meta.get("scene", "result"))  # no scene text picks the directory
@@ -271,8 +269,3 @@ def normal_force_envelope(result: Result, window: float = 0.5, *,
     fn, r = fn[:n * w].reshape(n, w), r[:n * w].reshape(n, w)
     lo, hi = fn.min(axis=1), fn.max(axis=1)
     return r.mean(axis=1), lo, hi, (hi - lo) / 2
-
-
-# the figures of a scene of parts, written through this module's _save (imported last: it
-# reads this module's names when it draws)
-from winder.plots.machine import machine_figures  # noqa: E402

@@ -5,7 +5,7 @@ heat map) with its least, largest and mean value.
 They are drawn from the result's channels only (``NAME_s{i}_x``, ``NAME_s{i}_z``,
 ``NAME_twist``, ``NIP_s{i}_normal_force``, ``NIP_line_load_*``) and the scene's parts (each
 flexible part's ``flex`` and its length), and called by
-:func:`winder.plots.figures.machine_figures` for a scene that has flexible parts."""
+:func:`winder.plots.machine.machine_figures` for a scene that has flexible parts."""
 
 from __future__ import annotations
 
