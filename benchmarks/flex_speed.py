@@ -6,16 +6,21 @@ sliced): N = 1 is the rigid drum. For each N: the time to generate and compile i
 into an empty cache, the generated right-hand side and exact Jacobian called the way the
 compiled integrators call them (the C loop of the machine's library), and the numeric
 Pinocchio path (``MachineSystem(scene, backend="pinocchio").rhs``). Best of repeats (the
-machine may be loaded).
+machine may be loaded). The build is timed in wall seconds and in CPU seconds (this
+process and the compiler processes: a loaded machine stretches the first, not the second);
+the slopes of log cost against log N between the two largest N (issue #33: at most
+log(4.5)/log(4) = 1.08 from N = 8 to 32).
 
-Run:  python benchmarks/flex_speed.py [--quick]
+Run:  python benchmarks/flex_speed.py [--quick] [--sizes 1 4 8 16 32] [--no-numeric]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
+import resource
 import shutil
 import sys
 import tempfile
@@ -87,7 +92,13 @@ def scene(n: int) -> winder.Scene:
                                   source=f"flex_speed_{n}.toml")
 
 
-def measure(n: int, quick: bool) -> dict[str, float]:
+def _cpu() -> float:
+    """CPU seconds of this process and its finished children [s]."""
+    return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
+                                                 resource.getrusage(resource.RUSAGE_CHILDREN)))
+
+
+def measure(n: int, quick: bool, numeric: bool = True) -> dict[str, float]:
     sc = scene(n)
     with tempfile.TemporaryDirectory() as cache:
         # the C integrators' objects are built once per cache, not per machine: copied in
@@ -95,9 +106,9 @@ def measure(n: int, quick: bool) -> dict[str, float]:
         old = os.environ.get("WINDER_CACHE_DIR")
         os.environ["WINDER_CACHE_DIR"] = cache
         try:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), _cpu()
             gen = MachineSystem(sc)
-            compile_s = time.perf_counter() - t0
+            compile_s, compile_cpu = time.perf_counter() - t0, _cpu() - c0
         finally:
             if old is None:
                 del os.environ["WINDER_CACHE_DIR"]
@@ -113,35 +124,64 @@ def measure(n: int, quick: bool) -> dict[str, float]:
                          1, reps) / calls
         jac_us = best_us(lambda: loop(fns, integ.F_JAC, calls, 0.1, y, p, m, out_jac),
                          1, reps) / calls
-    num = MachineSystem(sc, backend="pinocchio")
-    k = 20 if quick else 100
-    num_us = best_us(lambda: [num.rhs(0.1, y) for _ in range(k)], k, reps)
+    num_us = float("nan")
+    if numeric:
+        num = MachineSystem(sc, backend="pinocchio")
+        k = 20 if quick else 100
+        num_us = best_us(lambda: [num.rhs(0.1, y) for _ in range(k)], k, reps)
     return {"segments": n, "states": gen.n_states, "compile_s": compile_s,
+            "compile_cpu_s": compile_cpu, "jac_nnz": _jac_nnz(gen, y),
             "rhs_us": rhs_us, "jac_us": jac_us, "numeric_rhs_us": num_us}
+
+
+def _jac_nnz(system: MachineSystem, y: np.ndarray) -> int:
+    """Nonzeros of the exact Jacobian at ``y`` (the structural ones that are not 0 there)."""
+    return int(np.count_nonzero(system.jac(0.1, y)))
+
+
+def slopes(rows: list[dict[str, float]]) -> dict[str, float]:
+    """log-log slopes of the costs between the two largest N."""
+    a, b = rows[-2], rows[-1]
+    r = math.log(b["segments"] / a["segments"])
+    return {k: math.log(b[k] / a[k]) / r for k in ("compile_s", "compile_cpu_s", "rhs_us",
+                                                    "jac_us", "jac_nnz")}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer calls and repeats")
+    ap.add_argument("--sizes", type=int, nargs="+", default=[1, 4, 8, 16, 32],
+                    help="segments per drum")
+    ap.add_argument("--no-numeric", action="store_true", help="skip the Pinocchio path")
     args = ap.parse_args()
     rows = []
-    for n in (1, 4, 8, 16):
-        rows.append(measure(n, args.quick))
+    for n in args.sizes:
+        rows.append(measure(n, args.quick, not args.no_numeric))
         print(rows[-1], flush=True)
+    slope = slopes(rows) if len(rows) > 1 else {}
     lines = ["# Flexible drum: cost per evaluation and compile time", "",
              "`python benchmarks/flex_speed.py`: the single-drum winder with a flexible "
              "drum of N segments (N = 1: rigid), its nip sliced; generated code called "
              "in the C loop of its library, the numeric Pinocchio path from Python; best "
              "of repeats on a shared 2-core machine.", "",
-             "| N | states | compile [s] | rhs [µs] | Jacobian [µs] | numeric rhs [µs] |",
-             "|---|---|---|---|---|---|"]
+             "| N | states | build [s] | build CPU [s] | rhs [µs] | Jacobian nonzeros | "
+             "Jacobian [µs] | numeric rhs [µs] |",
+             "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['segments']} | {r['states']} | {r['compile_s']:.1f} | "
-                     f"{r['rhs_us']:.2f} | {r['jac_us']:.1f} | {r['numeric_rhs_us']:.0f} |")
+                     f"{r['compile_cpu_s']:.1f} | {r['rhs_us']:.2f} | {r['jac_nnz']} | "
+                     f"{r['jac_us']:.1f} | {r['numeric_rhs_us']:.0f} |")
+    if slope:
+        a, b = rows[-2]["segments"], rows[-1]["segments"]
+        lines += ["", f"log-log slopes from N = {a} to {b} (1: linear): build "
+                  f"{slope['compile_s']:.2f} (CPU {slope['compile_cpu_s']:.2f}), rhs "
+                  f"{slope['rhs_us']:.2f}, Jacobian {slope['jac_us']:.2f} (its nonzeros "
+                  f"{slope['jac_nnz']:.2f})."]
     text = "\n".join(lines) + "\n"
     atomic_write(DOCS / "flex_speed.md", lambda p: p.write_text(text, encoding="utf-8"))
     atomic_write(DOCS / "flex_speed.json",
-                 lambda p: p.write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8"))
+                 lambda p: p.write_text(json.dumps({"rows": rows, "slopes": slope}, indent=1)
+                                        + "\n", encoding="utf-8"))
     print(text)
 
 
