@@ -52,21 +52,21 @@ FUNCTIONS = ("rhs", "jac", "out", "sw")
 #: into the functions that call them rather than called through the PLT (the rhs 1.7×
 #: faster; the same operations, so the same results).
 CFLAGS = ("-O3", "-shared", "-fPIC", "-fno-semantic-interposition")
-#: The optimisation level of each generated function's object (:func:`function_flags`): the
+#: The optimisation level of each generated function's object (:func:`level`): the
 #: right-hand side and the switching functions, called at every stage of every step, at -O3;
 #: the Jacobian and the channels, called once per step or per output, at -Og (as fast as
 #: -O1 at run time, 30 % cheaper to compile). None changes a result: no fast-math, no FMA
 #: contraction on the default target.
 OPTIMISE = {"rhs": "-O3", "jac": "-Og", "out": "-Og", "sw": "-O3"}
 #: A Jacobian or channel function of more CasADi instructions than this compiles at -O0:
-#: the compiler's time grows with the function (register allocation: 11 s at -O1, 7.8 s
-#: at -Og, 3.9 s at -O0 for the flexible two-drum winder's Jacobian of 58,825
-#: instructions, 4800 nonzeros; it then runs in 48 µs rather than 20 µs, once per step of
-#: an implicit method).
-LARGE = 20000
+#: the compiler's time grows with the function (the flexible two-drum winder's Jacobian of
+#: 58,825 instructions, 4800 nonzeros: 11 s CPU at -O1, 7.8 s at -Og, 3.9 s at -O0, where it
+#: runs in 48 µs rather than 20 µs, once per step of an implicit method; its channels, 8394
+#: instructions: 2.0 s at -O1, 0.7 s at -O0). The rigid machines stay under it.
+LARGE = 5000
 #: The layout of the generated code (in the cache key): one C file per function, the
 #: Jacobian on its nonzeros scattered by its flat entry point, CasADi's null checks removed.
-LAYOUT = "split-sparse-jac-unguarded-1"
+LAYOUT = "split-sparse-jac-unguarded-2"
 #: ``WINDER_SANITIZE=1`` (``make test-asan``): AddressSanitizer and UBSan on every object
 #: and the link (Python then needs libasan preloaded; see the Makefile).
 SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
@@ -288,8 +288,9 @@ def _unguarded(code: str) -> str:
 def _flat_entry(symbol: str, k: str, f: Any, sparsity: Any) -> str:
     """The flat, reentrant entry point ``SYMBOL_K_flat(t, x, p, m, out)`` of one generated
     function; for the Jacobian (``sparsity``: its CCS pattern) the nonzeros are written to
-    the front of ``out`` and moved in place to their dense column-major places, last first
-    (the dense place of the k-th nonzero is never before k), the rest set to 0."""
+    the front of ``out``, the rest is set to 0 (one ``memset``) and each nonzero moved to its
+    dense column-major place, last first (the place of the k-th nonzero is never before k,
+    so none is overwritten before it moves)."""
     head = (f"\n/* flat, reentrant entry point */\n"
             f"int {symbol}_{k}_flat(const double* t, const double* x, const double* p, "
             f"const double* m, double* out) {{\n"
@@ -302,16 +303,17 @@ def _flat_entry(symbol: str, k: str, f: Any, sparsity: Any) -> str:
     rows, cols = sparsity.get_triplet()
     place = [int(r) + n * int(c) for r, c in zip(rows, cols, strict=True)]
     lines = [", ".join(str(v) for v in place[i:i + 16]) for i in range(0, len(place), 16)]
-    table = (f"static const casadi_int {symbol}_jac_place[{max(nnz, 1)}] = {{\n  "
+    table = ("#include <string.h>\n"
+             f"static const casadi_int {symbol}_jac_place[{max(nnz, 1)}] = {{\n  "
              + ",\n  ".join(lines or ["0"]) + "};\n")
     return (table + head
             + f"  int flag = {symbol}_{k}(arg, res, iw, w, 0);\n"
-            f"  casadi_int end = {n * n}, i, k;\n"
+            f"  casadi_int k;\n"
+            f"  memset(out + {nnz}, 0, sizeof(double) * {n * n - nnz});\n"
             f"  for (k = {nnz} - 1; k >= 0; k--) {{\n"
-            f"    casadi_int d = {symbol}_jac_place[k];\n"
-            f"    for (i = d + 1; i < end; i++) out[i] = 0.;\n"
-            f"    out[d] = out[k];\n    end = d;\n  }}\n"
-            f"  for (i = 0; i < end; i++) out[i] = 0.;\n"
+            f"    double v = out[k];\n"
+            f"    out[k] = 0.;\n"
+            f"    out[{symbol}_jac_place[k]] = v;\n  }}\n"
             f"  return flag;\n}}\n")
 
 
