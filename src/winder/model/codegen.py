@@ -55,14 +55,14 @@ CFLAGS = ("-O3", "-shared", "-fPIC", "-fno-semantic-interposition")
 #: The optimisation level of each generated function's object (:func:`level`): the
 #: right-hand side and the switching functions, called at every stage of every step, at -O3;
 #: the Jacobian and the channels, called once per step or per output, at -Og (as fast as
-#: -O1 at run time, 30 % cheaper to compile). None changes a result: no fast-math, no FMA
-#: contraction on the default target.
+#: -O1 at run time, 30 % cheaper to compile: the flexible two-drum winder's Jacobian, 58,825
+#: instructions, 7.8 s CPU against 10.9 s at -O1 and 24.7 s at -O3, 20 µs a call). None
+#: changes a result: no fast-math, no FMA contraction on the default target.
 OPTIMISE = {"rhs": "-O3", "jac": "-Og", "out": "-Og", "sw": "-O3"}
-#: A Jacobian or channel function of more CasADi instructions than this compiles at -O0:
-#: the compiler's time grows with the function (the flexible two-drum winder's Jacobian of
-#: 58,825 instructions, 4800 nonzeros: 11 s CPU at -O1, 7.8 s at -Og, 3.9 s at -O0, where it
-#: runs in 48 µs rather than 20 µs, once per step of an implicit method; its channels, 8394
-#: instructions: 2.0 s at -O1, 0.7 s at -O0). The rigid machines stay under it.
+#: A channel function of more CasADi instructions than this compiles at -O0 (called once
+#: per output row: the flexible two-drum winder's, 8394 instructions, 2.0 s CPU at -O1, 0.7 s
+#: at -O0). Not the Jacobian: at -O0 it compiles in half the time of -Og (3.9 s) but runs
+#: 2-2.5 times slower (48 against 20 µs; an implicit method calls it every step).
 LARGE = 5000
 #: The layout of the generated code (in the cache key): one C file per function, the
 #: Jacobian on its nonzeros scattered by its flat entry point, CasADi's null checks removed.
@@ -110,9 +110,9 @@ def compile_flags() -> tuple[str, ...]:
 
 def level(which: str, size: int) -> str:
     """The optimisation level of one generated function (one of :data:`FUNCTIONS`) of
-    ``size`` CasADi instructions: :data:`OPTIMISE`, and -O0 for a Jacobian or channel
-    function over :data:`LARGE`."""
-    return "-O0" if which in ("jac", "out") and size > LARGE else OPTIMISE[which]
+    ``size`` CasADi instructions: :data:`OPTIMISE`, and -O0 for a channel function over
+    :data:`LARGE`."""
+    return "-O0" if which == "out" and size > LARGE else OPTIMISE[which]
 
 
 def function_flags(which: str, size: int) -> tuple[str, ...]:
@@ -325,7 +325,7 @@ def _say(line: str) -> None:
 def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
     """The cache key of a machine's generated code (:func:`generate`): its structure, the
     physics' source, CasADi, the route, the layout and every object's flags."""
-    levels = f"{sorted(OPTIMISE.items())} -O0 over {LARGE}"
+    levels = f"{sorted(OPTIMISE.items())} out -O0 over {LARGE}"
     return hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(),
                                     route, LAYOUT, levels, " ".join(cflags))).encode()
                           ).hexdigest()[:20]
