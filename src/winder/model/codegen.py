@@ -3,12 +3,19 @@ functions, compiled once per structure and cached on disk.
 
 The machine's dynamics (:meth:`~winder.model.machine.Machine.evaluate`) runs once on CasADi
 symbols; four functions of ``(t, x, p, m)`` (time, state, parameters, locked modes) are
-generated as C, wrapped with flat entry points ``int NAME(const double* t, const double*
-x, const double* p, const double* m, double* out)`` and compiled with the system C
-compiler into an object file. The cache key is everything that changes the generated
-code: the machine's structure (:meth:`~winder.model.machine.Machine.structure_key`), the
-source of the physics (:mod:`winder.model`, :mod:`winder.parts`, :mod:`winder.forces`),
-the CasADi version and the compiler flags.
+generated as C, one file each, wrapped with flat entry points ``int NAME(const double* t,
+const double* x, const double* p, const double* m, double* out)``. Each file goes to its
+own compiler process as soon as it is written (the right-hand side first: it compiles while
+the Jacobian is generated), at the optimisation level of its function (:data:`OPTIMISE`),
+and the four objects are joined into one relocatable object. The Jacobian is generated on
+its structural nonzeros only; its flat entry point scatters them into the dense
+column-major matrix its callers expect. CasADi's null checks on each argument read and
+result written are removed (the flat entry points pass them all): one branch per element
+made the compiler's time grow faster than the function. The cache key is everything that
+changes the generated code: the machine's structure
+(:meth:`~winder.model.machine.Machine.structure_key`), the source of the physics
+(:mod:`winder.model`, :mod:`winder.parts`, :mod:`winder.forces`), the CasADi version, the
+layout (:data:`LAYOUT`) and the compiler flags and levels.
 
 The machine's library links that object with the objects the caller brings (the
 integrators of :mod:`winder.solve.cint`: ``generate(machine, link=...)``), cached under a
