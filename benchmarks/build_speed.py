@@ -137,12 +137,20 @@ cache keeps one `.o` per machine); no null checks (the functions are only called
 their flat entry points, which pass every argument); the Jacobian on its nonzeros, moved
 to their dense column-major places by its flat entry point (every caller keeps the dense
 interface: the C integrators, `MachineSystem.jac`, the FMU's directional derivatives);
-optimisation by function: rhs and switching functions -O3, Jacobian and channels -Og, -O0
-over 5,000 instructions (`OPTIMISE`, `LARGE`). Every result is bitwise the same as before
-(rhs, Jacobian, channels and switching functions of four shipped scenes at four states
-each). Run-time cost through the library (thread CPU, best of 30): two-drum rhs 0.233 →
-0.131 µs, Jacobian 1.18 → 0.81 µs; flexible rhs 3.43 → 2.60 µs, Jacobian 56 → 88 µs (-O0;
-at -Og it would run in about 20 µs plus the scatter, for 3.9 s more compile).
+optimisation by function: rhs and switching functions -O3, Jacobian -Og, channels -Og and
+-O0 over 5,000 instructions (`OPTIMISE`, `LARGE`). Every result is bitwise the same as
+before (rhs, Jacobian, channels and switching functions of four shipped scenes at four
+states each). Run-time cost through the library, old and new libraries measured in turn
+(thread CPU, best of 30, two rounds): two-drum rhs 0.139/0.144 → 0.138/0.142 µs, Jacobian
+0.76/0.78 → 0.89/0.89 µs; flexible rhs 2.85/2.79 → 2.83/2.73 µs, Jacobian 39.9/41.1 →
+38.1/36.5 µs. At -O0 the flexible Jacobian compiled in 3.9 s rather than 7.8 s but ran in
+88 µs (13 against 5 µs at N = 8): not taken.
+
+What is left: the Jacobian is about 70 % of the flexible build's compiler time and is only
+called by implicit methods, linearisation, modes and the FMU's directional derivatives; built
+on first use (a second library), a machine run with DOPRI5 would not pay it. Split into
+column blocks (1.08 times the instructions for 2 blocks) it would compile on both cores of
+an idle machine. The symbolic build (2 s of Python) is the floor beyond that.
 """
 
 
