@@ -138,7 +138,10 @@ their flat entry points, which pass every argument); the Jacobian on its nonzero
 to their dense column-major places by its flat entry point (every caller keeps the dense
 interface: the C integrators, `MachineSystem.jac`, the FMU's directional derivatives);
 optimisation by function: rhs and switching functions -O3, Jacobian -Og, channels -Og and
--O0 over 5,000 instructions (`OPTIMISE`, `LARGE`). Every result is bitwise the same as
+-O0 over 5,000 instructions (`OPTIMISE`, `LARGE`); a Jacobian of 2,000 nonzeros or more in
+two column blocks of about half the nonzeros each, two files compiled at once
+(`JAC_SPLIT`; the flexible winder's: 34,550 + 29,015 instructions, 1.08 times the one
+function's 58,825). Every result is bitwise the same as
 before (rhs, Jacobian, channels and switching functions of four shipped scenes at four
 states each). Run-time cost through the library, old and new libraries measured in turn
 (thread CPU, best of 30, two rounds): two-drum rhs 0.139/0.144 → 0.138/0.142 µs, Jacobian
@@ -149,8 +152,9 @@ states each). Run-time cost through the library, old and new libraries measured 
 What is left: the Jacobian is about 70 % of the flexible build's compiler time and is only
 called by implicit methods, linearisation, modes and the FMU's directional derivatives; built
 on first use (a second library), a machine run with DOPRI5 would not pay it. Split into
-column blocks (1.08 times the instructions for 2 blocks) it would compile on both cores of
-an idle machine. The symbolic build (2 s of Python) is the floor beyond that.
+column blocks it compiles on both cores of an idle machine (done; more blocks cost more
+instructions: 1.13 times for 3, 1.21 for 4). The symbolic build (2 s of Python) is the
+floor beyond that.
 """
 
 

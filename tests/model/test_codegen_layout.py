@@ -32,13 +32,18 @@ def _reference(m: Machine, route: str) -> ca.Function:
     return ca.Function("ref", [t, x, p, modes], [ca.densify(o) for o in outs])
 
 
-def test_functions_equal_casadi_bit_for_bit(tmp_path: Path,
+@pytest.mark.parametrize("split", [None, 10])
+def test_functions_equal_casadi_bit_for_bit(split: int | None, tmp_path: Path,
                                             monkeypatch: pytest.MonkeyPatch) -> None:
     """rhs, Jacobian (scattered from its nonzeros into a buffer full of NaN), channels and
     switching functions of the two-drum winder equal CasADi's evaluation exactly at
-    perturbed states (measured: 0 difference everywhere); the Jacobian is sparse (so the
-    scatter is exercised: 77 of 196 entries) and every structural zero is written as 0."""
+    perturbed states (measured: 0 difference everywhere), with the Jacobian in one piece
+    and (``split``: its 88 nonzeros over :data:`JAC_SPLIT`) in two column blocks; the
+    Jacobian is sparse (so the scatter is exercised: 77 of 196 entries) and every
+    structural zero is written as 0."""
     monkeypatch.setenv("WINDER_CACHE_DIR", str(tmp_path))
+    if split is not None:
+        monkeypatch.setattr(codegen, "JAC_SPLIT", split)
     m = Machine(mc.two_drum())
     g = codegen.generate(m)
     ref = _reference(m, g.route)
@@ -79,13 +84,24 @@ def test_levels_and_layout_are_in_the_key(monkeypatch: pytest.MonkeyPatch) -> No
     monkeypatch.setattr(codegen, "LARGE", 1)
     assert codegen._key(m, "py", flags) != base
     monkeypatch.undo()
+    monkeypatch.setattr(codegen, "JAC_SPLIT", 1)
+    assert codegen._key(m, "py", flags) != base
+    monkeypatch.undo()
     assert codegen._key(m, "py", flags) == base
 
 
-def test_sources_one_file_per_function_without_null_checks(tmp_path: Path) -> None:
-    """write_source: one file per function, no ``if (res[0]!=0)`` or ``arg[i]?`` left, the
-    Jacobian's function writes only its nonzeros, each file's level as generate uses it."""
+def test_sources_one_file_per_function_without_null_checks(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """write_source: one file per function (the Jacobian over :data:`JAC_SPLIT` nonzeros in
+    two), no ``if (res[0]!=0)`` or ``arg[i]?`` left, the Jacobian's function writes only its
+    nonzeros, each file's level as generate uses it."""
     m = Machine(mc.two_drum())
+    monkeypatch.setattr(codegen, "JAC_SPLIT", 10)
+    (tmp_path / "split").mkdir()
+    paths, symbol, pattern, levels = codegen.write_source(m, tmp_path / "split")
+    assert [p.name for p in paths] == [f"{symbol}_{k}.c" for k in ("rhs", "jac1", "jac", "out",
+                                                                    "sw")]
+    monkeypatch.undo()
     paths, symbol, pattern, levels = codegen.write_source(m, tmp_path)
     assert [p.name for p in paths] == [f"{symbol}_{k}.c" for k in codegen.FUNCTIONS]
     for path in paths:
