@@ -144,9 +144,10 @@ two column blocks of about half the nonzeros each, two files compiled at once
 function's 58,825). Every result is bitwise the same as
 before (rhs, Jacobian, channels and switching functions of four shipped scenes at four
 states each). Run-time cost through the library, old and new libraries measured in turn
-(thread CPU, best of 30, two rounds): two-drum rhs 0.139/0.144 → 0.138/0.142 µs, Jacobian
-0.76/0.78 → 0.89/0.89 µs; flexible rhs 2.85/2.79 → 2.83/2.73 µs, Jacobian 39.9/41.1 →
-38.1/36.5 µs. At -O0 the flexible Jacobian compiled in 3.9 s rather than 7.8 s but ran in
+(thread CPU, best of 30, two rounds each, the Jacobian in two blocks): two-drum rhs
+0.251/0.131 → 0.136/0.127 µs, Jacobian 1.20/0.70 → 0.83/0.82 µs; flexible rhs 3.47/2.44 →
+3.16/2.53 µs, Jacobian 51.5/35.2 → 51.0/36.2 µs (the rounds differ by the machine's load:
+compare within a round). At -O0 the flexible Jacobian compiled in 3.9 s rather than 7.8 s but ran in
 88 µs (13 against 5 µs at N = 8): not taken.
 
 What is left: the Jacobian is about 70 % of the flexible build's compiler time and is only
