@@ -106,15 +106,17 @@ def _model_header(iface: NativeInterface, symbol: str, guid: str, balance: Balan
     return text + "#endif\n"
 
 
-def _compile(sources: Path, model: str, out: Path, symbol: str, wrappers: tuple[str, ...],
-             sanitize: bool) -> None:
+def _compile(sources: Path, model: str, out: Path, symbol: str, generated: dict[str, str],
+             wrappers: tuple[str, ...], sanitize: bool) -> None:
     base = [f for f in CFLAGS if f != "-shared"] + ["-fvisibility=hidden"]
     if sanitize:
         base = ["-O1" if f == "-O3" else f for f in base] + list(SANITIZE_CFLAGS)
     strict = [*base, "-ffp-contract=off", "-std=c99"]  # as solve/cint.py compiles them
     objs = []
-    for src in (f"{symbol}.c", f"{symbol}_balance.c", *_INTEGRATORS, *wrappers):
+    for src in (*generated, f"{symbol}_balance.c", *_INTEGRATORS, *wrappers):
         flags = base if src.startswith(symbol) else strict
+        if src in generated and not sanitize:  # each at its level, as codegen compiles it
+            flags = [generated[src] if f == "-O3" else f for f in flags]
         obj = sources.parent.parent / (Path(src).stem + ".o")
         run_compiler([*flags, "-I", str(sources), "-c", str(sources / src), "-o", str(obj)],
                      src)
@@ -190,7 +192,8 @@ def build_fmu(scene_path: str | Path, out: str | Path, *, fmi_version: int = 2,
         stage, src = d / "fmu", d / "fmu" / "sources"
         (stage / "binaries" / platform).mkdir(parents=True)
         src.mkdir()
-        _, symbol, pattern = write_source(iface.system.machine, src)
+        paths, symbol, pattern, levels = write_source(iface.system.machine, src)
+        generated = {p.name: lv for p, lv in zip(paths, levels, strict=True)}
         balance = balance_of(iface.system.machine, iface.x0, iface.system.params)
         write_balance_source(iface.system.machine, balance, f"{symbol}_balance", src)
         for f in (*_INTEGRATORS, "events.h"):
@@ -210,8 +213,8 @@ def build_fmu(scene_path: str | Path, out: str | Path, *, fmi_version: int = 2,
         (src / "winder_model.h").write_text(_model_header(iface, symbol, guid, balance),
                                             encoding="utf-8")
         _compile(src, model, stage / "binaries" / platform / f"{model}.so", symbol,
-                 wrappers, sanitize)
-        sources = [f"{symbol}.c", f"{symbol}_balance.c", *_INTEGRATORS, *wrappers]
+                 generated, wrappers, sanitize)
+        sources = [*generated, f"{symbol}_balance.c", *_INTEGRATORS, *wrappers]
         (stage / "modelDescription.xml").write_bytes(model_description(
             iface, model, guid, scene, sources, pattern, fmi_version=fmi_version))
         if fmi_version == 3:

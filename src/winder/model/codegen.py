@@ -3,12 +3,20 @@ functions, compiled once per structure and cached on disk.
 
 The machine's dynamics (:meth:`~winder.model.machine.Machine.evaluate`) runs once on CasADi
 symbols; four functions of ``(t, x, p, m)`` (time, state, parameters, locked modes) are
-generated as C, wrapped with flat entry points ``int NAME(const double* t, const double*
-x, const double* p, const double* m, double* out)`` and compiled with the system C
-compiler into an object file. The cache key is everything that changes the generated
-code: the machine's structure (:meth:`~winder.model.machine.Machine.structure_key`), the
-source of the physics (:mod:`winder.model`, :mod:`winder.parts`, :mod:`winder.forces`),
-the CasADi version and the compiler flags.
+generated as C, one file each, wrapped with flat entry points ``int NAME(const double* t,
+const double* x, const double* p, const double* m, double* out)``. Each file goes to its
+own compiler process as soon as it is written (the right-hand side first: it compiles while
+the Jacobian is generated), at the optimisation level of its function (:data:`OPTIMISE`),
+and the objects are joined into one relocatable object. The Jacobian is generated on
+its structural nonzeros only (in two column blocks, two files, when it is large); its flat
+entry point scatters them into the dense column-major matrix its callers expect. CasADi's
+null checks on each argument read and result written are removed (the flat entry points
+pass them all): one branch per element made the compiler's time grow faster than the
+function. The cache key is everything that
+changes the generated code: the machine's structure
+(:meth:`~winder.model.machine.Machine.structure_key`), the source of the physics
+(:mod:`winder.model`, :mod:`winder.parts`, :mod:`winder.forces`), the CasADi version, the
+layout (:data:`LAYOUT`) and the compiler flags and levels.
 
 The machine's library links that object with the objects the caller brings (the
 integrators of :mod:`winder.solve.cint`: ``generate(machine, link=...)``), cached under a
@@ -25,11 +33,13 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -41,7 +51,8 @@ from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
            "stats", "Link", "compile_flags", "link_flags", "run_compiler",
-           "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash", "write_source"]
+           "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash", "write_source",
+           "OPTIMISE", "function_flags", "LAYOUT", "LARGE", "level", "JAC_SPLIT"]
 
 #: The generated functions, in the order of :attr:`Generated.addresses`.
 FUNCTIONS = ("rhs", "jac", "out", "sw")
@@ -49,6 +60,25 @@ FUNCTIONS = ("rhs", "jac", "out", "sw")
 #: into the functions that call them rather than called through the PLT (the rhs 1.7×
 #: faster; the same operations, so the same results).
 CFLAGS = ("-O3", "-shared", "-fPIC", "-fno-semantic-interposition")
+#: The optimisation level of each generated function's object (:func:`level`): the
+#: right-hand side and the switching functions, called at every stage of every step, at -O3;
+#: the Jacobian and the channels, called once per step or per output, at -Og (as fast as
+#: -O1 at run time, 30 % cheaper to compile: the flexible two-drum winder's Jacobian, 58,825
+#: instructions, 7.8 s CPU against 10.9 s at -O1 and 24.7 s at -O3, 20 µs a call). None
+#: changes a result: no fast-math, no FMA contraction on the default target.
+OPTIMISE = {"rhs": "-O3", "jac": "-Og", "out": "-Og", "sw": "-O3"}
+#: A channel function of more CasADi instructions than this compiles at -O0 (called once
+#: per output row: the flexible two-drum winder's, 8394 instructions, 2.0 s CPU at -O1, 0.7 s
+#: at -O0). Not the Jacobian: at -O0 it compiles in half the time of -Og (3.9 s) but runs
+#: 2-2.5 times slower (48 against 20 µs; an implicit method calls it every step).
+LARGE = 5000
+#: A Jacobian of this many nonzeros or more is generated in two column blocks, two files
+#: compiled at once (1.08 times the instructions of one for the flexible two-drum winder's
+#: 4800 nonzeros; a machine's Jacobian is most of its build).
+JAC_SPLIT = 2000
+#: The layout of the generated code (in the cache key): one C file per function, the
+#: Jacobian on its nonzeros scattered by its flat entry point, CasADi's null checks removed.
+LAYOUT = "split-sparse-jac-unguarded-3"
 #: ``WINDER_SANITIZE=1`` (``make test-asan``): AddressSanitizer and UBSan on every object
 #: and the link (Python then needs libasan preloaded; see the Makefile).
 SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
@@ -88,6 +118,21 @@ def compile_flags() -> tuple[str, ...]:
     if sanitized():  # -O1: a sanitized build compiles several times faster than -O3
         return (*("-O1" if f == "-O3" else f for f in flags), *SANITIZE_CFLAGS)
     return flags
+
+
+def level(which: str, size: int) -> str:
+    """The optimisation level of one generated function (one of :data:`FUNCTIONS`) of
+    ``size`` CasADi instructions: :data:`OPTIMISE`, and -O0 for a channel function over
+    :data:`LARGE`."""
+    return "-O0" if which == "out" and size > LARGE else OPTIMISE[which]
+
+
+def function_flags(which: str, size: int) -> tuple[str, ...]:
+    """The flags the object of one generated function is compiled with:
+    :func:`compile_flags` at its :func:`level` (sanitized: -O1 throughout)."""
+    flags = compile_flags()
+    lv = level(which, size)
+    return flags if sanitized() else tuple(lv if f == "-O3" else f for f in flags)
 
 
 def link_flags() -> tuple[str, ...]:
@@ -191,8 +236,19 @@ class Generated:
         return f"w{self.key}"
 
 
-def _c_source(machine: Machine, symbol: str, directory: Path, route: str
-              ) -> tuple[Path, dict[str, np.ndarray]]:
+def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
+              ready: Callable[[str, Path, int], None] | None = None, *,
+              pattern: bool = False
+              ) -> tuple[list[tuple[str, Path, int]], dict[str, np.ndarray]]:
+    """Write one C file per generated function, ``SYMBOL_{rhs,jac,out,sw}.c`` (each with
+    its flat entry point), calling ``ready(which, path, size)`` (``size``: CasADi
+    instructions) as soon as each is written (so that its compilation starts while the
+    next one is generated). The Jacobian is generated on its structural nonzeros only (CCS)
+    and scattered into the dense column-major matrix by its flat entry point; one of
+    :data:`JAC_SPLIT` nonzeros or more is generated in two column blocks, the second in
+    ``SYMBOL_jac1.c`` (compiled at once with the first). ``pattern``: also the structural
+    sparsity of dxdot/dx and dxdot/dp, ``(row, column)`` per nonzero (for an FMU). Returns
+    ``(which, path, size)`` per file and the patterns."""
     import casadi as ca
 
     from winder.model.backends import SymbolicBackend
@@ -203,40 +259,96 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str
     m = ca.SX.sym("m", len(machine.mode_names))
     ev = machine.evaluate(SymbolicBackend(machine.model, route), t, x, p, m)
     xdot = ca.vertcat(*[ev.rates[n] for n in machine.state_names])
-    outs = {
-        "rhs": xdot,
-        "jac": ca.densify(ca.jacobian(xdot, x)),
-        "out": ca.vertcat(*[ev.channels[n] for n in machine.channel_names]),
-        "sw": ca.vertcat(*[ev.switches[n] for n in machine.switch_names]),
-    }
-    # the structural sparsity of dxdot/dx and dxdot/dp: (row, column) of each nonzero
-    pattern = {}
-    for name, wrt in (("x", x), ("p", p)):
-        sp = ca.jacobian(xdot, wrt).sparsity()
-        pattern[name] = np.array(sp.get_triplet(), dtype=np.int64).reshape(2, -1).T
-    funcs = {k: ca.Function(f"{symbol}_{k}", [t, x, p, m], [ca.densify(v)], {"cse": True})
-             for k, v in outs.items()}
-    name = f"{symbol}.c"
-    cg = ca.CodeGenerator(name, {"with_header": False})
-    for f in funcs.values():
+    jac = ca.jacobian(xdot, x)
+    patterns = {}
+    if pattern:  # the structural sparsity of dxdot/dx and dxdot/dp: (row, column) per nonzero
+        for name, sp in (("x", jac.sparsity()), ("p", ca.jacobian(xdot, p).sparsity())):
+            patterns[name] = np.array(sp.get_triplet(), dtype=np.int64).reshape(2, -1).T
+    colind = jac.sparsity().colind()
+    cuts = [0, machine.n_states]
+    if jac.nnz() >= JAC_SPLIT:  # two column blocks of about half the nonzeros each
+        cuts.insert(1, next(c for c in range(machine.n_states + 1)
+                            if colind[c] >= jac.nnz() / 2))
+    blocks = [(f"jac{i}" if i else "jac", colind[a], jac[:, a:b])
+              for i, (a, b) in enumerate(zip(cuts, cuts[1:], strict=False))]
+    # the order of generation: the rhs first (its compile is long for its size), the
+    # Jacobian's file with the flat entry point last of its blocks
+    outs: list[tuple[str, str, Any]] = [("rhs", "rhs", lambda: ca.densify(xdot))]
+    outs += [("jac", name, lambda e=e: e) for name, _, e in reversed(blocks)]
+    outs += [("out", "out", lambda: ca.densify(ca.vertcat(*[ev.channels[n] for n in
+                                                             machine.channel_names]))),
+             ("sw", "sw", lambda: ca.densify(ca.vertcat(*[ev.switches[n] for n in
+                                                           machine.switch_names])))]
+    files: list[tuple[str, Path, int]] = []
+    made: dict[str, Any] = {}
+    for which, name, expr in outs:
+        f = made[name] = ca.Function(f"{symbol}_{name}", [t, x, p, m], [expr()], {"cse": True})
+        cg = ca.CodeGenerator(f"{symbol}_{name}.c", {"with_header": False})
         cg.add(f)
-    # dump() rather than generate(): the same code, written here, without loading CasADi's
-    # file-system plugin (dlopen with RTLD_DEEPBIND, which AddressSanitizer refuses)
-    path = directory / name
-    path.write_text(f"/* {symbol}: generated by CasADi {ca.__version__} for winder */\n"
-                    + cg.dump())
-    wrap = ["", "/* flat, reentrant entry points */"]
-    for k, f in funcs.items():
-        wrap.append(
+        # dump() rather than generate(): the same code, written here, without loading
+        # CasADi's file-system plugin (dlopen with RTLD_DEEPBIND, which AddressSanitizer
+        # refuses)
+        path = directory / f"{symbol}_{name}.c"
+        entry = "" if name.startswith("jac") and name != "jac" else _flat_entry(
+            symbol, which, f, [(f"{symbol}_{n}", made[n], off) for n, off, _ in blocks]
+            if name == "jac" else None, jac.sparsity())
+        path.write_text(f"/* {symbol}_{name}: generated by CasADi {ca.__version__} for "
+                        "winder */\n" + _unguarded(cg.dump()) + entry)
+        files.append((which, path, f.n_instructions()))
+        if ready is not None:
+            ready(*files[-1])
+    return files, patterns
+
+
+def _unguarded(code: str) -> str:
+    """CasADi's code without its null checks on each argument read (``arg[i]? arg[i][j] :
+    0``) and each result written (``if (res[0]!=0) ...``): the functions are only called
+    through their flat entry points, which pass every argument and the result. One branch
+    per element made the compiler's register allocation superlinear in the function's size
+    (the flexible two-drum winder's Jacobian: 4800 writes, MEASURED)."""
+    code = code.replace("if (res[0]!=0) ", "")
+    return re.sub(r"arg\[(\d+)\]\? (arg\[\1\]\[\d+\]) : 0", r"\2", code)
+
+
+def _flat_entry(symbol: str, k: str, f: Any, blocks: list[tuple[str, Any, int]] | None,
+                sparsity: Any) -> str:
+    """The flat, reentrant entry point ``SYMBOL_K_flat(t, x, p, m, out)`` of one generated
+    function. The Jacobian's (``blocks``: each column block's function name, function and
+    offset of its first nonzero; ``sparsity``: the CCS pattern): each block writes its
+    nonzeros to the front of ``out`` at its offset, the rest is set to 0 (one ``memset``)
+    and each nonzero moved to its dense column-major place, last first (the place of the
+    k-th nonzero is never before k, so none is overwritten before it moves)."""
+    head = (f"\n/* flat, reentrant entry point */\n"
             f"int {symbol}_{k}_flat(const double* t, const double* x, const double* p, "
-            f"const double* m, double* out) {{\n"
-            f"  const casadi_real* arg[{max(f.sz_arg(), 4)}] = {{t, x, p, m}};\n"
-            f"  casadi_real* res[{max(f.sz_res(), 1)}] = {{out}};\n"
-            f"  casadi_int iw[{f.sz_iw() + 1}];\n  casadi_real w[{f.sz_w() + 1}];\n"
-            f"  return {symbol}_{k}(arg, res, iw, w, 0);\n}}")
-    with open(path, "a") as fh:
-        fh.write("\n".join(wrap) + "\n")
-    return path, pattern
+            f"const double* m, double* out) {{\n")
+    if blocks is None:
+        return (head + f"  const casadi_real* arg[{max(f.sz_arg(), 4)}] = {{t, x, p, m}};\n"
+                f"  casadi_real* res[{max(f.sz_res(), 1)}] = {{out}};\n"
+                f"  casadi_int iw[{f.sz_iw() + 1}];\n  casadi_real w[{f.sz_w() + 1}];\n"
+                f"  return {symbol}_{k}(arg, res, iw, w, 0);\n}}\n")
+    n, nnz = sparsity.size1(), sparsity.nnz()
+    rows, cols = sparsity.get_triplet()
+    place = [int(r) + n * int(c) for r, c in zip(rows, cols, strict=True)]
+    lines = [", ".join(str(v) for v in place[i:i + 16]) for i in range(0, len(place), 16)]
+    decls = "".join(f"int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, "
+                    "casadi_real* w, int mem);\n" for name, _, _ in blocks[1:])
+    calls = "".join(f"  res[0] = out + {off};\n  flag |= {name}(arg, res, iw, w, 0);\n"
+                    for name, _, off in blocks)
+    fs = [g for _, g, _ in blocks]
+    return ("#include <string.h>\n" + decls
+            + f"static const casadi_int {symbol}_jac_place[{max(nnz, 1)}] = {{\n  "
+            + ",\n  ".join(lines or ["0"]) + "};\n" + head
+            + f"  const casadi_real* arg[{max(4, *(g.sz_arg() for g in fs))}] = {{t, x, p, m}};\n"
+            f"  casadi_real* res[{max(1, *(g.sz_res() for g in fs))}];\n"
+            f"  casadi_int iw[{max(g.sz_iw() for g in fs) + 1}];\n"
+            f"  casadi_real w[{max(g.sz_w() for g in fs) + 1}];\n"
+            f"  int flag = 0;\n  casadi_int k;\n" + calls
+            + f"  memset(out + {nnz}, 0, sizeof(double) * {n * n - nnz});\n"
+            f"  for (k = {nnz} - 1; k >= 0; k--) {{\n"
+            f"    double v = out[k];\n"
+            f"    out[k] = 0.;\n"
+            f"    out[{symbol}_jac_place[k]] = v;\n  }}\n"
+            f"  return flag;\n}}\n")
 
 
 def _say(line: str) -> None:
@@ -245,24 +357,59 @@ def _say(line: str) -> None:
 
 
 def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
-    """The cache key of a machine's generated code (:func:`generate`)."""
+    """The cache key of a machine's generated code (:func:`generate`): its structure, the
+    physics' source, CasADi, the route, the layout and every object's flags."""
+    levels = f"{sorted(OPTIMISE.items())} out -O0 over {LARGE}; jac split at {JAC_SPLIT}"
     return hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(),
-                                    route, " ".join(cflags))).encode()).hexdigest()[:20]
+                                    route, LAYOUT, levels, " ".join(cflags))).encode()
+                          ).hexdigest()[:20]
 
 
 def write_source(machine: Machine, directory: Path, *, route: str | None = None
-                 ) -> tuple[Path, str, dict[str, np.ndarray]]:
-    """Write the machine's generated C (the code :func:`generate` compiles, with its flat
-    entry points ``SYMBOL_{rhs,jac,out,sw}_flat``) into ``directory``: its path,
-    ``SYMBOL`` and the structural sparsity of the right-hand side's Jacobians w.r.t. the
-    states (``"x"``) and the parameters (``"p"``), ``(row, column)`` per nonzero (for an
-    FMU's ``sources/`` and ``ModelStructure``; imports CasADi)."""
+                 ) -> tuple[list[Path], str, dict[str, np.ndarray], list[str]]:
+    """Write the machine's generated C (the code :func:`generate` compiles: one file
+    ``SYMBOL_K.c`` per function K of :data:`FUNCTIONS`, each with its flat entry point
+    ``SYMBOL_K_flat``, and ``SYMBOL_jac1.c`` for a Jacobian in two blocks) into
+    ``directory``: the files' paths, ``SYMBOL``, the structural
+    sparsity of the right-hand side's Jacobians w.r.t. the states (``"x"``) and the
+    parameters (``"p"``), ``(row, column)`` per nonzero (for an FMU's ``sources/`` and
+    ``ModelStructure``), and each file's optimisation :func:`level` (imports CasADi)."""
     from winder.model.backends import default_route
 
     route = default_route() if route is None else route
     symbol = f"w{_key(machine, route, compile_flags())}"
-    path, pattern = _c_source(machine, symbol, Path(directory), route)
-    return path, symbol, pattern
+    files, pattern = _c_source(machine, symbol, Path(directory), route, pattern=True)
+    return ([f for _, f, _ in files], symbol, pattern,
+            [level(which, size) for which, _, size in files])
+
+
+class _Compiles:
+    """The generated functions' objects compiled at once (one compiler process each,
+    started as soon as its source is written); :meth:`wait` raises :class:`CompileError`
+    on the first failure; leaving the ``with`` block ends any still running."""
+
+    def __init__(self) -> None:
+        self.running: list[tuple[subprocess.Popen[str], str]] = []
+
+    def start(self, args: list[str], what: str) -> None:
+        self.running.append((subprocess.Popen([_compiler(), *args], stdout=subprocess.DEVNULL,
+                                              stderr=subprocess.PIPE, text=True), what))
+
+    def wait(self) -> None:
+        for proc, what in self.running:
+            _, err = proc.communicate()
+            if proc.returncode != 0:
+                raise CompileError(f"compiling {what} failed ({proc.args[0]}):\n"
+                                   + err[-2000:])
+
+    def __enter__(self) -> _Compiles:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for proc, _ in self.running:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
 
 
 @dataclass(frozen=True)
@@ -302,13 +449,21 @@ def generate(machine: Machine, *, directory: Path | None = None,
                 name = getattr(getattr(machine, "scene", None), "name", "the machine")
                 _say(f"winder: building {name}'s code once ({machine.n_states} states, "
                      f"{machine.model.nbodies - 1} bodies; cached in {root})")
-                src = _c_source(machine, symbol, Path(tmp), route)[0]
-                tmp_obj = Path(tmp) / obj.name
-                run_compiler([*cflags, "-c", str(src), "-o", str(tmp_obj)],
-                             "the generated model")
+                with _Compiles() as jobs:  # each function compiles while the next is made
+                    def ready(which: str, src: Path, size: int) -> None:
+                        jobs.start([*function_flags(which, size), "-c", str(src), "-o",
+                                    str(src.with_suffix(".o"))], "the generated model")
+
+                    srcs = [f for _, f, _ in _c_source(machine, symbol, Path(tmp), route,
+                                                       ready)[0]]
+                    jobs.wait()
+                tmp_obj = Path(tmp) / obj.name  # one relocatable object of the four
+                run_compiler(["-r", "-nostdlib", *(str(s.with_suffix(".o")) for s in srcs),
+                              "-o", str(tmp_obj)], "the generated model (-r)")
                 os.replace(tmp_obj, obj)
+                size = sum(s.stat().st_size for s in srcs)
                 _say(f"winder: {name}'s code built in {time.perf_counter() - t0:.1f} s "
-                     f"({src.stat().st_size / 1024:.0f} kB of C)")
+                     f"({size / 1024:.0f} kB of C)")
             tmp_lib = Path(tmp) / lib.name
             extra = [str(o) for o in link.objects] if link is not None else []
             run_compiler([*link_flags(), str(obj), *extra, "-o", str(tmp_lib), "-lm"],
