@@ -6,7 +6,10 @@ bodies' rotation speeds, the other states (the nips' friction states, ...) and a
 body's segment angles (its twist). A mode's **kinetic energy** is ``½ m |ẋ|²`` per free
 coordinate (onto the generalised coordinates of :class:`~winder.analysis.shapes.Shapes`:
 a flexible body's bending orders) and ``½ J |θ̇|²`` per turning body; where the eigenvalue
-is zero (a free mass: nothing holds it) the displacement ``½ m |x|²`` stands in for it. Its
+is zero (a free mass: nothing holds it) the displacement ``½ m |x|²`` stands in for it;
+with ``flex.rotary_inertia`` each section's rotation rate ``s`` (``SEG.tilt_rate_x``/``_z``)
+adds ``½ j_r |s|²`` (``j_r`` half the segment's polar inertia), part of the total that every
+share divides. Its
 **mechanical share** is the participation of the mechanical states (all but the "other"
 ones) in it: ``|l_i r_i|`` summed over them over the sum over all states (``l``, ``r`` the
 left and right eigenvectors; unit-free): about 1 for a mode of the bodies, about 0 for a
@@ -24,6 +27,11 @@ label:
   (``set.x``) always names one: where none oscillates the real eigenvalue with the largest
   share (the coordinate is overdamped there: frequency 0, damping ratio 1), or a zero
   eigenvalue (free: nothing holds it);
+- a mode of the bodies (oscillating or not) whose kinetic energy is at least
+  :data:`ROTATION_SHARE` in the sections' rotation (Timoshenko's second spectrum, kHz) takes
+  no bounce, bending or torsion label: it is a **rotation mode** ``BODY.rotation.{x,z}{n}``
+  (:meth:`Shapes.rotation_label`: the body and axis with the most of it, ``n`` the dominant
+  order of its rates on ``cos(nπ y/L)``, ``n = 0 … N − 1``; not unique);
 - of the rest, an oscillating mode whose kinetic energy is at least half in the flexible
   bodies' twist is a **torsion mode** ``BODY.torsion{n}`` (:meth:`Shapes.torsion_label`),
   each label once: the mode with the most energy in that order of that body;
@@ -41,7 +49,7 @@ import numpy as np
 
 from winder.analysis.shapes import Shapes
 
-__all__ = ["Mode", "label_modes", "MECHANICAL_SHARE", "SHAPE_SHARE"]
+__all__ = ["Mode", "label_modes", "MECHANICAL_SHARE", "SHAPE_SHARE", "ROTATION_SHARE"]
 
 #: The least mechanical share (participation of the bodies' states) of a labelled
 #: oscillating mode.
@@ -52,16 +60,21 @@ _BOUNCE_SHARE = 0.25
 #: twin drums of a two-drum winder share their order-2 modes through the set: each drum's
 #: x2 and z2 12-24 % of them).
 SHAPE_SHARE = 0.1
+#: The kinetic-energy share of the sections' rotation (flex.rotary_inertia) from which an
+#: oscillating mode is a rotation mode: no bounce, bending or torsion label.
+ROTATION_SHARE = 0.5
 
 
 @dataclass(frozen=True)
 class Mode:
     """One eigenvalue (of a pair): ``frequency`` [Hz] (damped, 0 for a real eigenvalue),
     ``natural_frequency`` ``|λ|/2π`` [Hz], ``damping_ratio`` [-], ``kind`` (``bounce``,
-    ``bending``, ``slip`` or ``torsion``) and ``coordinate``: the free coordinate that
+    ``bending``, ``slip``, ``torsion`` or ``rotation``) and ``coordinate``: the free
+    coordinate that
     dominates a bounce mode (``BODY.x``/``BODY.z``), a flexible body's bending order
     (``BODY.bend.z1``, :mod:`winder.analysis.shapes`) or torsion order
-    (``BODY.torsion1``), or the state that dominates a slip mode (a bending or torsion
+    (``BODY.torsion1``), a section-rotation order (``BODY.rotation.z0``), or the state that
+    dominates a slip mode (a bending or torsion
     label only on an oscillating mode of that shape: module text)."""
 
     eigenvalue: complex
@@ -96,12 +109,14 @@ def mechanical_share(left: np.ndarray, right: np.ndarray, mechanical: np.ndarray
 
 def label_modes(A: np.ndarray, *, shapes: Shapes, n_positions: int, n_speeds: int,
                 mass: np.ndarray, inertia: np.ndarray, names: list[str],
-                mechanical: np.ndarray) -> list[Mode]:
+                mechanical: np.ndarray, rotary: np.ndarray | None = None) -> list[Mode]:
     """The modes of the fast states' Jacobian ``A`` (module text): the bounce and bending
     modes in the order of ``shapes.labels`` (those that have one), then the slip modes
     (slowest first), then the torsion modes (slowest first). ``n_positions`` free
     coordinates (of masses ``mass`` [kg]), ``n_speeds`` turning bodies (``inertia``
-    [kg·m²]), ``names`` of the fast states, ``mechanical`` the mask of the bodies' states."""
+    [kg·m²]), ``names`` of the fast states, ``mechanical`` the mask of the bodies' states,
+    ``rotary`` per fast state the rotary inertia ``j_r`` [kg·m²] of a section whose
+    rotation rate it is (``SEG.tilt_rate_x``/``_z``; 0 elsewhere, None: none)."""
     from scipy.linalg import eig
     from scipy.optimize import linear_sum_assignment
 
@@ -116,16 +131,26 @@ def label_modes(A: np.ndarray, *, shapes: Shapes, n_positions: int, n_speeds: in
     mech = mechanical_share(left[:, keep], right[:, keep], mechanical)
     weight = np.sqrt(np.concatenate([(Q * Q) @ mass, inertia]))
 
-    def energy_rows(V: np.ndarray) -> np.ndarray:  # √(m) ẋ per coordinate, √(J) θ̇ per body
-        return weight[:, None] * np.vstack([Q @ V[nt:2 * nt], V[2 * nt:2 * nt + ns]])
+    jr = np.zeros(A.shape[0]) if rotary is None else np.asarray(rotary, dtype=float)
+    tilt = np.nonzero(jr > 0.0)[0]  # the sections' rotation rates
+
+    def energy_rows(V: np.ndarray) -> np.ndarray:  # √(m) ẋ, √(J) θ̇, √(j_r) s
+        return np.vstack([weight[:, None] * np.vstack([Q @ V[nt:2 * nt],
+                                                        V[2 * nt:2 * nt + ns]]),
+                          np.sqrt(jr[tilt])[:, None] * V[tilt]])
 
     V = _split_degenerate(right[:, keep], lam[keep], still, energy_rows, mech)
     moving = np.where(still[None, :], Q @ V[:nt], Q @ V[nt:2 * nt])
     kin = np.vstack([((Q * Q) @ mass)[:, None] * np.abs(moving) ** 2,
                      inertia[:, None] * np.abs(V[2 * nt:2 * nt + ns]) ** 2])
-    share = kin[:nt] / np.maximum(kin.sum(axis=0), 1e-300)
+    spin = jr[tilt, None] * np.abs(V[tilt]) ** 2  # the sections' rotation: ½ j_r |s|²
+    total = kin.sum(axis=0) + spin.sum(axis=0)
+    share = kin[:nt] / np.maximum(total, 1e-300)
     oscillating = lam[keep].imag > 0.0
     good = oscillating & (mech >= MECHANICAL_SHARE)
+    # a rotation mode: of the bodies, mostly the sections' rotation (oscillating or not)
+    turning = (mech >= MECHANICAL_SHARE) & (spin.sum(axis=0) >= ROTATION_SHARE * total)
+    good &= ~turning
     first = good[None, :] & (share >= _BOUNCE_SHARE)
     shaped = np.array([".bend." in c for c in shapes.labels], dtype=bool)[:, None]
     shape_ok = good[None, :] & (share >= SHAPE_SHARE)
@@ -137,10 +162,15 @@ def label_modes(A: np.ndarray, *, shapes: Shapes, n_positions: int, n_speeds: in
                 shapes.labels[c]) for c in range(nt) if c in bounce]
     taken = set(bounce.values())
     best: dict[str, tuple[float, int]] = {}  # torsion label -> (energy in it, k)
-    rest = []
+    rest, rotations = [], []
     for k in (k for k in range(len(keep)) if keep[k] not in taken):
+        if turning[k]:
+            rotations.append(Mode(complex(lam[keep[k]]), "rotation",
+                                  shapes.rotation_label([names[i] for i in tilt],
+                                                        V[tilt, k], jr[tilt])))
+            continue
         label = shapes.torsion_label(V[2 * nt:2 * nt + ns, k], inertia,
-                                     float(kin[:, k].sum())) if good[k] else None
+                                     float(total[k])) if good[k] else None
         if label is None:
             rest.append(k)
             continue
@@ -155,7 +185,8 @@ def label_modes(A: np.ndarray, *, shapes: Shapes, n_positions: int, n_speeds: in
                   names[nt + int(np.argmax(np.abs(V[nt:, k])))]) for k in rest]
     torsions = [Mode(complex(lam[keep[k]]), "torsion", c) for c, (_, k) in best.items()]
     slowest = lambda m: abs(m.eigenvalue)  # noqa: E731
-    return out + sorted(slips, key=slowest) + sorted(torsions, key=slowest)
+    return out + sorted(slips, key=slowest) + sorted(torsions, key=slowest) \
+        + sorted(rotations, key=slowest)
 
 
 def _split_degenerate(V: np.ndarray, lam: np.ndarray, still: np.ndarray, energy_rows,

@@ -195,8 +195,11 @@ class _Linearisation:
         slow = {m.index(f"{b.name}.theta") for b in m.bodies if not b.prescribed}
         slow -= set(self.angles)
         slow |= {m.index(_radius_state(b)) for b in m.bodies if b.radius_state}
+        # a flexible body's sections' rotations (flex.rotary_inertia): elastic, fast,
+        # states of the bodies (not friction states)
+        self.tilts = [i for i, n in enumerate(names) if ".tilt_" in n]
         taken = set(self.positions) | set(self.velocities) | set(self.speeds) | slow
-        taken |= set(self.angles)
+        taken |= set(self.angles) | set(self.tilts)
         self.others = [i for i in range(len(names)) if i not in taken]  # friction, ...
         self._sets()
         self.paper = {m.index(f"{b.name}.theta_dot"): m.index(_radius_state(b))
@@ -233,9 +236,10 @@ class _Linearisation:
     def _sets(self) -> None:
         """The balance's unknowns and their equations (rates), the modes' fast states."""
         twists = list(self.twists)
-        self.unknowns = self.positions + self.speeds + self.others + twists
-        self.equations = self.velocities + self.speeds + self.others + twists
-        self.fast = self.positions + self.velocities + self.speeds + self.others + self.angles
+        self.unknowns = self.positions + self.speeds + self.others + twists + self.tilts
+        self.equations = self.velocities + self.speeds + self.others + twists + self.tilts
+        self.fast = self.positions + self.velocities + self.speeds + self.others + self.angles \
+            + self.tilts
 
     # ---- the operating point ------------------------------------------------------------
     def _radius_of(self, y: np.ndarray, name: str) -> float:
@@ -506,12 +510,17 @@ class _Linearisation:
         inertia = np.array([float(ev.bodies[b.name].inertia)
                             for b in self.machine.bodies if not b.prescribed])
         others = set(self.others)
+        names = [self.machine.state_names[i] for i in self.fast]
+        # a section's rotary inertia j_r = J_seg/2 on its rotation rate (flex_beam's
+        # _rotary_bending: ṡ = 2 g/J_seg)
+        p, m = self.system.params, self.machine
+        rotary = np.array([0.5 * float(p[m.param_index(f"{n.split('.', 1)[0]}.inertia")])
+                           if ".tilt_rate_" in n else 0.0 for n in names])
         return label_modes(self.fast_jacobian(y), shapes=self.shapes,
                            n_positions=len(self.positions), n_speeds=len(self.speeds),
-                           mass=mass, inertia=inertia,
-                           names=[self.machine.state_names[i] for i in self.fast],
+                           mass=mass, inertia=inertia, names=names,
                            mechanical=np.array([i not in others for i in self.fast],
-                                               dtype=bool))
+                                               dtype=bool), rotary=rotary)
 
     def initial(self) -> np.ndarray:
         """The machine's initial state (``winder run``'s at ``t = 0``: the static balance

@@ -18,7 +18,9 @@ mode's kinetic energy, name a **torsion mode** ``BODY.torsion{n}``: the dominant
 their projection onto the body's own torsion shapes (:func:`torsion_basis`: held at the
 drive segment, or free–free); a mode whose energy is mostly a free body's rigid rotation is
 a slip mode, no torsion mode. Only an oscillating mode of the bodies carries a bending or
-torsion label (:mod:`winder.analysis.mode_labels`).
+torsion label (:mod:`winder.analysis.mode_labels`); a mode mostly in the sections' rotation
+(``flex.rotary_inertia``) is a rotation mode ``BODY.rotation.{x,z}{n}``
+(:meth:`Shapes.rotation_label`).
 """
 
 from __future__ import annotations
@@ -68,6 +70,8 @@ class Shapes:
         self.labels: list[str] = []
         seen: set[tuple[str, str]] = set()
         self.torsion: list[_Group] = []
+        #: a flexible body's segment name -> (the body's name, its index)
+        self.segment = {b.name: (b.segment_of, b.index) for b in bodies if b.segment_of}
         row = 0
         for j, c in enumerate(coords):
             name, axis = c.rsplit(".", 1)
@@ -125,6 +129,30 @@ class Shapes:
         k = int(np.argmax(share))
         return (f"{g.body}.torsion{k + 1}",
                 e / max(total, 1e-300) * share[k] / max(float(np.sum(np.abs(w) ** 2)), 1e-300))
+
+
+    def rotation_label(self, names: list[str], rates: np.ndarray, inertia: np.ndarray
+                       ) -> str:
+        """``BODY.rotation.{x,z}{n}`` of a mode whose sections' rotation rates are ``rates``
+        (complex) on the states ``names`` (``SEG.tilt_rate_x``/``_z``; rotary inertias
+        ``inertia`` [kg·m²]): the body and axis with the most of their energy
+        ``½ j_r |s|²``, ``n`` the dominant order of its rates on ``cos(nπ y/L)`` at the
+        segment centres, ``n = 0 … N − 1`` (DCT-II, orthogonal; a section's rotation in a
+        bending mode ``sin(nπ y/L)`` is ``∝ cos(nπ y/L)``)."""
+        groups: dict[tuple[str, str], dict[int, complex]] = {}
+        for name, s, j in zip(names, rates, inertia, strict=True):
+            seg, state = name.split(".", 1)
+            body, index = self.segment[seg]
+            groups.setdefault((body, state[-1]), {})[index] = complex(np.sqrt(j) * s)
+        (body, axis), w = max(groups.items(),
+                              key=lambda g: sum(abs(x) ** 2 for x in g[1].values()))
+        n = max(w) + 1
+        u = np.zeros(n, dtype=complex)
+        for i, x in w.items():
+            u[i] = x
+        basis = np.cos(np.outer(np.arange(n), np.arange(n) + 0.5) * np.pi / n)
+        share = np.abs(basis @ u) ** 2 / np.sum(basis * basis, axis=1)
+        return f"{body}.rotation.{axis}{int(np.argmax(share))}"
 
 
 def torsion_basis(n: int, fixed: bool) -> np.ndarray:
