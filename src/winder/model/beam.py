@@ -103,6 +103,22 @@ def element_stiffness(EI: float, kGA: float | None, length: float) -> np.ndarray
         [6 * ll, (2 - phi) * ll * ll, -6 * ll, (4 + phi) * ll * ll]])
 
 
+def _assembled_stiffness(n: int, length: float, EI: float, kGA: float | None,
+                         bearing_stiffness: float) -> np.ndarray:
+    """The stiffness of the ``n + 2`` nodes (bearing, ``n`` stations at the segments'
+    centres, bearing; ``(w, ψ)`` each) of a body of ``length`` [m]: its ``n + 1`` elements
+    (half a segment at each end) and a bearing of ``bearing_stiffness`` [N/m] at each end."""
+    h = length / n
+    nodes = n + 2
+    full = np.zeros((2 * nodes, 2 * nodes))
+    for e, le in enumerate([h / 2, *([h] * (n - 1)), h / 2]):
+        dofs = slice(2 * e, 2 * e + 4)
+        full[dofs, dofs] += element_stiffness(EI, kGA, le)
+    for d in (0, 2 * (nodes - 1)):
+        full[d, d] += bearing_stiffness
+    return full
+
+
 def beam_matrices(n: int, length: float, mass: float, EI: float, kGA: float | None,
                   bearing_stiffness: float, bearing_damping: float, damping_ratio: float,
                   GJ: float) -> BeamMatrices:
@@ -112,16 +128,9 @@ def beam_matrices(n: int, length: float, mass: float, EI: float, kGA: float | No
     ``damping_ratio`` [-] of the first bending mode, ``GJ`` [N·m²]."""
     if n < 2:
         raise ValueError(f"beam_matrices: n must be at least 2, got {n}")
-    h = length / n
+    full = _assembled_stiffness(n, length, EI, kGA, bearing_stiffness)
     stations = n + 2  # bearing, n stations, bearing
-    lengths = [h / 2, *([h] * (n - 1)), h / 2]
-    full = np.zeros((2 * stations, 2 * stations))
-    for e, le in enumerate(lengths):
-        dofs = slice(2 * e, 2 * e + 4)
-        full[dofs, dofs] += element_stiffness(EI, kGA, le)
     ends = (0, 2 * (stations - 1))
-    for d in ends:
-        full[d, d] += bearing_stiffness
     kept = [2 * (i + 1) for i in range(n)]
     rest = [d for d in range(2 * stations) if d not in kept]
     Krr, Krc = full[np.ix_(kept, kept)], full[np.ix_(kept, rest)]
@@ -136,7 +145,7 @@ def beam_matrices(n: int, length: float, mass: float, EI: float, kGA: float | No
     bending = w2[w2 > 1e-9 * scale]
     omega1 = float(np.sqrt(bending[0])) if bending.size else 0.0
     beta = 2.0 * damping_ratio / omega1 if omega1 > 0.0 else 0.0
-    k_t = GJ / h
+    k_t = GJ / (length / n)
     return BeamMatrices(K, beta * K + Cb, beta, omega1, k_t, beta * k_t)
 
 
@@ -193,16 +202,9 @@ def rotary_beam_matrices(n: int, length: float, mass: float, inertia: float, EI:
     :func:`beam_matrices`)."""
     if n < 2:
         raise ValueError(f"rotary_beam_matrices: n must be at least 2, got {n}")
-    h = length / n
+    full = _assembled_stiffness(n, length, EI, kGA, bearing_stiffness)
     nodes = n + 2  # bearing, n stations, bearing
-    lengths = [h / 2, *([h] * (n - 1)), h / 2]
-    full = np.zeros((2 * nodes, 2 * nodes))
-    for e, le in enumerate(lengths):
-        dofs = slice(2 * e, 2 * e + 4)
-        full[dofs, dofs] += element_stiffness(EI, kGA, le)
     last = 2 * (nodes - 1)
-    for d in (0, last):
-        full[d, d] += bearing_stiffness
     bearings = [0, 1, last, last + 1]
     stations = list(range(2, last))  # (w_0, ψ_0, w_1, ψ_1, ...)
     Kbb = full[np.ix_(bearings, bearings)]
@@ -226,6 +228,6 @@ def rotary_beam_matrices(n: int, length: float, mass: float, inertia: float, EI:
     omega1 = float(np.sqrt(bending[0])) if bending.size else 0.0
     beta = 2.0 * damping_ratio / omega1 if omega1 > 0.0 else 0.0
     C = beta * Kh + Cb
-    k_t = GJ / h
+    k_t = GJ / (length / n)
     return RotaryBeamMatrices(K, T, K_wp, K_pp, C[w, w], C[w, p], C[p, p], beta, omega1,
                               k_t, beta * k_t)
