@@ -48,6 +48,11 @@ class DancerController(ForceElement):
             machine.state(f"{b.name}.position_integral", 0.0)
             machine.channel(self.CHANNELS[0], w.span_channel)
 
+    def structure_tag(self, machine: Machine) -> str:
+        """The dancer each controlled unwind holds (it changes the generated code)."""
+        return ",".join(f"{w.unwind.name}:{w.unwind.part.drive.dancer}" for w in machine.webs
+                        if w.unwind is not None and self.name in w.unwind.drives)
+
     def apply(self, ev: Evaluation) -> None:
         for w in ev.machine.webs:
             if w.unwind is not None and self.name in w.unwind.drives:

@@ -37,7 +37,9 @@ class Roles:
     roller: a roller of a web line (machines.md §11): a span may end at it and the next
     start there. wrap: the web's wrap angle on it [rad] where given (a roller).
     dancer: a roller's dancer carriage (with ``stiffness``, ``load``, ``travel`` and
-    ``position(t_up, t_down)``, its static position), else None."""
+    ``position(t_up, t_down)``, its static position), else None. paced: a roller whose
+    speed its drive prescribes (a pull roll on a speed profile): the tension zone an unwind
+    controls ends at it."""
 
     web: str | None = None
     nip: str = "fixed"
@@ -48,6 +50,7 @@ class Roles:
     roller: bool = False
     wrap: float | None = None
     dancer: Any = None
+    paced: bool = False
 
     def __post_init__(self) -> None:
         if self.web is not None and self.web not in WEB_ROLES:

@@ -178,9 +178,11 @@ class IdlerBody(DrumBody):
     @classmethod
     def roles_of(cls, part: Any) -> Roles:
         """The web wraps it as a roller of its line; fixed centre; bearing drag; a
-        dancer's carriage."""
+        dancer's carriage; paced by a speed-profile drive (a pull roll)."""
+        drive = getattr(part, "drive", None)
         return Roles(web="wraps", nip="fixed", roller=True, wrap=part.wrap,
-                     bearing_torques=True, dancer=getattr(part, "dancer", None))
+                     bearing_torques=True, dancer=getattr(part, "dancer", None),
+                     paced=getattr(drive, "kind", None) == "speed_profile")
 
     def drawing(self) -> Drawing:
         return Drawing(colour="idler")

@@ -97,8 +97,11 @@ DRIVE_KEYS = Table((
             "three poles at −ω_c)"),
     Key(name="dancer", kind="ref", default_text="required (kind dancer_control)",
         doc="kind dancer_control: the idler on a dancer carriage it holds at d = 0"),
+    Key(name="span", unit="-", lo=0.0, hi=1e3,
+        doc="kind tension_control: the index of the span whose tension it holds (0: the "
+            "first, from the unwinding roll; on a web line the load cell's span)"),
 ), kinds={"torque": ("kind", "torque"),
-          "tension_control": ("kind", "tension", "bandwidth"),
+          "tension_control": ("kind", "tension", "bandwidth", "span"),
           "dancer_control": ("kind", "dancer", "bandwidth")})
 
 
@@ -131,13 +134,20 @@ class UnwindTorqueDrive:
 @dataclass(frozen=True, kw_only=True)
 class TensionControl:
     """``drive = { kind = "tension_control" }`` of an unwinding roll: the unwind torque
-    holds the span tension at ``tension`` [N]; ``bandwidth`` ω_c [rad/s] is the closed
-    loop's bandwidth, from which the engine derives the gains by its rule; bounds:
-    :data:`DRIVE_KEYS`."""
+    holds the tension of span ``span`` (an index from the unwinding roll, machines.md §11)
+    at ``tension`` [N]; ``bandwidth`` ω_c [rad/s] is the closed loop's bandwidth, from
+    which the engine derives the gains by its rule; bounds: :data:`DRIVE_KEYS`."""
 
     kind: str = "tension_control"
     tension: float
     bandwidth: float = 10.0
+    span: int = 0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.span, bool) or not float(self.span).is_integer():
+            raise ValueError(f"tension_control: span must be a whole number (a span's "
+                             f"index), got {self.span!r}")
+        object.__setattr__(self, "span", int(self.span))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -224,6 +234,9 @@ def _parse_drive(reader: TableReader, label: str, kw: Mapping[str, Any],
     if "tension" not in d:
         raise reader.fail(dlabel, "tension",
                           "missing required key (kind = 'tension_control': the set-point [N])")
+    if not float(d.get("span", 0)).is_integer():
+        raise reader.fail(dlabel, "span", f"{show(d['span'])}: not a whole number; valid: a "
+                                          "span's index 0, 1, … from the unwinding roll")
     return TensionControl(**d)
 
 

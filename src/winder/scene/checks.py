@@ -370,7 +370,8 @@ def _check_travel(source: str, parts: _Parts, web: WebPart, i: int) -> None:
 
 
 def check_unwind_drives(source: str, bodies: Bodies, parts: _Parts) -> None:
-    """An unwind's dancer control holds a dancer its web wraps (machines.md §11)."""
+    """An unwind's dancer control holds a dancer its web wraps, its tension control a span
+    of its web that no paced pull roll separates from it (machines.md §11)."""
     web_of = {w.span.source: (label, w) for label, w in parts.webs if w.span is not None}
     for cls, group in _types(bodies):
         for p in group:
@@ -388,6 +389,25 @@ def check_unwind_drives(source: str, bodies: Bodies, parts: _Parts) -> None:
                     raise fail(source, dlabel, "dancer",
                                f"{show(dancer)} {what}; valid names: dancers [{label}] "
                                f"wraps: {', '.join(dancers) or '(none)'}")
+            if getattr(drive, "kind", None) == "tension_control":
+                _check_controlled_span(source, dlabel, parts, label, web, drive.span)
+
+
+def _check_controlled_span(source: str, dlabel: str, parts: _Parts, label: str,
+                           web: WebPart, span: int) -> None:
+    """Span ``span`` of ``web`` lies in its unwind's tension zone: its spans up to the
+    first one that ends at a paced roller (a pull roll on a speed profile) or the entry
+    drum (machines.md §11)."""
+    zone = next((i for i, s in enumerate(web.spans)
+                 if s.to is None or parts.roles[s.to].paced), len(web.spans) - 1)
+    if span <= zone:
+        return
+    why = f"[{label}] has {len(web.spans)} span(s)" if span >= len(web.spans) else \
+        (f"span {span} lies beyond the pull roll {web.spans[zone].to!r}, whose drive "
+         "prescribes its speed: the unwind's torque cannot hold it")
+    raise fail(source, dlabel, "span",
+               f"{span!r}: {why}; valid: " + (", ".join(map(str, range(zone + 1)))
+                                              + " (from the unwinding roll)"))
 
 
 def check_wound_fed(source: str, parts: _Parts) -> None:
