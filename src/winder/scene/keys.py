@@ -63,6 +63,9 @@ def key_unit(path: str, data: Mapping[str, Any] | None = None) -> str:
         array = head in ARRAYS and ".".join([head, *rest[:-1]]) not in LEGACY_TABLES
     if array:
         head, rest = head + "[]", rest[1:]  # skip the element's name
+    elif data is not None and len(rest) > 2 and isinstance(data.get(head), Mapping) and \
+            isinstance(data[head].get(rest[0]), list):  # a web line's span by its index
+        head, rest = f"{head}.{rest[0]}", rest[2:]
     if not rest:
         return ""
     try:

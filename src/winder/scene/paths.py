@@ -1,6 +1,7 @@
 """Key paths on a scene's nested tables (:meth:`~winder.scene.Scene.to_dict`):
 ``drum.front.drive.web_speed`` enters a table by key and an array of tables by the
-element's ``name``. Sweeps (:mod:`winder.analysis.sweep_grid`) and
+element's ``name``, or, where its elements have no names (a web line's spans,
+``[[web.span]]``), by the element's index from 0: ``web.span.1.length``. Sweeps (:mod:`winder.analysis.sweep_grid`) and
 :func:`~winder.scene.keys.key_unit` read them."""
 
 from __future__ import annotations
@@ -14,13 +15,17 @@ __all__ = ["resolve", "get_path", "set_path"]
 
 
 def _names(node: list) -> list[str]:
-    return [str(e.get("name")) for e in node if isinstance(e, Mapping) and "name" in e]
+    """How the path names the elements of an array of tables: by ``name``, or, where none
+    has one (a web line's spans), by index ``0, 1, …``."""
+    named = [str(e.get("name")) for e in node if isinstance(e, Mapping) and "name" in e]
+    return named if named else [str(i) for i in range(len(node))]
 
 
 def resolve(data: Any, key: str) -> tuple[Any, str | int]:
     """``(container, slot)`` of the value that ``key`` names in nested ``data``:
     ``container[slot]`` is the value (the slot may not exist yet: a key the scene leaves
-    at its default). Dicts are entered by key; lists of tables by the element's ``name``.
+    at its default). Dicts are entered by key; lists of tables by the element's ``name``
+    (by its index where the elements have no names).
 
     Raises :class:`ArgumentError` naming the key path where a segment does not exist.
     """
