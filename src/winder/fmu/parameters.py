@@ -14,7 +14,12 @@ set, under which names and units, and the scene with the host's values applied.
   ``NIP_slip_reference_velocity``, ``NIP_relaxation_length``, and ``web_tension``.
   A winder line (``[web.span]``, machines.md §5) has ``span_length``, ``span_EA`` and
   ``span_T_in`` instead of ``web_tension`` (the tension is the span's state); a web line
-  of several spans (``[[web.span]]``, §11) has none of these yet.
+  of several spans (``[[web.span]]``, §11) has them per span, named as its channels
+  (``span0_length``, ``span1_EA``, …; ``T_in`` the first span's only), and the web's
+  ``web_mu``; its idlers their bearings' ``IDLER_bearing_viscous``,
+  ``IDLER_bearing_coulomb``, their ``IDLER_wrap`` and a dancer's ``IDLER_dancer_damping``
+  (its stiffness and load move the carriage's initial balance, which only the scene
+  solves).
 
 Descriptions and units are the scene keys' declarations: a key newly declared with
 ``fmu=...`` is a parameter at once.
@@ -26,6 +31,7 @@ from typing import Any
 
 from winder._errors import WinderError
 from winder._schema import Key
+from winder.model.spans import span_tag
 from winder.parts import PARTS
 from winder.scene import naming_of
 from winder.scene.keys import find_key
@@ -115,12 +121,24 @@ def _parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str, str]]:
                 out[f"{part.name}_{k.fmu}"] = ((table, part.name, path),
                                                f"{table} {part.name}: {k.doc} [{unit}]", unit)
     web = scene.web
-    if web is not None and len(web.spans) <= 1:  # a web line's spans: not yet parameters
+    if web is not None and len(web.spans) <= 1:
         sub = ("span",) if web.span is not None else ()
         for path, k, unit in _flagged(".".join(("web", *sub)),
                                       web.span if sub else web):
             who = " ".join(("web", *sub)) + ": " if sub else ""
             out[k.fmu] = (("web", None, (*sub, *path)), f"{who}{k.doc} [{unit}]", unit)
+    elif web is not None:  # a web line (machines.md §11): each span's, named as its channels
+        for i, span in enumerate(web.spans):
+            tag = span_tag(i, len(web.spans))
+            for path, k, unit in _flagged("web.span", span):
+                if k.name == "T_in" and i > 0:  # the first span's only
+                    continue
+                out[f"{tag}_{k.fmu.removeprefix('span_')}"] = (
+                    ("web", None, ("span", str(i), *path)),
+                    f"web span {i}: {k.doc} [{unit}]", unit)
+        for path, k, unit in _flagged("web", web):
+            if len(path) == 1 and k.name != "tension":  # its own; the spans hold T
+                out[k.fmu] = (("web", None, path), f"web: {k.doc} [{unit}]", unit)
     return out
 
 
@@ -145,8 +163,9 @@ def parameter_value(scene: Scene, place: ParameterPath) -> float:
         obj: Any = getattr(scene, table)
     else:
         obj = next(p for p in _elements(scene, table) if p.name == element)
-    for key in path:
-        obj = getattr(obj, key)
+    prev = None
+    for key in path:  # a web line's span by its index (machines.md §11)
+        obj, prev = (prev.spans[int(key)] if key.isdigit() else getattr(obj, key)), obj
     return float(obj)
 
 

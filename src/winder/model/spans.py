@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Span", "line_spans"]
+__all__ = ["Span", "line_spans", "span_tag"]
 
 
 @dataclass
@@ -27,6 +27,12 @@ class Span:
     downstream: Any = None
 
 
+def span_tag(index: int, count: int) -> str:
+    """How span ``index`` of a web of ``count`` spans is named in its states, parameters,
+    channels and FMU parameters: ``span`` for a web's only span, else ``span{index}``."""
+    return "span" if count == 1 else f"span{index}"
+
+
 def line_spans(web: Any, unwind: Any, bodies: Mapping[str, Any], key: str,
                channel: str) -> list[Span]:
     """The :class:`Span` s of the web part ``web`` (its ``spans``, else its one ``span``)
@@ -36,7 +42,7 @@ def line_spans(web: Any, unwind: Any, bodies: Mapping[str, Any], key: str,
     out: list[Span] = []
     up = unwind
     for i, sp in enumerate(parts):
-        tag = "span" if len(parts) == 1 else f"span{i}"
+        tag = span_tag(i, len(parts))
         down = bodies[sp.to] if getattr(sp, "to", None) else None
         out.append(Span(sp, i, f"{key}{tag}.", f"{channel}{tag}_", up, down))
         up = down

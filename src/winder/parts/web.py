@@ -24,7 +24,7 @@ KEYS = Table((
     Key(name="span", kind="table", default_text="none",
         doc="an elastic span from an unwinding roll, a sub-table: keys below; several "
             "spans over idler rollers: [[web.span]], one table per span in order"),
-    Key(name="mu", unit="-", lo=0.0, lo_open=True, hi=10.0, default=0.3,
+    Key(name="mu", unit="-", lo=0.0, lo_open=True, hi=10.0, default=0.3, fmu="web_mu",
         doc="friction coefficient of the web on the idler rollers (their traction)"),
 ))
 
