@@ -96,8 +96,9 @@ def _check_scene(scene: Scene, where: str) -> None:
         raise ArgumentError(f"{where}: {scene.source}: the resonance map needs a wound roll "
                             "and the web entering it ([web] entry_nip); this scene has no "
                             "[web]")
-    for b in body_elements(scene):  # a body with a drive speed runs prescribed
-        if b.drive_web_speed() is not None and not b.prescribed:
+    for b in body_elements(scene):  # a body with a drive speed runs prescribed (a pull
+        # roll on a torque input turns at the speed its spans balance, as an idler)
+        if b.drive_web_speed() is not None and not b.prescribed and not b.roles.roller:
             raise ArgumentError(f"{where}: {scene.source}: the resonance map needs "
                                 f"{_where_drive(scene, b)} kind = 'speed_profile' (its "
                                 f"web speed is the operating speed), got "
@@ -275,6 +276,9 @@ class _Linearisation:
                     omega[b] = -omega[a] * ra / rb
                 elif b in omega and a not in omega:
                     omega[a] = -omega[b] * rb / ra
+        for b in m.bodies:  # the web line's rollers and its unwinding roll carry it at v
+            if b.roles.web in ("unwinds", "wraps") and b.name not in omega:
+                omega[b.name] = b.sense * self.v / self._radius_of(y, b.name)
         for b in m.bodies:
             if not b.prescribed and b.name in omega:
                 y[m.index(f"{b.name}.theta_dot")] = omega[b.name]
