@@ -12,12 +12,11 @@ from typing import Any
 import numpy as np
 import pytest
 import tomli_w
+from test_idler_line import _dancer_controlled
 
 import winder
 from winder.cli import main
 from winder.scene.keys import key_unit
-
-from test_idler_line import _dancer_controlled
 
 #: one point: a span by its index, the dancer's carriage, an idler's bearing, the unwind's
 #: loop, the web's friction on the rollers

@@ -28,13 +28,12 @@ from typing import Any
 import numpy as np
 import pytest
 import tomli_w
+from test_idler_line import T_SET, L, V, _data, _idler, _spans
 
 import winder
 from winder.cli import main
 from winder.forces.tension_control import tension_gains
 from winder.model.paper_roll import paper_roll_mass
-
-from test_idler_line import L, T_SET, V, _data, _idler, _spans
 
 MODEL = Path(__file__).resolve().parents[1] / "models" / "winder_line.toml"
 WC = 10.0        # [rad/s] the loop's bandwidth

@@ -116,6 +116,7 @@ def test_a_parameter_set_through_the_fmu_is_the_scene_changed(name: str, line_fm
             base.step(dt)
             got = fmu.getReal(vrs)
             want = [changed.output(k) for k in OUTPUTS]
-            assert got == want, (i, dict(zip(OUTPUTS, np.subtract(got, want))))
-            moved = max(moved, max(abs(g - base.output(k)) for g, k in zip(got, OUTPUTS)))
+            assert got == want, (i, dict(zip(OUTPUTS, np.subtract(got, want), strict=True)))
+            moved = max(moved, max(abs(g - base.output(k))
+                                   for g, k in zip(got, OUTPUTS, strict=True)))
     assert moved > 1e-6  # the change took

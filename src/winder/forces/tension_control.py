@@ -24,7 +24,8 @@ put the three closed-loop poles at ``−ω_c``, for any radius (``ω_c`` is the 
 **A span behind rollers** (``span = k > 0``). Its tension reaches the roll only through
 the rollers between, each a mass on the spans' springs (the roller–span modes, lightly
 damped by the transport); a rate term on that span's tension acts through their phase and
-destabilises them (measured: a pole at +4.9 1/s on a 1.5 + 1.5 m line at 5 m/s). The rate
+destabilises them (linearised: a pole at +4.97 1/s on a 1.5 + 1.5 m line at 5 m/s,
+ω_c = 10 rad/s). The rate
 is therefore taken where the torque acts, from the roll's own speed: below the roller
 modes the rollers pass the tension, every span of the unwind's **tension zone** (spans
 0 … m, up to the first that ends at a paced pull roll or at the entry drum) strains

@@ -1,8 +1,8 @@
 """Key paths on a scene's nested tables (:meth:`~winder.scene.Scene.to_dict`):
 ``drum.front.drive.web_speed`` enters a table by key and an array of tables by the
 element's ``name``, or, where its elements have no names (a web line's spans,
-``[[web.span]]``), by the element's index from 0: ``web.span.1.length``. Sweeps (:mod:`winder.analysis.sweep_grid`) and
-:func:`~winder.scene.keys.key_unit` read them."""
+``[[web.span]]``), by the element's index from 0: ``web.span.1.length``. Sweeps
+(:mod:`winder.analysis.sweep_grid`) and :func:`~winder.scene.keys.key_unit` read them."""
 
 from __future__ import annotations
 
