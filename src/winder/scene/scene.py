@@ -146,7 +146,8 @@ class Scene:
     def to_dict(self) -> dict[str, Any]:
         """The scene as nested dictionaries (TOML tables; arrays of tables as lists of
         dictionaries with their ``name``). A roll's density or caliper equal to
-        ``[paper]``'s is left to ``[paper]``; tuples become lists."""
+        ``[paper]``'s is left to ``[paper]``, a tension controller's ``span`` of 0 (the
+        default) is left out; tuples become lists."""
         out: dict[str, Any] = {"scene": _table_dict(self.scene),
                                "effects": self.effects.to_dict()}
         if self.legacy:
@@ -162,6 +163,8 @@ class Scene:
             for key in ("density", "caliper"):
                 if self.paper is not None and roll[key] == getattr(self.paper, key):
                     del roll[key]
+            if (roll.get("drive") or {}).get("span") == 0:  # the default: the first span
+                del roll["drive"]["span"]
         if len(self.webs) == 1:
             out["web"] = _web_dict(self.webs[0])
         elif self.webs:  # [[web]], one table per wound roll
