@@ -15,7 +15,8 @@ Oracles:
   design's closed loop ``((3ω_c² − 3ω_c b + b²) s + ω_c³) / (s + ω_c)³`` and settles when
   it does; the held span sits at the set-point, the first span below it by the roller's
   drag over its radius;
-- refusals: a span that does not exist or lies beyond a paced pull roll (API and CLI).
+- refusals: a span that does not exist, lies beyond a paced pull roll or behind a dancer
+  (API and CLI).
 """
 
 from __future__ import annotations
@@ -172,6 +173,11 @@ REFUSALS = [
         drive={"kind": "speed_profile", "web_acceleration": 0.0, "web_speed": V}),
      r"\[roll 'parent'.drive\] span: 1: span 1 lies beyond the pull roll 'idler'.*"
      r"valid: 0 "),
+    ("behind a dancer", lambda d: d["idler"][0].update(
+        wrap=math.pi, dancer={"stiffness": 2e4, "load": 2 * T_SET + DRAG, "mass": 20.0,
+                              "travel": [-0.1, 0.1]}),
+     r"\[roll 'parent'.drive\] span: 1: the dancer 'idler' lies in the unwind's tension "
+     r"zone.*valid: 0 \(the first span\), or kind = 'dancer_control'"),
     ("not whole", lambda d: d["roll"][1]["drive"].update(span=0.5),
      r"\[roll 'parent'.drive\] span: 0.5: not a whole number"),
 ]

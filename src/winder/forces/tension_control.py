@@ -31,12 +31,12 @@ modes the rollers pass the tension, every span of the unwind's **tension zone** 
 0 … m, up to the first that ends at a paced pull roll or at the entry drum) strains
 together, and the paper balance of the zone gives
 
-    C Ṫ = v_m − r ω − b C δT,     C = Σ_{i≤m} L_i / EA_i + Σ_dancers 4 / k_d,
-    b = v_m / (EA_m C)
+    C Ṫ = v_m − r ω − b C δT,     C = Σ_{i≤m} L_i / EA_i,     b = v_m / (EA_m C)
 
-(``v_m`` the surface speed of the body ending the zone; ``C`` [m/N] its compliance, a
-dancer's carriage adding the ``4/k`` of its two spans; ``b`` [1/s] the transport's
-self-regulation). The controller's rate is ``Ṫ_est = (v_m − r ω) / C``; with
+(``v_m`` the surface speed of the body ending the zone; ``C`` [m/N] its compliance;
+``b`` [1/s] the transport's self-regulation; a dancer in the zone is refused by the
+scene's checks: its damped carriage, not the unwind, sets the tension behind it). The
+controller's rate is ``Ṫ_est = (v_m − r ω) / C``; with
 ``g = r / (J C)`` the gains
 
     k_d = (3 ω_c − b) / g,   k_p = 3 ω_c² / g − r − k_d b,   k_i = ω_c³ / g
@@ -138,8 +138,6 @@ class TensionController(ForceElement):
             zone = tension_zone(w.spans)
             end = zone[-1].downstream or w.entry.a
             c = sum(ev.p(f"{s.key}length") / ev.p(f"{s.key}EA") for s in zone)
-            c = c + sum(4.0 / ev.p(f"{s.downstream.name}.dancer_stiffness") for s in zone
-                        if s.downstream is not None and s.downstream.roles.dancer is not None)
             v_end = ev.bodies[end.name].r * ev.bodies[end.name].speed
             kp, ki, kd = tension_gains(wc, r / (J * c), r,
                                        v_end / (ev.p(f"{zone[-1].key}EA") * c))

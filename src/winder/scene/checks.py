@@ -397,9 +397,17 @@ def _check_controlled_span(source: str, dlabel: str, parts: _Parts, label: str,
                            web: WebPart, span: int) -> None:
     """Span ``span`` of ``web`` lies in its unwind's tension zone: its spans up to the
     first one that ends at a paced roller (a pull roll on a speed profile) or the entry
-    drum (machines.md §11)."""
+    drum (machines.md §11); a span after the first only where no dancer lies in the
+    zone."""
     zone = next((i for i, s in enumerate(web.spans)
                  if s.to is None or parts.roles[s.to].paced), len(web.spans) - 1)
+    dancers = [s.to for s in web.spans[:zone] if parts.roles[s.to].dancer is not None]
+    if 0 < span <= zone and dancers:
+        raise fail(source, dlabel, "span",
+                   f"{span!r}: the dancer {dancers[0]!r} lies in the unwind's tension zone "
+                   "(the spans it strains together): its carriage, not the unwind, sets "
+                   "the tension behind it and the rule has no design for it; valid: 0 (the "
+                   "first span), or kind = 'dancer_control'")
     if span <= zone:
         return
     why = f"[{label}] has {len(web.spans)} span(s)" if span >= len(web.spans) else \
