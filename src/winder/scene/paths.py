@@ -18,7 +18,9 @@ def _names(node: list) -> list[str]:
     """How the path names the elements of an array of tables: by ``name``, or, where none
     has one (a web line's spans), by index ``0, 1, …``."""
     named = [str(e.get("name")) for e in node if isinstance(e, Mapping) and "name" in e]
-    return named if named else [str(i) for i in range(len(node))]
+    if named or not all(isinstance(e, Mapping) for e in node):
+        return named  # a list of numbers (a centre, a load schedule) has no elements here
+    return [str(i) for i in range(len(node))]
 
 
 def resolve(data: Any, key: str) -> tuple[Any, str | int]:
