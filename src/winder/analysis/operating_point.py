@@ -41,6 +41,7 @@ import numpy as np
 
 from winder._args import number, show
 from winder._errors import ArgumentError, ArgumentTypeError
+from winder.analysis.line_modes import line_coordinates
 from winder.analysis.linearise import jacobian
 from winder.analysis.mode_labels import Mode, label_modes
 from winder.analysis.shapes import Shapes
@@ -516,11 +517,13 @@ class _Linearisation:
         p, m = self.system.params, self.machine
         rotary = np.array([0.5 * float(p[m.param_index(f"{n.split('.', 1)[0]}.inertia")])
                            if ".tilt_rate_" in n else 0.0 for n in names])
+        line = line_coordinates(m, p, names, {b: float(s.inertia)
+                                              for b, s in ev.bodies.items()})
         return label_modes(self.fast_jacobian(y), shapes=self.shapes,
                            n_positions=len(self.positions), n_speeds=len(self.speeds),
                            mass=mass, inertia=inertia, names=names,
                            mechanical=np.array([i not in others for i in self.fast],
-                                               dtype=bool), rotary=rotary)
+                                               dtype=bool), rotary=rotary, line=line)
 
     def initial(self) -> np.ndarray:
         """The machine's initial state (``winder run``'s at ``t = 0``: the static balance
