@@ -347,9 +347,8 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         out = scene.naming.output_name  # the result's channels as the scene names them
         nips = {n.name: (out(f"{n.name}_normal_force"), out(f"{mm.roll}_radius"))
                 for n in scene.nips if mm.roll in (n.a, n.b)}
-        title = f"Resonance map of {scene.name}" + (
-            f": the web line's modes against the unwinding roll {mm.roll}'s radius"
-            if mm.unwinding else "")
+        title = f"Line modes of {scene.name} against the parent's radius" \
+            if mm.unwinding else f"Resonance map of {scene.name}"
         path = campbell_figure(mm, plot, result=result, envelopes=nips or None, title=title,
                                colours=nip_colours(scene))
         print(f"  figure written to {path}")
