@@ -38,7 +38,8 @@ def _carriage(modes: list[winder.Mode], name: str = "dancer") -> winder.Mode:
 def test_dancer_at_standstill_is_its_spring_and_spans() -> None:
     """Held spans either side, the web at rest: the mode labelled ``dancer.carriage`` is
     undamped at ``sqrt((k + 2 EA/L) / m_d) / 2π`` (31.08 Hz; measured 0 relative error,
-    the roller 2.2e-16: the Jacobian exact at d = 0); the roller's own mode ``dancer.roller`` at ``sqrt(2 (EA − T) R² / (L J)) / 2π``."""
+    the roller 2.2e-16: the Jacobian exact at d = 0); the roller's own mode
+    ``dancer.roller`` at ``sqrt(2 (EA − T) R² / (L J)) / 2π``."""
     scene = winder.scene_from_dict(_dancer_line(), source="<dancer>")
     modes = winder.modes_at(scene)
     m = _carriage(modes)
