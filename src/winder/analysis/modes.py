@@ -23,6 +23,10 @@ relaxation (a real eigenvalue, a slip mode), and no label where no oscillating m
 that shape (NaN in the map). A harmonic ``k`` meets a bending mode of frequency ``f_b``
 where ``k v/(2π r) = f_b``, at ``r = k v/(2π f_b)``.
 
+A web line (machines.md §11) maps against its unwinding roll's radius too (``roll``): its
+tension and dancer modes (``dancer.carriage``, ``span0.tension``, …:
+:mod:`winder.analysis.line_modes`) against the parent's rotation ``k v/(2π r)``.
+
 A scene without a winding operating point (no wound roll: no ``[web]``, e.g. a drum alone
 on its bearings; or ``[effects] contact = false``) has one row: the modes of the machine at
 its initial state (``winder run``'s at ``t = 0``, the imbalance off; the free bodies as
@@ -124,7 +128,8 @@ def _at_rest(scene: Scene, where: str, web_speed: float | None) -> _Linearisatio
 
 @dataclass(frozen=True)
 class ModeMap:
-    """Modes against the wound roll's radius (or, :attr:`initial_state`, one row: the
+    """Modes against the wound roll's radius (or, :attr:`unwinding`, an unwinding roll's:
+    its web line's modes in :attr:`line`; or, :attr:`initial_state`, one row: the
     modes at the initial state). Arrays over ``radius`` [m]; frequencies
     [Hz]; speeds [m/s].
 
@@ -357,9 +362,8 @@ class ModeMap:
             kind = "real (no oscillation): |λ|/2π" if np.all(f[ok] == 0) else "damped"
             shown = nat if np.all(f[ok] == 0) else f
             out.append(f"line mode {c} {kind} {shown[i]:.2f} -> {shown[j]:.2f} Hz, damping "
-                       f"ratio {z[i]:.3f} -> {z[j]:.3f}"
-                       + ("" if len(ok) == len(f) else f" (found at {len(ok)} of {len(f)} "
-                          "radii)"))
+                       f"ratio {z[i]:.3f} -> {z[j]:.3f}" + ("" if len(ok) == len(f) else
+                                                            f" (at {len(ok)} of {len(f)} radii)"))
         crossings = self.crossings(self.line_shown)
         out += [f"{h} rotation of {self.roll} meets {c} at r = {rc:.4f} m"
                 for c, h, rc in crossings]
