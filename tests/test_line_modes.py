@@ -258,3 +258,30 @@ def test_modes_cli_over_the_parent(tmp_path) -> None:
     with pytest.raises(winder.ArgumentError, match="roll = 'guide1'.*'parent'"):
         winder.mode_map(winder.load_scene(MODEL), roll="guide1", n=3)
     assert main(["modes", str(MODEL), "--roll", "rider", "--points", "3"]) == 2
+
+
+def test_line_map_figure_draws_the_map(tmp_path, monkeypatch) -> None:
+    """The line map's figure draws each oscillating line mode's frequencies over the
+    parent's radius and the parent's rotation ``k v / (2π r)``, legend beside the chart."""
+    import winder.plots.figures as _plots
+    from winder.plots.campbell import campbell_figure
+
+    mm = winder.mode_map(winder.load_scene(MODEL), roll="parent", n=4)
+    drawn: dict[str, np.ndarray] = {}
+    save = _plots._save
+
+    def capture(fig, path: Path) -> Path:
+        drawn.update({ln.get_label(): np.asarray(ln.get_ydata(), float)
+                      for ln in fig.axes[0].get_lines()})
+        drawn["legends"] = np.array([len(fig.legends)])
+        return save(fig, path)
+
+    monkeypatch.setattr(_plots, "_save", capture)
+    campbell_figure(mm, tmp_path / "line.png", title="line")
+    for c in mm.line_shown:
+        np.testing.assert_array_equal(drawn[f"line mode {c} (damped)"], mm.line[c])
+    for k in (1, 2, 3):
+        label = f"{k}× rotation of parent (unwinding) at 41.7 m/s"
+        np.testing.assert_allclose(drawn[label], k * 41.7 / (2 * np.pi * mm.radius),
+                                   rtol=1e-12)
+    assert drawn["legends"][0] == 1  # the figure's legend, beside the chart
