@@ -35,6 +35,9 @@ label:
 - of the rest, an oscillating mode whose kinetic energy is at least half in the flexible
   bodies' twist is a **torsion mode** ``BODY.torsion{n}`` (:meth:`Shapes.torsion_label`),
   each label once: the mode with the most energy in that order of that body;
+- of the rest, a web line's modes take the line's labels by their energy
+  (:mod:`winder.analysis.line_modes`: ``span0.tension``, ``dancer.carriage``,
+  ``guide1.roller``, ``parent.unwind``; kind ``line``);
 - every other mode, the real ones (the friction states' relaxations among them) included,
   is a **slip mode** named by the state (not a position) with the largest entry of its
   eigenvector (``nip_s7.friction``, ``roll.theta_dot``): never a shape label.
@@ -47,6 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from winder.analysis.line_modes import LineCoordinates
 from winder.analysis.shapes import Shapes
 
 __all__ = ["Mode", "label_modes", "MECHANICAL_SHARE", "SHAPE_SHARE", "ROTATION_SHARE"]
@@ -69,7 +73,8 @@ ROTATION_SHARE = 0.5
 class Mode:
     """One eigenvalue (of a pair): ``frequency`` [Hz] (damped, 0 for a real eigenvalue),
     ``natural_frequency`` ``|λ|/2π`` [Hz], ``damping_ratio`` [-], ``kind`` (``bounce``,
-    ``bending``, ``slip``, ``torsion`` or ``rotation``) and ``coordinate``: the free
+    ``bending``, ``slip``, ``torsion``, ``rotation`` or ``line``: a web line's tension,
+    dancer or roller mode, :mod:`winder.analysis.line_modes`) and ``coordinate``: the free
     coordinate that
     dominates a bounce mode (``BODY.x``/``BODY.z``), a flexible body's bending order
     (``BODY.bend.z1``, :mod:`winder.analysis.shapes`) or torsion order
@@ -109,9 +114,12 @@ def mechanical_share(left: np.ndarray, right: np.ndarray, mechanical: np.ndarray
 
 def label_modes(A: np.ndarray, *, shapes: Shapes, n_positions: int, n_speeds: int,
                 mass: np.ndarray, inertia: np.ndarray, names: list[str],
-                mechanical: np.ndarray, rotary: np.ndarray | None = None) -> list[Mode]:
+                mechanical: np.ndarray, rotary: np.ndarray | None = None,
+                line: LineCoordinates | None = None) -> list[Mode]:
     """The modes of the fast states' Jacobian ``A`` (module text): the bounce and bending
-    modes in the order of ``shapes.labels`` (those that have one), then the slip modes
+    modes in the order of ``shapes.labels`` (those that have one), then a web line's
+    modes (``line``: :mod:`winder.analysis.line_modes`, kind ``line``, in the order of its
+    labels), then the slip modes
     (slowest first), then the torsion modes (slowest first). ``n_positions`` free
     coordinates (of masses ``mass`` [kg]), ``n_speeds`` turning bodies (``inertia``
     [kg·m²]), ``names`` of the fast states, ``mechanical`` the mask of the bodies' states,
@@ -181,11 +189,20 @@ def label_modes(A: np.ndarray, *, shapes: Shapes, n_positions: int, n_speeds: in
             best[label[0]] = (label[1], k)
         else:
             rest.append(k)
+    lines: list[Mode] = []
+    if line is not None:  # a web line's tension and dancer modes, by their energy
+        part = mechanical_share(left[:, keep], right[:, keep], mechanical | line.states)
+        named = line.assign(V, lam[keep], rest, total, part,
+                            mechanical_share(left[:, keep], right[:, keep], line.line_states))
+        order = {c: i for i, c in enumerate(line.labels)}
+        lines = sorted((Mode(complex(lam[keep[k]]), "line", c) for k, c in named.items()),
+                       key=lambda m: order[m.coordinate])
+        rest = [k for k in rest if k not in named]
     slips = [Mode(complex(lam[keep[k]]), "slip",
                   names[nt + int(np.argmax(np.abs(V[nt:, k])))]) for k in rest]
     torsions = [Mode(complex(lam[keep[k]]), "torsion", c) for c, (_, k) in best.items()]
     slowest = lambda m: abs(m.eigenvalue)  # noqa: E731
-    return out + sorted(slips, key=slowest) + sorted(torsions, key=slowest) \
+    return out + lines + sorted(slips, key=slowest) + sorted(torsions, key=slowest) \
         + sorted(rotations, key=slowest)
 
 

@@ -23,6 +23,10 @@ relaxation (a real eigenvalue, a slip mode), and no label where no oscillating m
 that shape (NaN in the map). A harmonic ``k`` meets a bending mode of frequency ``f_b``
 where ``k v/(2π r) = f_b``, at ``r = k v/(2π f_b)``.
 
+A web line (machines.md §11) maps against its unwinding roll's radius too (``roll``): its
+tension and dancer modes (``dancer.carriage``, ``span0.tension``, …:
+:mod:`winder.analysis.line_modes`) against the parent's rotation ``k v/(2π r)``.
+
 A scene without a winding operating point (no wound roll: no ``[web]``, e.g. a drum alone
 on its bearings; or ``[effects] contact = false``) has one row: the modes of the machine at
 its initial state (``winder run``'s at ``t = 0``, the imbalance off; the free bodies as
@@ -71,8 +75,8 @@ SHOWN_ORDERS = 2
 FREE_BELOW = 1e-3
 
 
-def modes_at(scene: Scene, radius: float | None = None, *, web_speed: float | None = None
-             ) -> list[Mode]:
+def modes_at(scene: Scene, radius: float | None = None, *, web_speed: float | None = None,
+             roll: str | None = None) -> list[Mode]:
     """Modes of the linearised machine at ``radius`` [m] of the wound roll and ``web_speed``
     [m/s] (see :func:`operating_point` for the valid range): the bounce modes, one per free
     translational coordinate in the machine's order (a single-drum scene: its one bounce
@@ -80,15 +84,19 @@ def modes_at(scene: Scene, radius: float | None = None, *, web_speed: float | No
     then the slip and torsion modes (:mod:`winder.analysis.mode_labels`). A scene without a
     winding operating point (no wound roll, or ``[effects] contact = false``:
     :func:`~winder.analysis.operating_point.winding_reason`) has the modes of its initial
-    state: give no ``radius`` (``web_speed`` is checked, and unused)."""
+    state: give no ``radius`` (``web_speed`` is checked, and unused). ``roll``: the paper
+    roll ``radius`` is of (default the wound roll; a web's unwinding roll: the parent's
+    radius, the other paper rolls at their initial radius); a web line's modes are kind
+    ``line`` (:mod:`winder.analysis.line_modes`)."""
     _check_type(scene, "modes_at")
     reason = winding_reason(scene)
     if reason is not None:
         _no_radius("modes_at", "radius", radius, scene, reason)
+        _no_radius("modes_at", "roll", roll, scene, reason)
         lin = _at_rest(scene, "modes_at", web_speed)
         return lin.modes(lin.initial())
     where = "operating_point"
-    lin = _linearisation(scene, where, web_speed, lo_open=False)
+    lin = _linearisation(scene, where, web_speed, lo_open=False, roll=roll)
     if radius is None:
         raise ArgumentError(f"modes_at: radius is required: {scene.source} winds its roll; "
                             f"valid: a finite radius >= {_core_key(lin)} = {lin.rc:g} m")
@@ -120,7 +128,8 @@ def _at_rest(scene: Scene, where: str, web_speed: float | None) -> _Linearisatio
 
 @dataclass(frozen=True)
 class ModeMap:
-    """Modes against the wound roll's radius (or, :attr:`initial_state`, one row: the
+    """Modes against the wound roll's radius (or, :attr:`unwinding`, an unwinding roll's:
+    its web line's modes in :attr:`line`; or, :attr:`initial_state`, one row: the
     modes at the initial state). Arrays over ``radius`` [m]; frequencies
     [Hz]; speeds [m/s].
 
@@ -157,6 +166,15 @@ class ModeMap:
     #: ``radius`` the wound roll's initial radius (none: NaN)
     initial_state: bool = False
     initial_reason: str = ""
+    #: per line mode of a web line (``dancer.carriage``, ``guide1.roller``,
+    #: ``span0.tension``, ``parent.unwind``: :mod:`winder.analysis.line_modes`) its damped
+    #: frequency [Hz] (0 where its eigenvalue is real), damping ratio [-] and natural
+    #: frequency ``|λ|/2π`` [Hz]; NaN at a radius where no mode has that label
+    line: dict[str, np.ndarray] = field(default_factory=dict)
+    line_damping: dict[str, np.ndarray] = field(default_factory=dict)
+    line_natural: dict[str, np.ndarray] = field(default_factory=dict)
+    #: True: ``radius`` is an unwinding roll's (``roll``, the parent), not the wound roll's
+    unwinding: bool = False
 
     @property
     def coordinates(self) -> list[str]:
@@ -178,10 +196,27 @@ class ModeMap:
         out = [c for c in self.coordinates if ".bend." not in c or order(c) <= orders]
         return out + [c for c in self.torsion if order(c) == 1]
 
+    def frequency(self, mode: str) -> np.ndarray:
+        """The damped frequency [Hz] of a bounce, bending or line mode, or the natural
+        frequency of a torsion mode, over :attr:`radius`."""
+        for table in (self.frequencies, self.line, self.torsion):
+            if mode in table:
+                return table[mode]
+        raise KeyError(mode)
+
+    @property
+    def line_shown(self) -> list[str]:
+        """The line modes that oscillate at some radius (a chart draws these)."""
+        return [c for c, f in self.line.items() if np.any(f > 0)]
+
     @property
     def main(self) -> str:
         """The wound roll's vertical mode (``ROLL.z``; flexible: ``ROLL.bend.z1``), else
-        the first; ``""`` for a machine without free coordinates."""
+        the first; ``""`` for a machine without free coordinates. A map over an unwinding
+        roll's radius: its line's first dancer carriage (else its first line mode)."""
+        if self.unwinding:
+            return next((c for c in self.line if c.endswith(".carriage")),
+                        next(iter(self.line), ""))
         for z in (f"{self.roll}.z", f"{self.roll}.bend.z1"):
             if self.roll and z in self.frequencies:
                 return z
@@ -189,11 +224,14 @@ class ModeMap:
 
     @property
     def bounce_frequency(self) -> np.ndarray:
-        return self.frequencies.get(self.main, np.full(len(self.radius), np.nan))
+        """:attr:`main`'s damped frequency [Hz]."""
+        return {**self.frequencies, **self.line}.get(self.main,
+                                                    np.full(len(self.radius), np.nan))
 
     @property
     def bounce_damping(self) -> np.ndarray:
-        return self.dampings.get(self.main, np.full(len(self.radius), np.nan))
+        return {**self.dampings, **self.line_damping}.get(self.main,
+                                                          np.full(len(self.radius), np.nan))
 
     def overdamped(self, mode: str | None = None) -> list[tuple[float, float]]:
         """The radius ranges ``(first, last)`` [m] over which a bounce mode (default
@@ -243,8 +281,8 @@ class ModeMap:
         frequency changes by less than 25 % between the two radii."""
         line = self.harmonics()[f"{order}x" if isinstance(order, int) else order]
         mode = mode or self.main
-        if mode in self.frequencies:
-            f = self.frequencies[mode]
+        if mode in self.frequencies or mode in self.line:
+            f = self.frequency(mode)
         else:  # a torsion mode's |λ|/2π: not where it is overdamped (a real root)
             f = np.where(self.torsion_damping[mode] < 1.0, self.torsion[mode], np.nan)
         d = f - line
@@ -263,7 +301,8 @@ class ModeMap:
     def crossings(self, modes: list[str] | None = None) -> list[tuple[str, str, float]]:
         """Every crossing ``(mode, harmonic, radius [m])`` of the bounce, bending and
         torsion modes (or of ``modes``, e.g. :meth:`shown`) with the harmonics."""
-        modes = [*self.coordinates, *self.torsion] if modes is None else modes
+        modes = [*self.coordinates, *self.torsion, *self.line_shown] if modes is None \
+            else modes
         return [(c, h, rc) for c in modes for h in self.harmonics()
                 for rc in self.critical_radii(h, c)]
 
@@ -275,6 +314,8 @@ class ModeMap:
         map of the initial state: each mode at it."""
         if self.initial_state:
             return self._initial_summary()
+        if self.unwinding:
+            return self._line_summary()
         if self.flexible:
             out = []
             for c in self.shown():
@@ -306,6 +347,27 @@ class ModeMap:
                            "r = " + (", ".join(f"{x:.4f} m" for x in crit) if crit
                                      else "(no crossing)"))
         return out
+
+    def _line_summary(self) -> list[str]:
+        """The lines of a map over an unwinding roll's radius: each line mode from the
+        first to the last radius, then where a harmonic of the roll's rotation meets one."""
+        out = []
+        for c, f in self.line.items():
+            z, nat = self.line_damping[c], self.line_natural[c]
+            ok = np.nonzero(np.isfinite(f))[0]
+            if not len(ok):
+                out.append(f"line mode {c}: no mode of this shape over the map")
+                continue
+            i, j = ok[0], ok[-1]
+            kind = "real (no oscillation): |λ|/2π" if np.all(f[ok] == 0) else "damped"
+            shown = nat if np.all(f[ok] == 0) else f
+            out.append(f"line mode {c} {kind} {shown[i]:.2f} -> {shown[j]:.2f} Hz, damping "
+                       f"ratio {z[i]:.3f} -> {z[j]:.3f}" + ("" if len(ok) == len(f) else
+                                                            f" (at {len(ok)} of {len(f)} radii)"))
+        crossings = self.crossings(self.line_shown)
+        out += [f"{h} rotation of {self.roll} meets {c} at r = {rc:.4f} m"
+                for c, h, rc in crossings]
+        return out or ["no line mode over the map"]
 
     def _initial_summary(self) -> list[str]:
         """The lines of a map of the initial state: each bounce or bending mode (a flexible
@@ -352,6 +414,11 @@ class ModeMap:
             key = c.replace(".", "_")
             cols[f"{key}_frequency"] = f
             cols[f"{key}_damping"] = self.torsion_damping[c]
+        for c, f in self.line.items():
+            key = c.replace(".", "_")
+            cols[f"{key}_frequency"] = f
+            cols[f"{key}_damping"] = self.line_damping[c]
+            cols[f"{key}_natural_frequency"] = self.line_natural[c]
         cols.update({"slip_frequency": self.slip_frequency, "slip_damping": self.slip_damping,
                      "rotation_1x": self.rotation_1x, "rotation_2x": self.rotation_2x,
                      "rotation_3x": 3 * self.rotation_1x})
@@ -376,8 +443,10 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
     roll, rc = lin.roll, lin.rc
     key = _core_key(lin)
     hi = ROLL_KEYS["initial_radius"].hi
+    if lin.unwinding and radius_max is None:  # the parent from empty (its core) to full
+        radius_max = roll.initial_radius
     if radius_min is None:
-        lo = roll.initial_radius
+        lo = rc if lin.unwinding else roll.initial_radius
     else:
         lo = number(where, names[0], radius_min, lo=rc, hi=hi, unit="m",
                     valid=f"a finite radius >= {key} = {rc:g} m and <= {hi:g} m")
@@ -389,7 +458,8 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
                                 f"scene's duration); valid: a smaller {names[0]}, or give "
                                 f"{names[1]} too")
         return lo, end
-    below = "the roll's initial radius" if radius_min is None else names[0]
+    below = "the roll's initial radius" if radius_min is None and not lin.unwinding \
+        else f"the roll's core radius ({key})" if radius_min is None else names[0]
     up = number(where, names[1], radius_max, lo=lo, lo_open=True, hi=hi, unit="m",
                 valid=f"a finite radius > {below} = {lo:g} m and <= {hi:g} m")
     return lo, up
@@ -397,7 +467,7 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
 
 def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
              web_speed: float | None = None, n: int = 200, radius_min: float | None = None,
-             radius_max: float | None = None,
+             radius_max: float | None = None, roll: str | None = None,
              _names: tuple[str, str] = ("radius_min", "radius_max")) -> ModeMap:
     """The resonance map over ``radii`` [m] of the wound roll (each ``>=`` its core
     radius; default: ``n`` points, 2 … 10 000, from ``radius_min`` [m] (default its initial
@@ -409,6 +479,13 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     false``) gives one row, the modes of its initial state (:attr:`ModeMap.initial_state`;
     ``n`` checked and unused, ``web_speed`` [m/s] ``>= 0`` only for the drums' rotation,
     default each drum's own).
+
+    ``roll`` names the paper roll whose radius the map follows: the wound roll (default),
+    or a web's unwinding roll (the parent): then the map holds its web line's tension and
+    dancer modes (:attr:`ModeMap.line`, :mod:`winder.analysis.line_modes`) against the
+    parent's radius, from its core radius (empty; default ``radius_min``) to its initial
+    radius (full; default ``radius_max``), the wound roll at its initial radius, and the
+    harmonics are the parent's rotation ``v/(2π r)``.
 
     Raises
     ------
@@ -422,10 +499,10 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     if reason is not None:  # one row: the modes of the initial state
         integer(where, "n", n, lo=2, hi=MAX_POINTS)  # checked, unused
         for name, value in (("radii", radii), (_names[0], radius_min),
-                            (_names[1], radius_max)):
+                            (_names[1], radius_max), ("roll", roll)):
             _no_radius(where, name, value, scene, reason)
         return _initial_map(scene, where, web_speed, reason)
-    lin = _linearisation(scene, where, web_speed, lo_open=True)
+    lin = _linearisation(scene, where, web_speed, lo_open=True, roll=roll)
     v, rc = lin.v, lin.rc
     if radii is None:
         n = integer(where, "n", n, lo=2, hi=MAX_POINTS)
@@ -474,8 +551,12 @@ def _assembled(lin: _Linearisation, scene: Scene, radii: np.ndarray, rows: list[
     damp = np.full((nt, len(radii)), np.nan)
     natural = np.full((nt, len(radii)), np.nan)
     slip = np.full((2, len(radii)), np.nan)
+    line: dict[str, np.ndarray] = {}  # label -> (frequency, damping, natural) rows
     for i, ms in enumerate(rows):
         for m in ms:
+            if m.kind == "line":
+                row = line.setdefault(m.coordinate, np.full((3, len(radii)), np.nan))
+                row[:, i] = m.frequency, m.damping_ratio, m.natural_frequency
             if m.kind in ("bounce", "bending"):
                 j = lin.labels.index(m.coordinate)
                 freq[j, i], damp[j, i] = m.frequency, m.damping_ratio
@@ -494,7 +575,11 @@ def _assembled(lin: _Linearisation, scene: Scene, radii: np.ndarray, rows: list[
                    lin.v, roll, drums, naming_of(scene),
                    dict(zip(lin.labels, natural, strict=True)),
                    {c: torsion[c] for c in order}, {c: tdamp[c] for c in order},
-                   initial_state=bool(reason), initial_reason=reason)
+                   initial_state=bool(reason), initial_reason=reason,
+                   line={c: x[0] for c, x in line.items()},
+                   line_damping={c: x[1] for c, x in line.items()},
+                   line_natural={c: x[2] for c, x in line.items()},
+                   unwinding=lin.unwinding)
 
 
 def _initial_map(scene: Scene, where: str, web_speed: float | None, reason: str) -> ModeMap:

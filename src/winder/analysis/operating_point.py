@@ -41,6 +41,7 @@ import numpy as np
 
 from winder._args import number, show
 from winder._errors import ArgumentError, ArgumentTypeError
+from winder.analysis.line_modes import line_coordinates
 from winder.analysis.linearise import jacobian
 from winder.analysis.mode_labels import Mode, label_modes
 from winder.analysis.shapes import Shapes
@@ -149,9 +150,13 @@ class _Linearisation:
     """The machine of a scene at its operating points (see the module docstring): one
     :class:`MachineSystem` with the imbalance off and the drums at full speed ``v``."""
 
-    def __init__(self, scene: Scene, v: float, *, winding: bool = True) -> None:
+    def __init__(self, scene: Scene, v: float, *, winding: bool = True,
+                 roll: str | None = None, where: str = "mode_map") -> None:
         """``winding`` false: the machine as the scene has it (its drives' ramps), for the
-        modes at its :meth:`initial` state (no wound roll, or contact off)."""
+        modes at its :meth:`initial` state (no wound roll, or contact off). ``roll``: the
+        paper roll whose radius is the map's (default the wound roll; a web's unwinding
+        roll: its line's modes against the parent's radius, the other paper rolls at their
+        initial radius)."""
         self.scene, self.v = scene, v
         self.system = sys_ = MachineSystem(scene)
         m = self.machine = sys_.machine
@@ -162,8 +167,22 @@ class _Linearisation:
         for b in m.bodies if winding else ():  # the prescribed ones at full speed from t = 0
             b.hold_operating_speed(m, p, v)
         self.t = 0.0
-        #: the wound roll (the web's), or None
+        #: the roll whose radius is the map's: the wound roll (the web's), or None; or the
+        #: unwinding roll named by ``roll`` (:attr:`unwinding`)
         self.roll = m.entry.b if m.entry is not None else None
+        unwinding = [w.unwind.name for w in m.webs if w.unwind is not None]
+        if roll is not None and roll not in unwinding and \
+                (self.roll is None or roll != self.roll.name):
+            wound = f"the wound roll {self.roll.name!r} (the default) or " \
+                if self.roll is not None else ""
+            raise ArgumentError(f"{where}: roll = {roll!r} is not a roll whose radius the "
+                                f"map can follow in {scene.source}; valid: {wound}a web's "
+                                "unwinding roll ("
+                                f"{', '.join(map(repr, unwinding)) or 'none here'})")
+        #: the map follows an unwinding roll's radius (its line's modes)
+        self.unwinding = roll in unwinding
+        if self.unwinding:
+            self.roll = m.body[roll]
         if self.roll is not None:
             self.i_r = m.index(_radius_state(self.roll))
             self.rc = self.roll.least_radius
@@ -276,9 +295,12 @@ class _Linearisation:
                     omega[b] = -omega[a] * ra / rb
                 elif b in omega and a not in omega:
                     omega[a] = -omega[b] * rb / ra
-        for b in m.bodies:  # the web line's rollers and its unwinding roll carry it at v
-            if b.roles.web in ("unwinds", "wraps") and b.name not in omega:
-                omega[b.name] = b.sense * self.v / self._radius_of(y, b.name)
+        line = m.entry.a.surface_speed(self.v) if m.entry is not None else 0.0
+        for w in m.webs:  # a web line at the line's speed: its unwinding roll and rollers
+            for s in w.spans:
+                b = s.upstream
+                if b is not None and not b.prescribed:
+                    omega[b.name] = b.sense * line / self._radius_of(y, b.name)
         for b in m.bodies:
             if not b.prescribed and b.name in omega:
                 y[m.index(f"{b.name}.theta_dot")] = omega[b.name]
@@ -520,11 +542,13 @@ class _Linearisation:
         p, m = self.system.params, self.machine
         rotary = np.array([0.5 * float(p[m.param_index(f"{n.split('.', 1)[0]}.inertia")])
                            if ".tilt_rate_" in n else 0.0 for n in names])
+        line = line_coordinates(m, p, names, {b: float(s.inertia)
+                                              for b, s in ev.bodies.items()})
         return label_modes(self.fast_jacobian(y), shapes=self.shapes,
                            n_positions=len(self.positions), n_speeds=len(self.speeds),
                            mass=mass, inertia=inertia, names=names,
                            mechanical=np.array([i not in others for i in self.fast],
-                                               dtype=bool), rotary=rotary)
+                                               dtype=bool), rotary=rotary, line=line)
 
     def initial(self) -> np.ndarray:
         """The machine's initial state (``winder run``'s at ``t = 0``: the static balance
@@ -536,10 +560,14 @@ class _Linearisation:
         return y
 
 
-def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: bool
-                   ) -> _Linearisation:
+def _linearisation(scene: Scene, where: str, web_speed: float | None, lo_open: bool,
+                   roll: str | None = None) -> _Linearisation:
     _check_scene(scene, where)
-    return _Linearisation(scene, _web_speed(where, scene, web_speed, lo_open=lo_open))
+    if roll is not None and not isinstance(roll, str):
+        raise ArgumentTypeError(f"{where}: roll must be a roll's name (str), got "
+                                f"{show(roll)} ({type(roll).__name__})")
+    return _Linearisation(scene, _web_speed(where, scene, web_speed, lo_open=lo_open),
+                          roll=roll, where=where)
 
 
 def _core_key(lin: _Linearisation) -> str:

@@ -310,12 +310,17 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     from winder.io.files import atomic_write, csv_writer
 
     mm = mode_map(scene, web_speed=args.web_speed, n=args.points, radius_min=args.radius_min,
-                  radius_max=args.radius_max, _names=("--radius-min", "--radius-max"))
+                  radius_max=args.radius_max, roll=args.roll,
+                  _names=("--radius-min", "--radius-max"))
     if mm.initial_state:  # no wound roll, or contact off: one row
         where = "" if math.isnan(mm.radius[0]) else \
             f", the wound roll at r = {mm.radius[0]:.3f} m"
         print(f"{scene.name}: modes at the initial state ({mm.initial_reason}: no map over "
               f"a wound roll's radius{where})")
+    elif mm.unwinding:
+        print(f"{scene.name}: the web line's modes at {len(mm.radius)} radii of the "
+              f"unwinding roll {mm.roll!r}, {mm.radius[0]:.3f}-{mm.radius[-1]:.3f} m, web "
+              f"speed {mm.web_speed:g} m/s")
     else:
         print(f"{scene.name}: modes at {len(mm.radius)} radii, {mm.radius[0]:.3f}-"
               f"{mm.radius[-1]:.3f} m, web speed {mm.web_speed:g} m/s")
@@ -330,7 +335,10 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         from winder.solve.simulate import simulate
 
         result = None
-        if args.simulate and mm.initial_state:
+        if args.simulate and mm.unwinding:
+            print("  (the normal-force envelope follows the wound roll's radius: not "
+                  "simulated for a map over the unwinding roll's)", file=sys.stderr)
+        elif args.simulate and mm.initial_state:
             print("  (the normal-force envelope needs a map over a wound roll's radius: not "
                   "simulated)", file=sys.stderr)
         elif args.simulate:
@@ -339,8 +347,9 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         out = scene.naming.output_name  # the result's channels as the scene names them
         nips = {n.name: (out(f"{n.name}_normal_force"), out(f"{mm.roll}_radius"))
                 for n in scene.nips if mm.roll in (n.a, n.b)}
-        path = campbell_figure(mm, plot, result=result, envelopes=nips or None,
-                               title=f"Resonance map of {scene.name}",
+        title = f"Line modes of {scene.name} against the parent's radius" \
+            if mm.unwinding else f"Resonance map of {scene.name}"
+        path = campbell_figure(mm, plot, result=result, envelopes=nips or None, title=title,
                                colours=nip_colours(scene))
         print(f"  figure written to {path}")
     return 0
@@ -453,6 +462,12 @@ def _build_parser() -> argparse.ArgumentParser:
     modes.add_argument("--radius-max", type=_POSITIVE, metavar="R",
                        help="largest radius of the wound roll [m] (default: its radius at "
                        "the end of the scene's run)")
+    modes.add_argument("--roll", metavar="NAME",
+                       help="the paper roll whose radius the map follows: the wound roll "
+                       "(default) or a web's unwinding roll (the parent: its web line's "
+                       "tension and dancer modes against the parent's radius, from its core "
+                       "radius to its initial radius by default; the wound roll stays at "
+                       "its initial radius)")
     modes.add_argument("--simulate", action=argparse.BooleanOptionalAction, default=True,
                        help="add the simulated normal-force envelope to the plot")
     modes.set_defaults(func=_cmd_modes)

@@ -1,6 +1,7 @@
 """The resonance map's figure (a Campbell chart) of a :class:`winder.ModeMap`: its modes
 against the wound roll's radius with the rotation harmonics and their crossings, the
-simulated normal-force envelopes below; a map of one row (the initial state of a machine
+simulated normal-force envelopes below (a map over an unwinding roll's radius: its web
+line's modes and the parent's rotation harmonics); a map of one row (the initial state of a machine
 without a wound roll, or with contact off) as markers."""
 
 from __future__ import annotations
@@ -46,11 +47,12 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
     each crossing numbered where its number overlaps no other (crossings closer than a
     marker share one) and listed in a table below the chart."""
     mm = mode_map
-    one = len(mm.coordinates) == 1
-    drawn = mm.shown() if mm.flexible else mm.coordinates  # flexible: orders 1-2, torsion 1
+    line = mm.unwinding  # a web line's modes against the parent's radius
+    one = len(mm.coordinates) == 1 and not line
+    drawn = mm.line_shown if line else mm.shown() if mm.flexible else mm.coordinates
     crossings = mm.crossings(drawn)
     width, height = (13.5, 6.5) if mm.flexible else (8, 4.2) if one else (11, 4.6)
-    rows = _crossing_rows(crossings)
+    rows = _crossing_rows(crossings, mm.roll if line else "roll")
     # the table's columns: as many as fit beside the legend (its longest label, 7 pt)
     legend = _PT * 7 * max([54, *(len(f"bending mode {c} (damped)") for c in drawn)]) + 0.9
     column = _PT * 7.5 * max([len(x) for x in rows] + [1]) + 0.3
@@ -69,9 +71,10 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
         if not mm.flexible else mode_styles(drawn, MODE_COLOURS)
     over = []  # the overdamped stretches: (mode, mask)
     for i, c in enumerate(drawn):
-        f = mm.frequencies[c] if c in mm.frequencies else mm.torsion[c]
+        f = mm.frequency(c)
         colour, ls, marker = styles[c]
-        kind = "torsion" if c in mm.torsion else "bending" if ".bend." in c else "bounce"
+        kind = "torsion" if c in mm.torsion else "bending" if ".bend." in c else \
+            "line" if c in mm.line else "bounce"
         label = "bounce mode (damped)" if one else f"{kind} mode {c} " + (
             "|λ|/2π" if kind == "torsion" else "(damped)")
         if single:  # one row: markers (an x order beside its z order of the same frequency:
@@ -86,33 +89,41 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
                     marker="D" if kind == "torsion" else "o", **hollow, label=label)
             continue
         ax.plot(r, np.where(f > 0, f, np.nan), color=colour, ls=ls, marker=marker or None,
-                markevery=max(1, len(r) // 8), ms=4, lw=2 if kind == "bounce" else 1.3,
-                label=label)
+                markevery=max(1, len(r) // 8), ms=4,
+                lw=2 if kind == "bounce" or c.endswith(".carriage") else 1.3, label=label)
         if np.any(f == 0):  # overdamped (real eigenvalue): a bar along the bottom
             over.append((c, f == 0))
-    if not single or np.all(mm.slip_frequency > 0):  # (a NaN: no slip mode)
+    if line:
+        pass  # the line's map: its own modes only (the winder's slip modes stay put)
+    elif not single or np.all(mm.slip_frequency > 0):  # (a NaN: no slip mode)
         ax.plot(r, mm.slip_frequency, "C2" if one else "C7", lw=1.0,
                 **({"marker": "s", "ls": "none"} if single else {}),
                 label="slip/torsion mode |λ|/2π (slowest)")
     harmonics = mm.harmonics()
-    for name, line in harmonics.items():
+    for name, h in harmonics.items():
+        if line and name not in _HARMONIC_STYLE:
+            continue  # the drums' rotation: not an excitation of the line's map
         if name in _HARMONIC_STYLE:
-            if single and not np.all(np.isfinite(line)):
+            if single and not np.all(np.isfinite(h)):
                 continue  # no wound roll: no roll rotation
-            ax.plot(r, line, *(("x",) if single else (_HARMONIC_STYLE[name],)), color="k",
-                    lw=1, label=f"{name[:-1]}× roll rotation at {mm.web_speed:g} m/s")
+            which = f"rotation of {mm.roll} (unwinding)" if line else "roll rotation"
+            ax.plot(r, h, *(("x",) if single else (_HARMONIC_STYLE[name],)), color="k",
+                    lw=1, label=f"{name[:-1]}× {which} at {mm.web_speed:g} m/s")
         elif single:  # a drum's rotation: the same at every radius
-            ax.axhline(float(line[0]), ls="-.", color="0.45", lw=1, label=f"{name} rotation")
+            ax.axhline(float(h[0]), ls="-.", color="0.45", lw=1, label=f"{name} rotation")
         else:
-            ax.plot(r, line, "-.", color="0.45", lw=1, label=f"{name} rotation")
-    shown = [mm.frequencies[c] if c in mm.frequencies else mm.torsion[c] for c in drawn]
+            ax.plot(r, h, "-.", color="0.45", lw=1, label=f"{name} rotation")
+    shown = [mm.frequency(c) for c in drawn]
+    if line:
+        harmonics = {k: h for k, h in harmonics.items() if k in _HARMONIC_STYLE}
     values = np.concatenate([f[np.isfinite(f) & (f > 0)]
                              for f in (*shown, *harmonics.values())])
     log = values.size > 0 and values.max() / values.min() > 30
     if log:
         ax.set_yscale("log")
-        ax.set_ylim(max(values.min() * 0.7, 0.1), values.max() * 1.5)
-    elif single or not np.any(np.isfinite(mm.bounce_frequency)):
+        ax.set_ylim(values.min() * 0.7 if line else max(values.min() * 0.7, 0.1),
+                    values.max() * 1.5)
+    elif single or line or not np.any(np.isfinite(mm.bounce_frequency)):
         top = max(float(values.max()) if values.size else 0.0,
                   float(np.nanmax(mm.slip_frequency, initial=0.0)))
         ax.set_ylim(0, top * 1.15 if top > 0 else 1.0)
@@ -133,8 +144,7 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
                 "overdamped there (no oscillation)")
     points = []
     for c, h, rc in crossings:
-        f = float(np.interp(rc, r, mm.frequencies[c] if c in mm.frequencies
-                            else mm.torsion[c]))
+        f = float(np.interp(rc, r, mm.frequency(c)))
         ax.plot([rc], [f], "o", color="C3", ms=5, mfc="none", mew=1.2)
         points.append((rc, f))
         if one:
@@ -179,6 +189,9 @@ def campbell_figure(mode_map, path: str | Path, *, result: Result | None = None,
         axes[-1].set_xlabel(f"the initial state ({mm.initial_reason})")
     elif mm.initial_state:
         axes[-1].set_xlabel(f"roll radius r [m]: the initial state ({mm.initial_reason})")
+    elif line:
+        axes[-1].set_xlabel(f"radius of the unwinding roll {mm.roll} r [m] (core: empty, "
+                            "right: full)")
     else:
         axes[-1].set_xlabel("roll radius r [m]")
     if lines:
@@ -192,13 +205,15 @@ _TABLE_LINES = 30
 _PT = 0.6 / 72
 
 
-def _crossing_rows(crossings: list[tuple[str, str, float]]) -> list[str]:
-    """The table's lines: number, harmonic, mode, radius, in aligned columns."""
+def _crossing_rows(crossings: list[tuple[str, str, float]], roll: str = "roll") -> list[str]:
+    """The table's lines: number, harmonic (of ``roll``'s rotation), mode, radius, in
+    aligned columns."""
     if not crossings:
         return []
-    wide = max(len(short_harmonic(h)) for _, h, _ in crossings)
+    short = {h: short_harmonic(h).replace("× roll", f"× {roll}") for _, h, _ in crossings}
+    wide = max(len(x) for x in short.values())
     mode = max(len(c) for c, _, _ in crossings)
-    return [f"{i + 1:>2}  {short_harmonic(h):<{wide}}  {c:<{mode}}  r = {rc:.4f} m"
+    return [f"{i + 1:>2}  {short[h]:<{wide}}  {c:<{mode}}  r = {rc:.4f} m"
             for i, (c, h, rc) in enumerate(crossings)]
 
 

@@ -20,6 +20,7 @@ from winder.parts import BodyElement, WebPart, body_elements
 from winder.plots import figures as _f
 from winder.plots.flex import flex_figures
 from winder.plots.layout import LEGEND_INSIDE, MAX_HEIGHT, line_styles, page_suffix
+from winder.plots.line import line_figures
 from winder.plots.positions import FigureBody, figure_bodies, positions_figures
 from winder.plots.smooth import centred_mean
 from winder.scene.load import Scene
@@ -51,8 +52,10 @@ def _parts_scene(result: Result, scene: Scene | None) -> Scene:
 
 
 def _panel(ax: plt.Axes, t: np.ndarray, lines: list[tuple[str, np.ndarray]], ylabel: str,
-           title: str, *, lw: float = 0.8, colors: list[str] | None = None) -> None:
-    """One axes: a line per ``(label, values)``, legend naming the parts."""
+           title: str, *, lw: float = 0.8, colors: list[str] | None = None,
+           outside: bool = False) -> None:
+    """One axes: a line per ``(label, values)``, legend naming the parts (beside the
+    panel with more than :data:`LEGEND_INSIDE` lines, or ``outside``)."""
     many = len(lines) > LEGEND_INSIDE  # distinct styles, the legend beside the panel
     if colors is not None:  # given colours (a nip's): a repeated one gets another style
         seen = [colors[:i].count(c) for i, c in enumerate(colors)]
@@ -67,7 +70,7 @@ def _panel(ax: plt.Axes, t: np.ndarray, lines: list[tuple[str, np.ndarray]], yla
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
-    if many:
+    if many or outside:
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     elif lines:
         ax.legend(fontsize=8, loc="best")
@@ -97,7 +100,10 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
     body, its bounce without edge artefacts, a flexible body's segments as heat maps);
     ``STEM_slip.png``: a row per nip with its slip
     velocity; with a web span, ``STEM_span.png``: the span tension, the controller's
-    tension error, the unwind torque and the radii; flexible parts:
+    tension error, the unwind torque and the radii; a web line over rollers,
+    ``STEM_line.png`` (:mod:`winder.plots.line`): every span's tension, each dancer's
+    position within its travel and its speed, each roller's load cell and traction;
+    flexible parts:
     :func:`winder.plots.flex.flex_figures`. ``STEM`` is the scene name made
     file-safe; part names appear only in titles and legends. A nip keeps its colour in
     every figure. A figure whose rows would pass :data:`~winder.plots.layout.MAX_HEIGHT_PX`
@@ -173,6 +179,8 @@ def machine_figures(result: Result, out_dir: str | Path, *, scene: Scene | None 
         if _tensions(result, w, pre):
             paths.append(_span_figure(result, scene, bodies, w, pre,
                                       out / f"{stem}_{pre}span.png", name))
+    paths += line_figures(result, spans, bodies, out, stem, name,
+                          lambda ch, pre: _f._in(result, ch, pre), _f._save)
     return paths + flex_figures(result, scene, out, stem, name, _f._save)
 
 
@@ -263,10 +271,14 @@ def _span_figure(result: Result, scene: Scene, bodies: list[BodyElement], web: W
     error = f"{pre}tension_error"
     fig, ax = _rows(4 if error in result else 3)
     unit = _f._in(result, _tensions(result, web, pre)[0])
-    _panel(ax[0], t, [(n[len(pre):].replace("_", " "), result[n])
-                      for n in _tensions(result, web, pre)], "T" + unit,
-           f"{name}: web span tension{unit} (EA = {span.EA:.3g} N, L = {span.length:g} m)",
-           lw=0.6)
+    line = len(web.spans) > 1  # a line: each span's length in the legend, legends beside
+    _panel(ax[0], t, [(n[len(pre):].replace("_", " ")
+                       + (f" (L = {web.spans[i].length:g} m, EA = {web.spans[i].EA:.3g} N)"
+                          if line else ""), result[n])
+                      for i, n in enumerate(_tensions(result, web, pre))], "T" + unit,
+           f"{name}: web span tension{unit}" + ("" if line else
+                                               f" (EA = {span.EA:.3g} N, L = {span.length:g} m)"),
+           lw=0.6, outside=line)
     rows = 1
     if error in result:
         unit = _f._in(result, error)
@@ -279,12 +291,12 @@ def _span_figure(result: Result, scene: Scene, bodies: list[BodyElement], web: W
     unit = _f._in(result, f"{unwind.name}_torque", "k")
     _panel(ax[rows], t, [(_body_label(unwind), result[f"{unwind.name}_torque"] / 1e3)],
            "torque" + unit, f"unwind torque of {unwind.name}{unit} (negative: braking)",
-           lw=0.6)
+           lw=0.6, outside=line)
     ax[rows].axhline(0.0, color="k", lw=0.5)
     unit = _f._in(result, f"{unwind.name}_radius")
     _panel(ax[rows + 1], t, [(_body_label(b), result[f"{b.name}_radius"])
                              for b in [unwind, *wound]], "radius r" + unit,
-           "radii of the unwinding and the wound rolls" + unit)
+           "radii of the unwinding and the wound rolls" + unit, outside=line)
     ax[-1].set_xlabel("t" + _f._in(result, "t"))
     return _f._save(fig, path)
 
