@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from types import SimpleNamespace
 
 import numpy as np
+from winder.viewer._line import ROLLER_ARC_POINTS, Circle, dancer_axis, line_path
 
 from winder._errors import WinderError
 from winder.forces.web_tension import exit_point
@@ -29,7 +30,6 @@ from winder.model.machine import Machine, Web
 from winder.parts import BodyElement as Body
 from winder.scene import Naming, naming_of
 from winder.scene.load import Scene
-from winder.viewer._line import ROLLER_ARC_POINTS, Circle, dancer_axis, line_path
 
 __all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
            "speed_channels",
