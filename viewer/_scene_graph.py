@@ -79,6 +79,7 @@ class WinderGraph:
         self.stands = self.fixed or self.machine.bodies
         #: Height of the floor [m]: 0.35 m below the lowest stand.
         self.floor_z = min(b.centre[1] - _radius0(b) for b in self.stands) - 0.35
+        self.roller_widths: dict[str, float] = {}  # (set below: they take their web's)
         entry = self.machine.entry
         self.web_width = 1.12 * (self._web_width(entry.b) if entry is not None
                                  else self.length)
@@ -87,6 +88,12 @@ class WinderGraph:
         self.web_nodes = [("web" if i == 0 else f"web-{w.name}",
                            1.12 * self._web_width(w.entry.b))
                           for i, w in enumerate(self.machine.webs)]
+        #: The drawn length of each roller of a web line [m]: 1.1 × its web's strip, so that
+        #: its ends (and their marks, its rotation) show beside the web that wraps it.
+        self.roller_widths = {s.downstream.name: 1.1 * width
+                              for w, (_, width) in zip(self.machine.webs, self.web_nodes,
+                                                       strict=True)
+                              for s in w.spans if s.downstream is not None}
         #: Segments of each web's strip (its path's points less one, :func:`web_points`).
         self.web_segments = [web_points(w) - 1 for w in self.machine.webs]
         #: The travel axis of each dancer's carriage (:func:`dancer_axes`), by name.
@@ -99,8 +106,11 @@ class WinderGraph:
 
     def _width(self, name: str) -> float:
         """The drawn length along ``y`` [m] of body ``name``: its own width, the width of
-        the body it takes it from, else the machine's (1.05 × :attr:`length`)."""
+        the body it takes it from, else the machine's (1.05 × :attr:`length`); a roller of a
+        web line :attr:`roller_widths`."""
         d = self.drawings[name]
+        if name in self.roller_widths:
+            return self.roller_widths[name]
         if d.width is not None:
             return d.width
         if d.width_of is not None and d.width_of in self.drawings:
