@@ -232,3 +232,36 @@ def test_dancer_line_html_poses_the_dancer_and_joins_the_web(tmp_path: Path, dan
                                atol=1e-12)
     texts = _embedded_readout(html)
     assert all(any(line.startswith("spans") for line in t.splitlines()) for t in texts)
+
+
+def test_readout_aggregates_a_long_line() -> None:
+    """A line of 9 spans over 8 rollers (one a dancer): the readout has one line for the
+    rollers (their count, least and largest speed and surface speed), one for the spans
+    (beyond MAX_LISTED_SPANS: their count, least, largest and mean tension, as numpy
+    has them) and one for the dancer (d in mm): 3 lines, not 17."""
+    from winder.viewer._motion import BodyMotion, Motion, WebMotion
+    from winder.viewer._readout import MAX_LISTED_SPANS
+
+    rng = np.random.default_rng(9)
+    one = np.ones(1)
+    names = [f"r{i}" for i in range(8)]
+    speeds = rng.uniform(10.0, 20.0, 8)
+    bodies = {n: BodyMotion(n, "drum", 1, 0 * one, 0 * one, 0 * one, 0.1 * one, w * one)
+              for n, w in zip(names, speeds, strict=True)}
+    bodies["r3"] = BodyMotion("r3", "drum", 1, 0 * one, 0 * one, 0 * one, 0.1 * one,
+                              speeds[3] * one, position=np.array([-0.0123]),
+                              axis=(0.0, -1.0), home=(0.0, 0.0), travel=(-0.15, 0.2))
+    tensions = tuple(np.array([t]) for t in rng.uniform(900.0, 1200.0, 9))
+    web = WebMotion("w", ("r0", "r1"), unwind="u", rollers=tuple(names),
+                    span_tensions=tensions)
+    m = Motion(np.zeros(1), bodies, {}, ("r0", "r1"), webs=(web,))
+    lines = readout_text(m, 0).splitlines()
+    assert len(tensions) > MAX_LISTED_SPANS
+    assert len(lines) == 4  # t, rollers, spans, dancer
+    each = np.array([t[0] for t in tensions])
+    assert lines[1].split() == ["rollers", "×8", f"{speeds.min():.2f}–{speeds.max():.2f}",
+                                "rad/s", f"{0.1 * speeds.min():.2f}–{0.1 * speeds.max():.2f}",
+                                "m/s"]
+    assert lines[2].split() == ["spans", "T", "×9", f"{each.min():.1f}–{each.max():.1f}",
+                                "mean", f"{each.mean():.1f}", "N"]
+    assert lines[3].split() == ["r3", "d", "-12.3", "mm", "(travel", "-150", "…", "+200)"]
