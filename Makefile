@@ -100,6 +100,7 @@ demo-two-drum: $(STAMP) chromium
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/winder_line_dancer.toml --t-end 60 --out $(OUT)/winder_line_dancer.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder modes models/winder_line_dancer.toml --roll parent --points 60 --plot $(OUT)/plots/winder_line_dancer_modes.png --csv $(OUT)/winder_line_dancer_modes.csv
+	$(PY) -m winder view $(OUT)/winder_line_dancer.npz --html $(OUT)/winder_line_dancer.html --snapshots $(OUT)/snapshots_line_dancer --every 20
 	$(PY) -m winder view $(OUT)/two_drum_winder.npz --html $(OUT)/two_drum_winder.html --snapshots $(OUT)/snapshots_two_drum --every 100
 	$(PY) -m winder modes models/two_drum_winder.toml --plot $(OUT)/plots/two_drum_modes.png --csv $(OUT)/two_drum_modes.csv
 	$(PY) -m winder run models/winder_line.toml --out $(OUT)/winder_line.npz --plots $(OUT)/plots --progress

@@ -1,7 +1,9 @@
 """What a result says about where every body of a machine is: centres, angles, radii,
 speeds and nip forces at chosen times, read from the result's channels, and the path of
 the web into its entry nip: from off-screen, or, on a winder line (a ``[web.span]``), from
-the unwinding roll's exit point ``p_u`` along the span (machines spec §5).
+the unwinding roll's exit point ``p_u`` along the span (machines spec §5), or, on a web
+line (``[[web.span]]`` over rollers, spec §11), over each roller (:mod:`._line`), a
+dancer's roller drawn where its ``NAME_position`` channel puts its carriage.
 
 A scene of parts (machines spec §9) names its channels per body (``NAME_angle``,
 ``NAME_speed``, ``NAME_x``/``NAME_z`` where free, ``NAME_radius`` for a paper roll) and
@@ -19,6 +21,7 @@ from dataclasses import dataclass, field
 from types import SimpleNamespace
 
 import numpy as np
+from winder.viewer._line import ROLLER_ARC_POINTS, Circle, dancer_axis, line_path
 
 from winder._errors import WinderError
 from winder.forces.web_tension import exit_point
@@ -31,7 +34,7 @@ from winder.scene.load import Scene
 __all__ = ["BodyMotion", "Motion", "body_channels", "nip_channels", "drawn_channels",
            "speed_channels",
            "check_drawable", "scene_of", "motion", "WebMotion", "web_path", "span_web_path",
-           "exit_points",
+           "exit_points", "web_points", "dancer_axes",
            "WEB_LEAD", "WEB_ARC_POINTS"]
 
 #: Length of the web's straight run drawn before it meets the entry drum [m] (off-screen).
@@ -72,7 +75,8 @@ def body_channels(scene: Scene | None, body: Body) -> dict[str, str]:
     """Channel of each role (``x``, ``z``, ``angle``, ``speed``, ``radius``) of ``body``
     that the result carries, as the scene names it; a role without a channel is constant
     (fixed coordinate, constant radius)."""
-    roles = [*body.free, "angle", "speed", *(("radius",) if body.radius_state else ())]
+    roles = [*body.free, "angle", "speed", *(("radius",) if body.radius_state else ()),
+             *(("position",) if body.roles.dancer is not None else ())]
     return {role: _naming(scene).output_name(f"{body.name}_{role}") for role in roles}
 
 
@@ -162,6 +166,13 @@ class BodyMotion:
     #: a flexible drum's segment: the centre of its bearings' line ``(x, z)`` [m], which
     #: its deflection is taken from (None: from its segments' mean)
     support: tuple[float, float] | None = None
+    #: a dancer's roller: its carriage position ``d`` [m] (its ``NAME_position``; the
+    #: centre is ``home + d · axis``), the unit ``axis`` of its travel, its ``home`` (the
+    #: scene's centre, ``d = 0``) and the ``travel`` ends ``(lo, hi)`` [m]; else None
+    position: np.ndarray | None = None
+    axis: tuple[float, float] | None = None
+    home: tuple[float, float] | None = None
+    travel: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -176,6 +187,10 @@ class WebMotion:
     unwind: str | None = None
     exit: np.ndarray | None = None
     span_tension: np.ndarray | None = None
+    #: a web line's rollers in order from the unwinding roll (machines spec §11)
+    rollers: tuple[str, ...] = ()
+    #: every span's tension [N] in order (``None`` where the result lacks its channel)
+    span_tensions: tuple[np.ndarray | None, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -216,11 +231,27 @@ class Motion:
 
     def _path(self, w: WebMotion, k: int) -> np.ndarray:
         a, b = (self.bodies[n] for n in w.entry)
+        if w.rollers:
+            return self._line(w, a, b, k)
         if w.exit is not None:
             return span_web_path(w.exit[k], (a.x[k], a.z[k]), a.radius[k], a.sense,
                                  (b.x[k], b.z[k]), b.radius[k])
         return web_path((a.x[k], a.z[k]), a.radius[k], a.sense, (b.x[k], b.z[k]),
                         b.radius[k])
+
+    def _line(self, w: WebMotion, a: BodyMotion, b: BodyMotion, k: int) -> np.ndarray:
+        """A web line's path at sample ``k``: :func:`._line.line_path` from the unwinding
+        roll over the rollers, then around the entry drum ``a`` into the nip with roll
+        ``b`` (:func:`_wrap`)."""
+        def circle(body: BodyMotion) -> Circle:
+            return Circle(float(body.x[k]), float(body.z[k]), float(body.radius[k]),
+                          1 if body.sense >= 0 else -1)
+        drum = circle(a)
+        points, meet = line_path(circle(self.bodies[w.unwind]),
+                                 [circle(self.bodies[n]) for n in w.rollers], drum)
+        alpha = math.atan2(meet[1] - drum.z, meet[0] - drum.x)
+        return np.vstack([points, _wrap(drum.c, drum.r, float(drum.s), alpha,
+                                        (b.x[k], b.z[k]), b.radius[k])])
 
     def extent(self) -> tuple[float, float, float, float]:
         """``(x_min, x_max, z_min, z_max)`` [m] of every body over all samples."""
@@ -242,9 +273,11 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
         return np.interp(times, result.t, result[name])
 
     bodies = {}
+    axes = dancer_axes(m)
     for b in m.bodies:
         ch = body_channels(scene, b)
         const = {"x": b.centre[0], "z": b.centre[1], "angle": 0.0, "speed": 0.0,
+                 "position": 0.0,
                  "radius": math.nan if b.radius_state else b.part.radius}
 
         def get(role: str, ch: dict = ch, const: dict = const) -> np.ndarray:
@@ -254,9 +287,16 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
         segment_of = getattr(b, "segment_of", None)
         support = tuple(b.part.centre) if segment_of and \
             type(b.part).__name__ == "DrumPart" else None
-        bodies[b.name] = BodyMotion(b.name, b.role, b.sense, get("x"), get("z"),
+        x, z, carriage = get("x"), get("z"), {}
+        if b.name in axes:  # a dancer: its roller where its carriage is
+            d, e = get("position"), axes[b.name]
+            x, z = b.centre[0] + d * e[0], b.centre[1] + d * e[1]
+            carriage = {"position": d, "axis": e, "home": tuple(b.centre),
+                        "travel": tuple(b.roles.dancer.travel)}
+        bodies[b.name] = BodyMotion(b.name, b.role, b.sense, x, z,
                                     b.sense * get("angle") * spin_gain, get("radius"),
-                                    get("speed"), b.radius_state, segment_of, support)
+                                    get("speed"), b.radius_state, segment_of, support,
+                                    **carriage)
     forces = {n: (sample(c) if c in result else None)
               for n, c in nip_channels(scene, m).items()}
     webs = []
@@ -267,8 +307,10 @@ def motion(scene: Scene, result: Result, times: np.ndarray, *,
             exit_ = exit_points(m, bodies, w)
             ch = f"{w.span_channel}span_tension"
             tension = sample(ch) if ch in result else None
+        names = [f"{s.channel}tension" for s in w.spans]
         webs.append(WebMotion(w.name, (w.entry.a.name, w.entry.b.name), unwind, exit_,
-                              tension))
+                              tension, _rollers(w),
+                              tuple(sample(c) if c in result else None for c in names)))
     slices = {n.name: n.whole for n in m.nips if getattr(n, "whole", None)}
     if not webs:
         return Motion(times, bodies, forces, None, units=dict(result.units), slices=slices)
@@ -296,6 +338,38 @@ def exit_points(machine: Machine, bodies: dict[str, BodyMotion], web: Web | None
         u.name: kin(bodies[u.name], u), a.name: kin(bodies[a.name], a)})
     _, _, ox, oz = exit_point(ev, web)
     return np.column_stack([bodies[u.name].x + ox, bodies[u.name].z + oz])
+
+
+def _rollers(web: Web) -> tuple[str, ...]:
+    """The rollers of ``web``'s line in order from its unwinding roll (none: one span)."""
+    return tuple(s.downstream.name for s in web.spans if s.downstream is not None)
+
+
+def web_points(web: Web) -> int:
+    """How many points the drawn path of ``web`` has (the same at every sample): the
+    unwinding roll's exit point or the lead, :data:`ROLLER_ARC_POINTS` per roller and
+    :data:`WEB_ARC_POINTS` around the entry drum."""
+    return 1 + ROLLER_ARC_POINTS * len(_rollers(web)) + WEB_ARC_POINTS
+
+
+def dancer_axes(machine: Machine) -> dict[str, tuple[float, float]]:
+    """The unit axis ``(e_x, e_z)`` of each dancer's travel (:func:`._line.dancer_axis`),
+    on the scene's layout: bodies at their scene centres and initial radii, every
+    carriage at ``d = 0``."""
+    def circle(body: Body) -> Circle:
+        return Circle(float(body.centre[0]), float(body.centre[1]),
+                      float(body.initial_radius), 1 if body.sense >= 0 else -1)
+    out = {}
+    for w in machine.webs:
+        for s in w.spans[1:]:
+            roller = s.upstream
+            if roller.roles.dancer is None:
+                continue
+            down = s.downstream if s.downstream is not None else w.entry.a
+            e = dancer_axis(circle(w.spans[s.index - 1].upstream), circle(roller),
+                            circle(down))
+            out[roller.name] = (float(e[0]), float(e[1]))
+    return out
 
 
 def web_path(c_a: tuple[float, float], r_a: float, sense_a: int,

@@ -1,5 +1,7 @@
 """On-screen readout: time, roll radii (the unwinding roll's too), body speeds, nip normal
-forces and, on a winder line, the span's tension, as an HTML overlay on meshcat's page;
+forces and, on a winder line, the span's tension (a web line: every span's on one line,
+its rollers' speeds on one line, each dancer's position), as an HTML overlay on meshcat's
+page;
 the units are the result's (:attr:`winder.Result.units`, carried on the Motion).
 
 meshcat 0.3.2 animates only numeric properties of objects, so the text is not part of the
@@ -22,9 +24,12 @@ from winder.model.channels import GENERIC_CHANNELS, WEB_SPEED
 from winder.parts import PARTS
 
 __all__ = ["readout_text", "deflections", "with_readout", "unit_of", "DEFAULT_UNITS",
-           "SURFACE_SPEED_UNIT", "READOUT_ID"]
+           "SURFACE_SPEED_UNIT", "READOUT_ID", "MAX_LISTED_SPANS"]
 
 READOUT_ID = "winder-readout"
+#: A web line with more spans than this shows their least, mean and largest tension
+#: instead of each.
+MAX_LISTED_SPANS = 6
 
 _STYLE = (f"#{READOUT_ID} {{position: fixed; left: 10px; top: 10px; margin: 0; "
           "padding: 6px 9px; background: rgba(255,255,255,0.82); color: #111; "
@@ -92,13 +97,16 @@ def readout_text(m: Motion, k: int) -> str:
     nip one (its slices' total force, their least and largest), whatever their number."""
     lines = [f"t  {m.times[k]:10.2f} {unit_of(m, 't')}"]
     spans = [w for w in m.webs if w.unwind is not None] or (
-        [SimpleNamespace(name="", span_tension=m.span_tension)] if m.unwind is not None else [])
+        [SimpleNamespace(name="", span_tension=m.span_tension, rollers=(),
+                         span_tensions=())] if m.unwind is not None else [])
     labels = ["span" if len(spans) == 1 else f"{w.name} span" for w in spans]
-    groups = _groups(m)
+    rollers = [n for w in spans for n in w.rollers]
+    groups = {n: g for n, g in _groups(m).items() if n not in rollers}
     nips: dict[str, list[str]] = {}
     for name in m.normal_forces:
         nips.setdefault(m.slices.get(name, name), []).append(name)
-    width = max(len(n) for n in (*groups, *nips, "span", *labels))
+    width = max(len(n) for n in (*groups, *nips, "span", *labels, *rollers,
+                                 *(("rollers", "spans") if rollers else ())))
     for name, segs in groups.items():
         if segs[0].radius_state:
             r = _mean([b.radius[k] for b in segs])
@@ -123,11 +131,42 @@ def readout_text(m: Motion, k: int) -> str:
                 if len(parts) > 1 else ""
         lines.append(f"{name:<{width}}  N {value} k{unit_of(m, 'normal_force', parts[0])}"
                      + more)
+    if rollers:
+        lines.append(_rollers_line(m, k, rollers, width))
     for label, w in zip(labels, spans, strict=True):
-        T = w.span_tension
-        value = "      -" if T is None else f"{T[k]:8.1f}"
-        lines.append(f"{label:<{width}}  T {value} {unit_of(m, 'span_tension', w.name)}")
+        unit = unit_of(m, 'span_tension', w.name)
+        if len(w.rollers) == 0:
+            T = w.span_tension
+            value = "      -" if T is None else f"{T[k]:8.1f}"
+            lines.append(f"{label:<{width}}  T {value} {unit}")
+            continue
+        lines.append(f"{label + 's':<{width}}  T {_tensions(w.span_tensions, k)} {unit}")
+    for name in rollers:
+        b = m.bodies[name]
+        if b.position is not None:
+            lo, hi = (1e3 * v for v in b.travel)
+            lines.append(f"{name:<{width}}  d {1e3 * b.position[k]:+8.1f} mm  "
+                         f"(travel {lo:+.0f} … {hi:+.0f})")
     return "\n".join(lines)
+
+
+def _rollers_line(m: Motion, k: int, names: list[str], width: int) -> str:
+    """One line for a web line's rollers: their number, least and largest speed and
+    surface speed."""
+    w = np.array([m.bodies[n].speed[k] for n in names])
+    v = np.array([m.bodies[n].speed[k] * m.bodies[n].radius[k] for n in names])
+    unit = unit_of(m, "speed", names[0])
+    return (f"{'rollers':<{width}}  ×{len(names)} {w.min():.2f}–{w.max():.2f} {unit} "
+            f"{v.min():.2f}–{v.max():.2f} {SURFACE_SPEED_UNIT}")
+
+
+def _tensions(tensions: tuple[np.ndarray | None, ...], k: int) -> str:
+    """Every span's tension at sample ``k`` in order (``-`` without its channel), or,
+    beyond :data:`MAX_LISTED_SPANS` spans, their least, mean and largest."""
+    if len(tensions) > MAX_LISTED_SPANS and all(T is not None for T in tensions):
+        each = np.array([T[k] for T in tensions])
+        return f"×{len(each)} {each.min():.1f}–{each.max():.1f} mean {each.mean():.1f}"
+    return " ".join("-" if T is None else f"{T[k]:.1f}" for T in tensions)
 
 
 def with_readout(page: str, texts: list[str], fps: int | None = None) -> str:

@@ -2,7 +2,9 @@
 radial mark (so that rotation shows), drawn as its element's
 :meth:`~winder.parts.BodyElement.drawing` says (a paper roll: core and paper), the web
 into its entry nip as a strip of segments (on a winder line from the unwinding roll), a
-floor and the far side frames of the fixed stands (drums, unwinding rolls).
+floor and the far side frames of the fixed stands (drums, unwinding rolls, rollers). A
+web line runs over its rollers (:mod:`._line`); a dancer's roller rides its carriage
+along a guide rail on the near side whose two end stops mark the ends of its travel.
 
 Placements of the bodies come from the Pinocchio model of the machine
 (:class:`winder.model.machine.Machine`: per body prismatic ``x``/``z`` where free, then a
@@ -22,7 +24,7 @@ import meshcat
 import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
-from winder.viewer._motion import WEB_ARC_POINTS, Motion
+from winder.viewer._motion import Motion, dancer_axes, web_points
 
 from winder.model.machine import Machine
 from winder.scene.load import Scene
@@ -33,7 +35,7 @@ __all__ = ["WinderGraph", "COLOURS", "COM_MARKER_GAIN", "DEFLECTION_GAIN", "WEB_
 #: Colours (hex RGB) of the parts; the browser tests look for them.
 COLOURS = {"drum": 0x3A6EA5, "paper": 0xF2E6C9, "core": 0x8B5A2B, "mark": 0xC0392B,
            "com": 0x27AE60, "floor": 0x9E9E9E, "frame": 0x555555, "rider": 0x7D3C98,
-           "web": 0xD4AC0D}
+           "web": 0xD4AC0D, "idler": 0x95A5A6, "rail": 0x2C3E50, "stop": 0xE67E22}
 #: The CoM offset (1 mm) is drawn this many times larger so that it can be seen.
 COM_MARKER_GAIN = 100.0
 #: The segments of a flexible body are drawn along its axis, their offsets from the
@@ -77,6 +79,7 @@ class WinderGraph:
         self.stands = self.fixed or self.machine.bodies
         #: Height of the floor [m]: 0.35 m below the lowest stand.
         self.floor_z = min(b.centre[1] - _radius0(b) for b in self.stands) - 0.35
+        self.roller_widths: dict[str, float] = {}  # (set below: they take their web's)
         entry = self.machine.entry
         self.web_width = 1.12 * (self._web_width(entry.b) if entry is not None
                                  else self.length)
@@ -85,6 +88,16 @@ class WinderGraph:
         self.web_nodes = [("web" if i == 0 else f"web-{w.name}",
                            1.12 * self._web_width(w.entry.b))
                           for i, w in enumerate(self.machine.webs)]
+        #: The drawn length of each roller of a web line [m]: 1.1 × its web's strip, so that
+        #: its ends (and their marks, its rotation) show beside the web that wraps it.
+        self.roller_widths = {s.downstream.name: 1.1 * width
+                              for w, (_, width) in zip(self.machine.webs, self.web_nodes,
+                                                       strict=True)
+                              for s in w.spans if s.downstream is not None}
+        #: Segments of each web's strip (its path's points less one, :func:`web_points`).
+        self.web_segments = [web_points(w) - 1 for w in self.machine.webs]
+        #: The travel axis of each dancer's carriage (:func:`dancer_axes`), by name.
+        self.dancer_axes = dancer_axes(self.machine)
 
     def _web_width(self, body: object) -> float:
         """The width [m] of the roll a web enters (a flexible roll: its whole width)."""
@@ -93,8 +106,11 @@ class WinderGraph:
 
     def _width(self, name: str) -> float:
         """The drawn length along ``y`` [m] of body ``name``: its own width, the width of
-        the body it takes it from, else the machine's (1.05 × :attr:`length`)."""
+        the body it takes it from, else the machine's (1.05 × :attr:`length`); a roller of a
+        web line :attr:`roller_widths`."""
         d = self.drawings[name]
+        if name in self.roller_widths:
+            return self.roller_widths[name]
         if d.width is not None:
             return d.width
         if d.width_of is not None and d.width_of in self.drawings:
@@ -130,10 +146,13 @@ class WinderGraph:
             node["mark"].set_object(g.Box([0.9 * R, 1.01 * length + 0.01, 0.04 * R]),
                                     lam(color=COLOURS["frame"]))
             node["mark"].set_transform(_translation([0.45 * R, 0.0, 0.0]))
-        for node, web_width in self.web_nodes:
-            for i in range(WEB_ARC_POINTS):
+        for (node, web_width), count in zip(self.web_nodes, self.web_segments, strict=True):
+            for i in range(count):
                 root[node][f"s{i:02d}"]["strip"].set_object(
                     g.Box([1.0, web_width, WEB_THICKNESS]), lam(color=COLOURS["web"]))
+        for b in self.machine.bodies:
+            if b.name in self.dancer_axes:
+                self._build_carriage(root, b)
         # context: floor and the far side frames carrying the drum bearings (the near ones
         # would hide the nips from the camera)
         # (a base plate 0.5 m wider than the stands: the web comes in past its edge)
@@ -143,6 +162,8 @@ class WinderGraph:
                                  lam(color=COLOURS["floor"]))
         root["floor"].set_transform(_translation([0.5 * (x0 + x1), 0.0, self.floor_z]))
         for b in self.fixed:
+            if b.name in self.dancer_axes:  # on its carriage's rail, not a stand
+                continue
             h = b.centre[1] - self.floor_z
             root["frame"][b.name].set_object(g.Box([0.25, 0.08, h]),
                                              lam(color=COLOURS["frame"]))
@@ -151,6 +172,30 @@ class WinderGraph:
         vis["/Grid"].set_property("visible", False)
         vis["/Axes"].set_property("visible", False)
         self.set_camera(vis, self.initial_extent())
+
+    def _build_carriage(self, root, b) -> None:
+        """A dancer's guide rail along its travel axis ``e`` on the near side (from
+        ``lo − R`` to ``hi + R``), an end stop across it at each end of its travel
+        (``home + lo e``, ``home + hi e``) and the carriage block (node ``carriage``,
+        posed with the roller's centre)."""
+        lam = g.MeshLambertMaterial
+        e = np.array(self.dancer_axes[b.name])
+        lo, hi = b.roles.dancer.travel
+        R, y = b.initial_radius, -0.56 * self._width(b.name)
+        home = np.array(b.centre, dtype=float)
+        turn = pin.utils.rotate("y", math.atan2(-e[1], e[0]))  # box x axis along e
+
+        def place(node, at: np.ndarray) -> None:
+            node.set_transform(pin.SE3(turn, np.array([at[0], y, at[1]])).homogeneous)
+        rail = root["carriage-rail"][b.name]
+        rail["rail"].set_object(g.Box([hi - lo + 2 * R, 0.04, 0.03]),
+                                lam(color=COLOURS["rail"]))
+        place(rail["rail"], home + 0.5 * (lo + hi) * e)
+        for end, d in (("lo", lo), ("hi", hi)):
+            rail[end].set_object(g.Box([0.02, 0.06, 3.0 * R]), lam(color=COLOURS["stop"]))
+            place(rail[end], home + d * e)
+        root["carriage"][b.name].set_object(g.Box([1.6 * R, 0.08, 1.6 * R]),
+                                            lam(color=COLOURS["rail"]))
 
     def initial_extent(self) -> tuple[float, float, float, float]:
         """``(x_min, x_max, z_min, z_max)`` [m] of the bodies at their scene centres."""
@@ -206,6 +251,9 @@ class WinderGraph:
         out = {}
         for b in self.machine.bodies:
             pose = self.data.oMi[b.joints["theta"]].homogeneous.copy()
+            if b.name in self.dancer_axes:  # a carriage the model does not move: its d
+                x, z, _ = frame[b.name]
+                pose[0, 3], pose[2, 3] = x, z
             pose[1, 3] += self.drawings[b.name].y  # a segment's place along the axis
             out[b.name] = pose
         return out
@@ -218,6 +266,10 @@ class WinderGraph:
         out: list[Pose] = []
         for b in self.machine.bodies:
             out.append(("transform", (b.name,), T[b.name]))
+            if b.name in self.dancer_axes:
+                c = T[b.name][:3, 3]
+                out.append(("transform", ("carriage", b.name),
+                            _translation([c[0], -0.56 * self._width(b.name), c[2]])))
             if b.radius_state:
                 r = float(bodies[b.name].radius[k])
                 out.append(("scale", (b.name, "paper"), [r, 1.0, r]))
