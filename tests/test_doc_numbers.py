@@ -1,0 +1,123 @@
+"""The numbers of the README and the docs pages against their sources
+(benchmarks/doc_numbers.py): every ``<!-- numbers: NAME -->…<!-- /numbers -->`` block says
+what its source gives (docs/numbers.json, the benchmarks' JSON, the scene files, closed
+forms); one changed digit in any block fails; and, slow, docs/numbers.json against a
+fresh run of the demo's scenes."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _load(name: str):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules.setdefault(name, module)
+    spec.loader.exec_module(module)
+    return module
+
+
+dn = _load("doc_numbers")
+
+
+@pytest.fixture(scope="module")
+def sources():
+    return dn.Sources()
+
+
+def _texts() -> dict[str, str]:
+    return {p.relative_to(ROOT).as_posix(): p.read_text("utf-8") for p in dn.pages()}
+
+
+def test_every_page_says_what_its_sources_give(sources):
+    stale = [str(s) for page, text in _texts().items()
+             for s in dn.check_text(text, page, sources)]
+    assert stale == [], ("stale numbers (python benchmarks/doc_numbers.py --write fills "
+                         "them):\n" + "\n".join(stale))
+
+
+def test_every_number_is_on_a_page_and_every_block_names_one():
+    used = {n for names in dn.used().values() for n in names}
+    assert sorted(set(dn.RENDER) - used) == [], "numbers no page quotes"
+    assert sorted(used - set(dn.RENDER)) == [], "blocks naming no number"
+    assert "README.md" in dn.used()
+
+
+def _bump(text: str) -> str:
+    """The block's text with its first digit changed (9 -> 0, else +1)."""
+    m = re.search(r"\d", text)
+    assert m, f"a block without a digit: {text!r}"
+    d = m.group()
+    return text[: m.start()] + ("0" if d == "9" else str(int(d) + 1)) + text[m.end():]
+
+
+def test_one_changed_digit_in_any_block_fails(sources):
+    """Every block of every page, one at a time: its first digit changed, the check names
+    that block (page, line, name), and filling the page restores it exactly."""
+    n = 0
+    for page, text in _texts().items():
+        for m in dn.BLOCK.finditer(text):
+            changed = (text[: m.start("text")] + _bump(m.group("text"))
+                       + text[m.end("text"):])
+            stale = dn.check_text(changed, page, sources)
+            line = text.count("\n", 0, m.start()) + 1
+            assert [(s.page, s.line, s.name) for s in stale] == \
+                [(page, line, m.group("name"))], (page, line)
+            assert dn.fill_text(changed, sources) == text
+            n += 1
+    assert n >= 30
+
+
+def test_the_blocks_syntax(sources):
+    ok = "a <!-- numbers: flex.segments -->8<!-- /numbers --> b"
+    assert dn.blocks(ok) == [("flex.segments", "8", 1)]
+    for bad in ("a <!-- numbers: flex.segments -->8 b",                   # not closed
+                "a 8<!-- /numbers --> b",                                  # not opened
+                "<!-- numbers: a -->1 <!-- numbers: b -->2<!-- /numbers -->"
+                "<!-- /numbers -->",                                        # nested
+                "text\n<!-- numbers: flex.segments -->8<!-- /numbers --> more"):  # line start
+        with pytest.raises(ValueError):
+            dn.blocks(bad)
+    table = "x\n\n<!-- numbers: flex.segments -->\n\n8\n\n<!-- /numbers -->\n"
+    assert dn.check_text(table, "t.md", sources) == []
+    with pytest.raises(KeyError, match="no such number"):
+        dn.check_text("a <!-- numbers: nope -->1<!-- /numbers -->", "t.md", sources)
+
+
+def test_the_closed_forms_against_the_flexible_drum_test():
+    """The rotary inertia's closed form here is the one of tests/parts/test_flex_rotary.py
+    (the Timoshenko equation on stiff bearings): the same drum, the same numbers."""
+    spec = importlib.util.spec_from_file_location(
+        "flex_rotary", ROOT / "tests" / "parts" / "test_flex_rotary.py")
+    ft = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ft)
+    import math
+    for k in (1, 2):
+        kappa = k * math.pi / ft.L
+        a, c = ft.RHO_A * ft.RHO_I / ft.KGA, ft.EI * kappa ** 4
+        b = ft.RHO_A + ft.RHO_I * kappa ** 2 + ft.RHO_A * ft.EI * kappa ** 2 / ft.KGA
+        want = math.sqrt((b - math.sqrt(b * b - 4 * a * c)) / (2 * a)) / (2 * math.pi)
+        got = dn._timoshenko(k, length=ft.L, ro=ft.RO, wall=ft.WALL, rotary=True)
+        assert got == pytest.approx(want, rel=1e-12)
+
+
+@pytest.mark.slow
+def test_numbers_json_against_a_fresh_run(tmp_path):
+    """docs/numbers.json against benchmarks/readme_numbers.py run afresh (minutes): every
+    number within 1e-3 relative (the runs are deterministic on one machine; the margin
+    is for another compiler's rounding), except the wall times and the event counts
+    (within 2 %)."""
+    rn = _load("readme_numbers")
+    fresh = tmp_path / "numbers.json"
+    assert rn.main(["--out", str(tmp_path), "--json", str(fresh)]) == 0
+    old = json.loads(dn.NUMBERS_JSON.read_text("utf-8"))
+    new = json.loads(fresh.read_text("utf-8"))
+    assert rn.differences(old, new) == []
