@@ -346,6 +346,10 @@ RENDER: dict[str, Callable[[Sources], str]] = {
     "rotary.now_1e9": lambda s: _machine_cell(s, "1e9", "on"),
     "rotary.now_stiff_error": lambda s: _machine_error(s, "stiff", "on"),
     "rotary.now_1e9_error": lambda s: _machine_error(s, "1e9", "on"),
+    "rotary.tube": lambda s: (
+        f"`EI` = {_sci(_flex_oracle().EI, 3)} N·m², `kGA` = {_sci(_flex_oracle().KGA, 3)} N, "
+        f"`m` = {_flex_oracle().MASS:.0f} kg, `J` = {_flex_oracle().INERTIA:.0f} kg·m², "
+        f"slenderness `L/r` = {_slenderness(6.0):.1f}"),
     "rotary.slenderness": lambda s: "; ".join(
         f"{_slenderness(length):.{1 if _slenderness(length) < 20 else 0}f}: "
         f"{_pct(_rotary_drop(1, length))} % / {_pct(_rotary_drop(2, length))} %"
@@ -445,24 +449,31 @@ def _render(name: str, sources: Sources) -> str:
     return RENDER[name](sources)
 
 
+def _same(found: str, want: str) -> bool:
+    """Equal up to whitespace: a block may sit on lines of its own, or wrap with its
+    paragraph."""
+    return found.split() == want.split()
+
+
 def check_text(text: str, page: str, sources: Sources) -> list[Stale]:
-    """The stale blocks of one page (the text compared with its surrounding whitespace
-    stripped: a block may sit on lines of its own)."""
+    """The stale blocks of one page."""
     out = []
     for name, found, line in blocks(text):
         want = _render(name, sources)
-        if found.strip() != want.strip():
+        if not _same(found, want):
             out.append(Stale(page, line, name, found, want))
     return out
 
 
 def fill_text(text: str, sources: Sources) -> str:
-    """The page with every block's text from its source (its surrounding whitespace
-    kept)."""
+    """The page with every stale block's text from its source (its surrounding whitespace
+    kept; a block that differs only in whitespace is left as it is)."""
     blocks(text)
 
     def sub(m: re.Match) -> str:
         old = m.group("text")
+        if _same(old, _render(m.group("name"), sources)):
+            return m.group(0)
         lead = old[: len(old) - len(old.lstrip())]
         trail = old[len(old.rstrip()):]
         return (f"<!-- numbers: {m.group('name')} -->{lead}"

@@ -327,6 +327,28 @@ def flex_numbers(res: winder.Result, mm) -> list[tuple[str, str]]:  # noqa: ANN0
     return rows
 
 
+def pages_numbers(out: Path, *, rerun: bool = False, two: winder.Result | None = None
+                  ) -> dict:
+    """The numbers the pages quote (docs/numbers.json): the paper's cycle, the two-drum
+    winder, the calibration example, the flexible drum's rotary inertia."""
+    paper = result_of("paper_winding", out, rerun=rerun)
+    two = two if two is not None else result_of("two_drum_winder", out, rerun=rerun)
+    return {"generated_by": "benchmarks/readme_numbers.py --json",
+            "paper_winding": {"final_radius": float(paper["radius"][-1])},
+            "two_drum_winder": two_drum_values(two),
+            "calibration": calibration_values(out),
+            "flex_rotary": flex_rotary_values()}
+
+
+def write_json(numbers: dict, path: Path) -> None:
+    """``numbers`` to ``path`` atomically (sorted keys, one space of indent)."""
+    text = json.dumps(numbers, indent=1, sort_keys=True, ensure_ascii=False) + "\n"
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(text, "utf-8")
+    tmp.replace(path)
+    print(f"{path}: written", file=sys.stderr)
+
+
 def differences(old, new, *, rtol: float = 1e-3, where: str = "") -> list[str]:  # noqa: ANN001
     """Where two sets of numbers (docs/numbers.json's) differ: every number within ``rtol``
     relative (or 1e-12 absolute), except wall times (not compared) and event counts
@@ -374,17 +396,7 @@ def main(argv: list[str] | None = None) -> int:
     flex_map = winder.mode_map(winder.load_scene(MODELS / "two_drum_winder_flexible.toml"),
                                radius_max=0.6, n=40)  # as make demo: the cycle's radii
     if args.json is not None:
-        paper = result_of("paper_winding", args.out, rerun=args.rerun)
-        numbers = {"generated_by": "benchmarks/readme_numbers.py --json",
-                   "paper_winding": {"final_radius": float(paper["radius"][-1])},
-                   "two_drum_winder": two_drum_values(two),
-                   "calibration": calibration_values(args.out),
-                   "flex_rotary": flex_rotary_values()}
-        text = json.dumps(numbers, indent=1, sort_keys=True, ensure_ascii=False) + "\n"
-        tmp = args.json.with_suffix(".json.tmp")
-        tmp.write_text(text, "utf-8")
-        tmp.replace(args.json)
-        print(f"{args.json}: written", file=sys.stderr)
+        write_json(pages_numbers(args.out, rerun=args.rerun, two=two), args.json)
     print("| quantity | value |\n|---|---|")
     for title, rows in (("two_drum_winder", two_drum_numbers(two)),
                         ("two_drum_winder, rider load", variants),
