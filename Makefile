@@ -147,6 +147,8 @@ bench: $(STAMP)
 	$(PY) benchmarks/sweep_scaling.py
 	$(PY) benchmarks/flex_speed.py
 	$(PY) benchmarks/flex_cycle.py
+	$(PY) benchmarks/fit_speed.py
+	$(PY) benchmarks/doc_numbers.py --write
 
 # Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
 peers: $(STAMP)

@@ -8,10 +8,11 @@ A page marks each measured number (a phrase, a table) as a block::
 ``NAME`` is an entry of :data:`RENDER`: a function of :class:`Sources` that returns the
 block's text. The sources:
 
-- ``docs/numbers.json``: the numbers of the demo's runs (the two-drum winder, its
-  rider-load variants, the winder line, the flexible winder, the paper cycle, the
-  calibration example), written by ``benchmarks/readme_numbers.py --json`` (minutes: it
-  runs the scenes); a slow test checks it against a fresh run;
+- ``docs/numbers.json``: the numbers of runs and analyses (the paper's cycle, the
+  two-drum winder, the calibration example, the tension loop's design, the flexible
+  drum's frequencies against the Timoshenko equation), written by
+  ``benchmarks/readme_numbers.py --json`` (a minute or two: it runs the scenes where
+  ``out/`` lacks them); a slow test checks it against a fresh run;
 - the benchmarks' JSON beside their pages (``docs/cycle_speed.json``,
   ``docs/build_speed.json``, ...), written by ``make bench``;
 - cheap numbers computed here from the scene files, the code's constants and closed
@@ -276,6 +277,30 @@ def _calibration_table(s: Sources) -> str:
                       _fit_row(s, "contact.damping", "N·s/m", "2e4")])
 
 
+def _loop(s: Sources) -> dict:
+    return s.numbers["tension_loop"]
+
+
+def _poles(s: Sources) -> str:
+    """The tension loop's closed-loop poles at the full parent: the real one and the pair
+    [rad/s]."""
+    poles = _loop(s)["parents"]["full"]["poles"]
+    real = [p for p in poles if p[1] == 0.0]
+    pair = [p for p in poles if p[1] > 0.0]
+    return (" and ".join(f"−{-p[0]:.1f}" for p in real) + " and "
+            + " and ".join(f"−{-p[0]:.2f} ± {p[1]:.2f}j" for p in pair) + " rad/s")
+
+
+def _margins(s: Sources) -> str:
+    parents = [_loop(s)["parents"][k] for k in ("full", "half", "empty")]  # as the page
+    gains = [p["gain_margin"] for p in parents]
+    return ("Phase margins " + ", ".join(f"{p['phase_margin']:.0f}°" for p in parents)
+            + " at crossovers " + ", ".join(f"{p['crossover']:.1f}" for p in parents)
+            + " rad/s; " + ("no finite gain margin" if all(g is None for g in gains) else
+                            "gain margins " + ", ".join("∞" if g is None else f"{g:.2g}"
+                                                        for g in gains)))
+
+
 def _calibration(s: Sources) -> dict:
     return s.numbers["calibration"]
 
@@ -379,6 +404,16 @@ RENDER: dict[str, Callable[[Sources], str]] = {
         f"{s.bench('fit_speed')['two_drum']['with_sensitivities']:.1f} s per simulation with "
         f"sensitivities of two keys, {s.bench('fit_speed')['two_drum']['without']:.1f} s "
         "without"),
+    # the unwind tension loop (examples/tension_loop_design.py)
+    "loop.poles": _poles,
+    "loop.bandwidth": lambda s: f"{_loop(s)['bandwidth']:g}",
+    "loop.spread": lambda s: _sci(_loop(s)["spread"], 1),
+    "loop.margins": _margins,
+    "loop.machine": lambda s: " … ".join(_sci(f(p["machine_agree"] for p in
+                                                 _loop(s)["parents"].values()), 1)
+                                         for f in (min, max)),
+    "loop.step": lambda s: (f"{_sci(_loop(s)['step_error'], 2)} N of "
+                            f"{_loop(s)['step_peak']:.1f} N"),
     # the calibration example (examples/calibrate_nip.py)
     "calibration.table": _calibration_table,
     "calibration.run": lambda s: (

@@ -216,6 +216,51 @@ def flex_rotary_values() -> dict:
     return out
 
 
+def tension_loop_values() -> dict:
+    """The unwind tension loop of ``examples/tension_loop_design.py`` (its scene, plant
+    and tuning rule, imported from it): per parent radius the phase margin [°] and its
+    crossover [rad/s], the gain margin (None: infinite), the tension loop's three
+    closed-loop poles [rad/s] and their largest relative distance from the linearised
+    tension-controlled machine's; the poles' spread over the radii [rad/s]; the +20 N
+    set-point step against the nonlinear line (largest difference and the response's
+    peak [N])."""
+    import importlib.util
+
+    import control as ct
+
+    spec = importlib.util.spec_from_file_location(
+        "tension_loop_design", ROOT / "examples" / "tension_loop_design.py")
+    ex = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ex)
+    scene = winder.load_scene(ex.SCENE)
+    span = scene.web.span
+    wc = next(r for r in scene.rolls if r.name == span.source).drive.bandwidth
+    out: dict = {"bandwidth": wc, "parents": {}}
+    for label, r in ex.PARENTS.items():
+        plant = winder.linearise(ex.line(r, torque=True), ex.SET_RADIUS,
+                                 inputs=["parent_torque"],
+                                 outputs=["span_tension", "parent_inertia"])
+        K, J = ex.controller(plant, r, wc, span.EA, span.length)
+        loop = -ct.tf(plant[0, 0]) * K
+        gm, pm, _, wp = ct.margin(loop)
+        closed = np.sort_complex(ct.feedback(loop, 1).poles())
+        slow = closed[np.abs(closed) < 4 * wc]
+        inside = np.linalg.eigvals(np.asarray(winder.linearise(
+            ex.line(r, torque=False), ex.SET_RADIUS, inputs=["parent_tension_setpoint"],
+            outputs=["span_tension"]).A))
+        out["parents"][label] = {
+            "radius": r, "inertia": float(J), "phase_margin": float(pm),
+            "crossover": float(wp), "gain_margin": float(gm) if np.isfinite(gm) else None,
+            "poles": [[float(p.real), float(p.imag)] for p in slow],
+            "machine_agree": float(max(np.min(np.abs(inside - p)) / abs(p) for p in slow))}
+    poles = {k: np.array([complex(*p) for p in v["poles"]])
+             for k, v in out["parents"].items()}
+    out["spread"] = float(max(np.max(np.abs(poles[k] - poles["full"])) for k in poles))
+    err, peak = ex.closed_loop_check(wc, False)
+    out["step_error"], out["step_peak"] = err, peak
+    return out
+
+
 def calibration_values(out: Path) -> dict:
     """The calibration example (``examples/calibrate_nip.py``): its fit of the nip from
     the guess, and the fitted machine's bounce frequency against the true one (largest
@@ -337,7 +382,8 @@ def pages_numbers(out: Path, *, rerun: bool = False, two: winder.Result | None =
             "paper_winding": {"final_radius": float(paper["radius"][-1])},
             "two_drum_winder": two_drum_values(two),
             "calibration": calibration_values(out),
-            "flex_rotary": flex_rotary_values()}
+            "flex_rotary": flex_rotary_values(),
+            "tension_loop": tension_loop_values()}
 
 
 def write_json(numbers: dict, path: Path) -> None:
@@ -349,10 +395,15 @@ def write_json(numbers: dict, path: Path) -> None:
     print(f"{path}: written", file=sys.stderr)
 
 
+#: Numbers that are round-off (a balance's residual [N], the poles' spread over the radii
+#: [rad/s]): compared absolutely, to these bounds.
+ROUND_OFF = {"balance_residual": 1e-6, "spread": 1e-9}
+
+
 def differences(old, new, *, rtol: float = 1e-3, where: str = "") -> list[str]:  # noqa: ANN001
     """Where two sets of numbers (docs/numbers.json's) differ: every number within ``rtol``
-    relative (or 1e-12 absolute), except wall times (not compared) and event counts
-    (within 2 %); strings and flags equal; the same keys."""
+    relative (or 1e-12 absolute), except wall times (not compared), event counts (within
+    2 %) and round-off (:data:`ROUND_OFF`); strings and flags equal; the same keys."""
     if isinstance(old, dict) and isinstance(new, dict):
         if set(old) != set(new):
             return [f"{where}: keys {sorted(set(old) ^ set(new))} in one only"]
@@ -366,6 +417,9 @@ def differences(old, new, *, rtol: float = 1e-3, where: str = "") -> list[str]: 
         return [] if old == new else [f"{where}: {old!r} against {new!r}"]
     if where.endswith(("wall_time", "generated_by")):
         return []
+    for key, atol in ROUND_OFF.items():  # numbers at round-off: absolute
+        if where.endswith(key):
+            return [] if abs(new - old) <= atol else [f"{where}: {old!r} against {new!r}"]
     tol = 0.02 if where.endswith(("events", "evaluations", "rhs_evaluations")) else rtol
     if abs(new - old) <= max(tol * abs(old), 1e-12):
         return []
