@@ -406,6 +406,8 @@ RENDER: dict[str, Callable[[Sources], str]] = {
         "without"),
     # the unwind tension loop (examples/tension_loop_design.py)
     "loop.poles": _poles,
+    "loop.inertia_ratio": lambda s: (
+        f"{_loop(s)['parents']['full']['inertia'] / _loop(s)['parents']['empty']['inertia']:.0f}"),
     "loop.bandwidth": lambda s: f"{_loop(s)['bandwidth']:g}",
     "loop.spread": lambda s: _sci(_loop(s)["spread"], 1),
     "loop.margins": _margins,
