@@ -529,11 +529,42 @@ def used(root: Path = ROOT) -> dict[str, list[str]]:
     return out
 
 
+#: A number with a unit or a decimal point, outside code: what ``--unmarked`` lists.
+_NUMBER = re.compile(r"(?<![\w.`])[−+-]?\d[\d,.]*(?:e[−-]?\d+)?(?:\s?(?:%|°|s|ms|µs|Hz|kHz|kN|N|"
+                     r"mm|m|GB|MB|min|t|µm|kg|rad/s|×|dB))?(?![\w`])")
+
+
+def unmarked(text: str) -> list[tuple[int, str]]:
+    """``(line, number)`` of the numbers a page states outside its blocks, code spans and
+    fences: the candidates to wire (a measured number) or to leave (an input). Bare
+    small integers (counts of things, section numbers) are left out."""
+    text = BLOCK.sub(lambda m: " " * len(m.group(0).split("\n")[0])
+                     + "\n" * m.group(0).count("\n"), text)
+    text = re.sub(r"```.*?```", lambda m: "\n" * m.group(0).count("\n"), text, flags=re.S)
+    out = []
+    for i, line in enumerate(text.splitlines(), 1):
+        line = re.sub(r"`[^`]*`|\]\([^)]*\)|<[^>]*>", " ", line)
+        for m in _NUMBER.finditer(line):
+            token = m.group(0)
+            if re.fullmatch(r"\d{1,2}\.?", token):
+                continue
+            out.append((i, token))
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--write", action="store_true",
                     help="fill every block from its source (default: check only)")
+    ap.add_argument("--unmarked", nargs="*", metavar="PAGE",
+                    help="list the numbers outside blocks of these pages (default every "
+                    "page): the candidates to wire")
     args = ap.parse_args(argv)
+    if args.unmarked is not None:
+        for page in [ROOT / p for p in args.unmarked] or pages():
+            for line, token in unmarked(page.read_text("utf-8")):
+                print(f"{page.relative_to(ROOT).as_posix()}:{line}: {token}")
+        return 0
     sources = Sources()
     stale: list[Stale] = []
     for page in pages():

@@ -134,3 +134,9 @@ def test_numbers_json_against_a_fresh_run(tmp_path):
     rn = _load("readme_numbers")
     old = json.loads(dn.NUMBERS_JSON.read_text("utf-8"))
     assert rn.differences(old, rn.pages_numbers(tmp_path)) == []
+
+
+def test_unmarked_lists_the_numbers_outside_blocks_and_code():
+    page = ("a <!-- numbers: flex.segments -->8.5 s<!-- /numbers --> and `2.5 s` and 4.67 1/s"
+            "\n\n```text\n3.5 s\n```\nsection 2. then 71.9° at 132.9 rad/s\n")
+    assert dn.unmarked(page) == [(1, "4.67"), (6, "71.9°"), (6, "132.9 rad/s")]
