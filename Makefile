@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.winder-installed
 OUT    ?= out
 
 .PHONY: demo test test-slow bench peers fmu docs-figures lint chromium libtbb clean venv pin-casadi \
-	scene-reference readme-numbers docs
+	scene-reference readme-numbers docs-numbers docs
 
 $(STAMP): pyproject.toml
 	@echo "creating $(VENV) and installing winder with its dependencies (pip; about 2 min the first time)"
@@ -149,6 +149,8 @@ bench: $(STAMP)
 	$(PY) benchmarks/sweep_scaling.py
 	$(PY) benchmarks/flex_speed.py
 	$(PY) benchmarks/flex_cycle.py
+	$(PY) benchmarks/fit_speed.py
+	$(PY) benchmarks/doc_numbers.py --write
 
 # Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
 peers: $(STAMP)
@@ -159,10 +161,18 @@ peers: $(STAMP)
 scene-reference: $(STAMP)
 	$(PY) -m winder.scene.reference --out docs/scene-reference.md
 
-# The README's quoted numbers of the two-drum winder, the winder line and the flexible winder, from the demo's
-# results in $(OUT)/ (run where missing): a table to paste.
+# Every measured number of the README and the docs pages comes from a script
+# (docs/contributing.md, "Numbers"): the demo's numbers into docs/numbers.json (from the
+# results in $(OUT)/, each scene run where missing: minutes), printed as a table too; then
+# every page's <!-- numbers: NAME --> blocks filled from it, the benchmarks' JSON, the
+# scene files and closed forms. tests/test_doc_numbers.py fails while a page disagrees.
 readme-numbers: $(STAMP)
-	$(PY) benchmarks/readme_numbers.py --out $(OUT)
+	$(PY) benchmarks/readme_numbers.py --out $(OUT) --json docs/numbers.json
+	$(PY) benchmarks/doc_numbers.py --write
+
+# The fill alone (seconds), after `make bench` or a new block (without --write: a check).
+docs-numbers: $(STAMP)
+	$(PY) benchmarks/doc_numbers.py --write
 
 # The README's resonance map and the examples' figures of the site's gallery (committed
 # under docs/; about 2 min).

@@ -128,3 +128,44 @@ def _flat_map(ModeMap):  # noqa: N803 - the class
     zeros = {k: np.zeros(r.size) for k in flat}
     return ModeMap(r, flat, zeros, np.zeros(r.size), np.zeros(r.size),
                    40.0 / (2 * np.pi * r), 40.0, "set")
+
+
+def test_bounce_has_no_edge_artefact(rn):
+    """A body rising at a steady rate with a 2 mm bounce, the band running to the run's
+    last sample: less its centred 0.5 s mean (501 samples of 1 ms, two whole periods: the
+    mean of the sampled sine is 0, of the ramp the ramp) the bounce is the sine exactly, to
+    the end. The old measure,
+    less the interpolated means of consecutive windows, held the last mean over the last
+    half window: there the ramp's own rise showed as bounce (the spike of every bounce
+    panel)."""
+    t = np.round(np.arange(10_001) * 0.001, 12)  # 10 s at 1 ms
+    amp, rate = 2e-3, 0.05  # [m], [m/s]
+    f = 2 / 0.501  # [Hz]
+    z = 0.4 + rate * t + amp * np.sin(2 * np.pi * f * t + 0.3)
+    band = slice(5_000, t.size)
+    lo, hi = rn.bounce_range(t, z, band)
+    # the samples with a whole window: the sine's extremes among them to 1e-6 of amp
+    idx, _ = rn.centred_mean(t, z)
+    kept = idx[(idx >= 5_000)]
+    sine = amp * np.sin(2 * np.pi * f * t[kept] + 0.3)
+    assert abs(hi - sine.max()) < 1e-12 and abs(lo - sine.min()) < 1e-12  # round-off
+    assert hi == pytest.approx(amp, rel=1e-5) and lo == pytest.approx(-amp, rel=1e-5)
+    tm, zm = rn.window_mean(t, z)
+    old = z - np.interp(t, tm, zm)
+    assert np.max(old[band]) > amp + 0.2 * rate * 0.25  # the old edge: the ramp's rise
+
+
+def test_two_drum_values_are_the_rows(rn):
+    """The raw numbers docs/numbers.json keeps are the ones the table prints."""
+    res = _two_drum()
+    res.meta.update({"static_residual": 1e-9, "static_scale": 5e4, "method": "DOPRI5",
+                     "rtol": 1e-6, "wall_time": 1.0, "rhs_evaluations": 10, "events": 3})
+    v = rn.two_drum_values(res)
+    rows = dict(rn.two_drum_numbers(res))
+    assert rows["force peak inside the band [kN]"] == ", ".join(
+        f"{n} {v['peak_band'][n] / 1e3:.1f}" for n in rn.NIPS)
+    assert rows["share of samples open, inside the band [%]"] == ", ".join(
+        f"{n} {100 * v['open_share_band'][n]:.1f}" for n in rn.NIPS)
+    assert v["band"]["t"] == [100.0, 139.98]
+    for body in ("rider", "set"):  # constant heights: no bounce (cumulative-sum round-off)
+        assert np.allclose(v["bounce_band"][body], 0.0, atol=1e-12)
