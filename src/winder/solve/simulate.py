@@ -3,6 +3,7 @@ progress."""
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import time
@@ -37,7 +38,7 @@ __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "
 DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
 #: Methods that run entirely compiled (generated code only); ROS2 is the Rosenbrock method
 #: of :mod:`winder.solve.rosenbrock` (stiff machines, exact Jacobian).
-COMPILED_METHODS = ("DOPRI5", "ROS2")
+COMPILED_METHODS = ("DOPRI5", "ROS2", "RODAS3", "RODAS4")
 #: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
 #: Jacobians for scipy's implicit methods: ``exact`` (generated; ``pinocchio`` is its old
 #: name) or ``fd`` (the integrator's finite differences).
@@ -123,13 +124,16 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
     lib = system.kernels  # the C integrators of the machine's library
     dopri5, rk4, ros2 = lib.dopri5, lib.rk4, lib.ros2
+    rodas3 = functools.partial(lib.rodas, order=3)
+    rodas4 = functools.partial(lib.rodas, order=4)
     for tb in breaks:
         while t < tb:
             budget = min(integ.CHUNK, guards.limit - int(stats[0]))
             if budget <= 0:
                 raise _Stop("max_rhs")
             if meth in COMPILED_METHODS:
-                run = dopri5 if meth == "DOPRI5" else ros2
+                run = {"DOPRI5": dopri5, "ROS2": ros2, "RODAS3": rodas3,
+                       "RODAS4": rodas4}[meth]
                 status, t, h, k = run(fns, table, t, tb, y, p, modes, rtol, atol, h, hmax,
                                       t_out, Ys, k, budget, stats)
             else:  # RK4: chunks of budget/4 steps
@@ -283,7 +287,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         guards.alternatives, guards.faster = _compiled_instead(meth, system)
     breaks = sorted({b for b in system.breakpoints if t_s < b < T} | {T})
     Ys = np.empty((len(y0), len(t_out)))
-    stats = np.zeros(5, dtype=np.int64)
+    stats = np.zeros(8, dtype=np.int64)
     at: list[Any] = [t_s, None, 0]
     try:
         try:
