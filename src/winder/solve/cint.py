@@ -34,7 +34,7 @@ import numpy as np
 
 from winder.model.codegen import Generated, Link, cache_dir, compile_flags, run_compiler
 
-__all__ = ["Kernels", "link", "SOURCES", "EXTRA_CFLAGS", "RODAS_REUSE"]
+__all__ = ["Kernels", "link", "SOURCES", "EXTRA_CFLAGS", "ROSENBROCK"]
 
 _DIR = Path(__file__).resolve().parent / "c"
 #: The translation units (each includes ``events.h``).
@@ -46,9 +46,12 @@ _dp = ctypes.POINTER(ctypes.c_double)
 _ip = ctypes.POINTER(ctypes.c_int64)
 _i64, _f64 = ctypes.c_int64, ctypes.c_double
 _LINKS: dict[tuple[str, ...], Link] = {}
-#: The Rosenbrock methods' default Jacobian reuse: the most accepted steps one Jacobian serves
-#: (benchmarks/flex_cycle.py measured 1, 4, 16; docs/flex_cycle.md).
-RODAS_REUSE = 8
+#: The Rosenbrock methods of ``rosenbrock.c``: ``(scheme, reuse)``, ``reuse`` the most
+#: accepted steps one Jacobian serves (RODAS3/4 are not W-methods: a kept Jacobian costs
+#: them their order and the steps it saves (flexible two-drum winder, 0.5 s at rtol 1e-6:
+#: RODAS4 reuse 4 took 7 times RODAS4 reuse 1's CPU); ROS34PW2 is a W-method: reuse 16 was
+#: its fastest of 1, 4, 16, 64 there).
+ROSENBROCK = {"RODAS3": (3, 1), "RODAS4": (4, 1), "ROS34PW2": (34, 16)}
 
 
 def link() -> Link:
@@ -180,12 +183,13 @@ class Kernels:
               y: np.ndarray, p: np.ndarray, m: np.ndarray, rtol: float, atol: float,
               h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
               budget: int, stats: np.ndarray, *, order: int = 4,
-              reuse: int = RODAS_REUSE) -> tuple[int, float, float, int]:
+              reuse: int = 1) -> tuple[int, float, float, int]:
         """RODAS3 (``order=3``), RODAS4 (``order=4``) or the W-method ROS34PW2
         (``order=34``) of ``rosenbrock.c`` (stiffly accurate, L-stable Rosenbrock methods
-        on the exact Jacobian, factored on its sparsity), as :meth:`dopri5`; ``reuse`` >= 1: the most steps one Jacobian serves
-        (1: a new one every step). ``stats`` needs 8 counters: [4] Jacobians, [5]
-        factorisations, [6] dense fallbacks, [7] L + U nonzeros."""
+        on the exact Jacobian, factored on its sparsity), as :meth:`dopri5`; ``reuse``
+        >= 1: the most steps one Jacobian serves (1: a new one every step). ``stats``
+        needs 8 counters: [4] Jacobians, [5] factorisations, [6] dense fallbacks, [7]
+        L + U nonzeros."""
         n = _check(fns, table, y, m, t_out, Y_out, stats)
         self._sizes(y, p)
         if stats.shape[0] < 8:
