@@ -93,20 +93,20 @@ int winder_rodas(const int64_t* fns, const int64_t* table, int64_t nslots,
     const Scheme* S = scheme == 4 ? &RODAS4 : scheme == 34 ? &ROS34PW2 : &RODAS3;
     Ctx ctx, *cx = &ctx;
     Slu lu;
-    double* v[16];
+    double* v[17];
     double* jac = malloc(sizeof(double) * (size_t)n * (size_t)n);
     if (!jac || !slu_init(&lu, n)) {
         free(jac);
         return NO_MEMORY;
     }
-    if (!ctx_init(cx, fns, table, nslots, n_switches, n, p, m, v, 16)) {
+    if (!ctx_init(cx, fns, table, nslots, n_switches, n, p, m, v, 17)) {
         free(jac);
         slu_free(&lu);
         return NO_MEMORY;
     }
-    double *f0 = v[0], *f1 = v[1], *ft = v[2], *dfdt = v[3], *y1 = v[4], *rc = v[5],
-           *err_v = v[6];
-    double* K[6] = {v[7], v[8], v[9], v[10], v[11], v[12]};
+    double *f0 = v[0], *f1 = v[1], *ft = v[2], *dfdt = v[3], *y1 = v[4], *err_v = v[5];
+    double* K[6] = {v[6], v[7], v[8], v[9], v[10], v[11]};
+    double* rc = v[12]; /* the dense output: 5 n (v[12] .. v[16]) */
     double* yt = cx->yt;
     memset(rc, 0, sizeof(double) * 5 * (size_t)n);
     if (reuse < 1)
@@ -276,7 +276,7 @@ int winder_rodas(const int64_t* fns, const int64_t* table, int64_t nslots,
     }
     stats[0] += nfev;
     stats[6] += lu.dense_factors;
-    stats[7] = lu.fill + 1000000 * lu.symbolic;
+    stats[7] = lu.fill;
     free(cx->g);
     free(jac);
     slu_free(&lu);
