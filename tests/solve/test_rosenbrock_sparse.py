@@ -195,3 +195,25 @@ def test_stepper_and_simulate_run_rodas4(models_dir) -> None:
     assert abs(sim.output("set_speed") / res["set_speed"][-1] - 1.0) < 4.7e-9
     with pytest.raises(winder.ArgumentError, match="not a Stepper method"):
         winder.Stepper(scene, method="RK45")
+
+
+def test_spectral_radius_estimate() -> None:
+    """auto's stiffness estimate on the linear machine: its eigenvalues are A's diagonal
+    but the oscillator's (-5e5 the largest in modulus)."""
+    from winder.solve.auto import spectral_radius
+
+    exact = float(np.max(np.abs(np.linalg.eigvals(A))))
+    assert exact == pytest.approx(5e5)
+    # measured: 5.0e5 to 1e-12 relative (a dominant real eigenvalue, 60 iterations)
+    assert spectral_radius(A) == pytest.approx(exact, rel=1e-9)
+
+
+def test_auto_keeps_dopri5_where_its_step_is_the_accuracy(models_dir) -> None:
+    """The smooth paper scene: DOPRI5's mean step over the probe is 3.9 times its stable
+    step 3.3/rho (measured), so auto runs DOPRI5 and says why in meta["auto"]."""
+    scene = winder.load_scene(models_dir / "paper_winding_smooth.toml")
+    res = winder.simulate(scene, method="auto", t_end=5.0, output_step=0.5)
+    assert res.meta["method"] == "DOPRI5"
+    probe = res.meta["auto"]["probe"]["DOPRI5"]
+    assert probe["h_mean"] > 2.0 * probe["h_stable"]
+    assert "RODAS4" not in res.meta["auto"]["probe"]
