@@ -30,9 +30,9 @@ typedef struct {
                           * column-major as the generated Jacobian) */
     int64_t* perm;       /* position -> original index */
     int64_t* lptr;       /* n + 1: row i's L columns lidx[lptr[i] .. lptr[i+1]) ascending */
-    int64_t* lidx;
+    int32_t* lidx;       /* (32-bit: half the index traffic of the solves) */
     int64_t* uptr;       /* row i's U columns (> i) */
-    int64_t* uidx;
+    int32_t* uidx;
     double* W;           /* n x n: the dense fallback's matrix */
     double* lval;        /* L's values, as lidx */
     double* uval;        /* U's values, as uidx */
@@ -131,8 +131,8 @@ static int slu_symbolic(Slu* s) {
     free(s->uidx);
     free(s->lval);
     free(s->uval);
-    s->lidx = malloc(sizeof(int64_t) * (size_t)(nl + 1));
-    s->uidx = malloc(sizeof(int64_t) * (size_t)(nu + 1));
+    s->lidx = malloc(sizeof(int32_t) * (size_t)(nl + 1));
+    s->uidx = malloc(sizeof(int32_t) * (size_t)(nu + 1));
     s->lval = malloc(sizeof(double) * (size_t)(nl + 1));
     s->uval = malloc(sizeof(double) * (size_t)(nu + 1));
     if (!s->lidx || !s->uidx || !s->lval || !s->uval) {
@@ -146,10 +146,10 @@ static int slu_symbolic(Slu* s) {
         s->uptr[i] = nu;
         for (int64_t k = 0; k < i; k++)
             if (F[i * n + k])
-                s->lidx[nl++] = k;
+                s->lidx[nl++] = (int32_t)k;
         for (int64_t j = i + 1; j < n; j++)
             if (F[i * n + j])
-                s->uidx[nu++] = j;
+                s->uidx[nu++] = (int32_t)j;
     }
     s->lptr[n] = nl;
     s->uptr[n] = nu;
@@ -203,7 +203,8 @@ static int slu_factor(Slu* s, const double* jac, double d, int* nomem) {
     }
     s->dense = 0;
     double* x = s->x;  /* the dense work row: zero outside a row's factorisation */
-    const int64_t *lp = s->lptr, *li = s->lidx, *up = s->uptr, *ui = s->uidx;
+    const int64_t *lp = s->lptr, *up = s->uptr;
+    const int32_t *li = s->lidx, *ui = s->uidx;
     double *lv = s->lval, *uv = s->uval;
     for (int64_t i = 0; i < n; i++) {
         const double* Jr = jac + P[i];  /* row P[i] of the column-major Jacobian */
@@ -274,7 +275,8 @@ static void slu_solve(const Slu* s, double* b) {
     }
     double* x = s->x;
     const int64_t* P = s->perm;
-    const int64_t *lp = s->lptr, *li = s->lidx, *up = s->uptr, *ui = s->uidx;
+    const int64_t *lp = s->lptr, *up = s->uptr;
+    const int32_t *li = s->lidx, *ui = s->uidx;
     const double *lv = s->lval, *uv = s->uval;
     for (int64_t i = 0; i < n; i++) {
         double v = b[P[i]];
