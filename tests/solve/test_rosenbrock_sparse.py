@@ -64,8 +64,8 @@ def linear(tmp_path_factory) -> tuple[Kernels, np.ndarray]:
     flags = (*compile_flags(), *EXTRA_CFLAGS)
     run_compiler([*flags, "-c", str(d / "lin.c"), "-o", str(d / "lin.o")], "the test machine")
     objects = [str(o) for o in link().objects]
-    run_compiler(["-shared", "-o", str(d / "lin.so"), str(d / "lin.o"), *objects, "-lm"],
-                 "the test library")
+    run_compiler([*flags, "-shared", "-o", str(d / "lin.so"), str(d / "lin.o"), *objects,
+                  "-lm"], "the test library")  # the flags: sanitized builds link the runtime
     lib = ctypes.CDLL(str(d / "lin.so"))
     fns = np.array([ctypes.cast(getattr(lib, f"lin_{k}"), ctypes.c_void_p).value
                     for k in ("rhs", "jac", "none", "none")], dtype=np.int64)
