@@ -9,7 +9,12 @@ load's spread along each nip (``(max − min)/mean``, its largest over the run a
 end), the drums' twist, the drums' and the set's largest mid-span deflection, and the
 difference of the set's final radius and the nips' mean total force from the rigid run.
 
-Run:  python benchmarks/flex_cycle.py [--t-end 414.5]
+``--methods``: instead, the integrators side by side (DOPRI5, RODAS4, RODAS3, ROS34PW2)
+on the first ``--window`` seconds, their work–precision diagram and what
+``method="auto"`` picks per shipped scene (``benchmarks/flex_methods.py``, writes
+docs/flex_methods.*).
+
+Run:  python benchmarks/flex_cycle.py [--t-end 414.5] [--methods [--window 20]]
 """
 
 from __future__ import annotations
@@ -114,7 +119,16 @@ def write(data: dict) -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=414.5, help="simulated time [s]")
+    ap.add_argument("--methods", action="store_true",
+                    help="the integrators side by side, work–precision, auto's picks")
+    ap.add_argument("--window", type=float, default=20.0,
+                    help="--methods: the window of the cycle run side by side [s]")
     args = ap.parse_args(argv)
+    if args.methods:
+        import flex_methods  # beside this file
+
+        flex_methods.main(args.window)
+        return 0
     write(measure(args.t_end))
     return 0
 

@@ -27,8 +27,8 @@ __all__ = ["EFFECT_NAMES", "METHODS", "BACKENDS", "DRIVE_KINDS", "MAX_SAMPLES", 
 #: :data:`winder.forces.FORCES` (:func:`effect_names` also those registered later).
 EFFECT_NAMES = tuple(FORCES)
 #: Integrators of ``[solver] method``.
-METHODS = ("auto", "DOPRI5", "RK4", "ROS2", "RK45", "DOP853", "Radau", "BDF", "LSODA",
-           "RK23")
+METHODS = ("auto", "DOPRI5", "RK4", "ROS2", "RODAS3", "RODAS4", "ROS34PW2", "RK45", "DOP853",
+           "Radau", "BDF", "LSODA", "RK23")
 #: Right-hand side backends: the compiled planar equations, or Pinocchio's ABA.
 BACKENDS = ("compiled", "pinocchio")
 #: Drive kinds of a drum.
@@ -88,7 +88,9 @@ PAPER_KEYS = Table(roll.KEYS.select("density", "caliper", required=True, default
 
 #: ``[solver]``.
 SOLVER_KEYS = Table((
-    Key(name="method", kind="str", choices=METHODS, doc="integrator; auto is DOPRI5"),
+    Key(name="method", kind="str", choices=METHODS,
+        doc="integrator; auto: DOPRI5, or RODAS4 where a short probe finds it faster "
+        "(docs/work_precision.md)"),
     Key(name="rtol", unit="-", **_POS, hi=RTOL_MAX, doc="relative tolerance"),
     Key(name="atol", unit="", doc_unit="state units", **_POS, hi=ATOL_MAX,
         doc="absolute tolerance"),

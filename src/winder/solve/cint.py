@@ -1,7 +1,8 @@
 """The integrators in C, linked into every machine's library (issue #23).
 
 ``solve/c/`` holds them: ``events.h`` (the shared mode table, event location and guard),
-``dopri5.c``, ``rk4.c``, ``ros2.c`` and ``machine.c`` (the modes and channels of a
+``dopri5.c``, ``rk4.c``, ``ros2.c``, ``rosenbrock.c`` (RODAS3/4 with ``sparse_lu.h``) and
+``machine.c`` (the modes and channels of a
 trajectory). :func:`link` compiles them once into objects (cached under
 :func:`~winder.model.codegen.cache_dir`, keyed by every source and header and the flags:
 the generated code's plus ``-ffp-contract=off -std=c99``, so no fused multiply–add
@@ -33,11 +34,11 @@ import numpy as np
 
 from winder.model.codegen import Generated, Link, cache_dir, compile_flags, run_compiler
 
-__all__ = ["Kernels", "link", "SOURCES", "EXTRA_CFLAGS"]
+__all__ = ["Kernels", "link", "SOURCES", "EXTRA_CFLAGS", "ROSENBROCK"]
 
 _DIR = Path(__file__).resolve().parent / "c"
 #: The translation units (each includes ``events.h``).
-SOURCES = ("dopri5.c", "rk4.c", "ros2.c", "machine.c")
+SOURCES = ("dopri5.c", "rk4.c", "ros2.c", "rosenbrock.c", "machine.c")
 #: Flags beyond the generated code's: no contraction into FMA.
 EXTRA_CFLAGS = ("-ffp-contract=off", "-std=c99")
 
@@ -45,6 +46,12 @@ _dp = ctypes.POINTER(ctypes.c_double)
 _ip = ctypes.POINTER(ctypes.c_int64)
 _i64, _f64 = ctypes.c_int64, ctypes.c_double
 _LINKS: dict[tuple[str, ...], Link] = {}
+#: The Rosenbrock methods of ``rosenbrock.c``: ``(scheme, reuse)``, ``reuse`` the most
+#: accepted steps one Jacobian serves (RODAS3/4 are not W-methods: a kept Jacobian costs
+#: them their order and the steps it saves (flexible two-drum winder, 0.5 s at rtol 1e-6:
+#: RODAS4 reuse 4 took 7 times RODAS4 reuse 1's CPU); ROS34PW2 is a W-method: reuse 16 was
+#: its fastest of 1, 4, 16, 64 there).
+ROSENBROCK = {"RODAS3": (3, 1), "RODAS4": (4, 1), "ROS34PW2": (34, 16)}
 
 
 def link() -> Link:
@@ -105,6 +112,8 @@ class Kernels:
                     _f64, _dp, _i64, _dp, _i64, _i64, _ip]
         self._dopri5 = self._fn(lib.winder_dopri5, [*adaptive, _i64, _dp, _dp, _ip])
         self._ros2 = self._fn(lib.winder_ros2, [*adaptive, _dp, _dp, _ip])
+        self._rodas = self._fn(lib.winder_rodas, [*adaptive[:-1], _i64, _i64, _ip, _dp, _dp,
+                                                  _ip])
         self._rk4 = self._fn(lib.winder_rk4, [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp,
                                               _dp, _f64, _dp, _i64, _dp, _i64, _ip, _dp, _dp,
                                               _ip])
@@ -168,6 +177,37 @@ class Kernels:
             t_out.shape[0], _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
             _ptr(stats, np.int64, "stats", True), ctypes.byref(tr), ctypes.byref(hr),
             ctypes.byref(kr))
+        return _result(status, tr, hr, kr)
+
+    def rodas(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float,
+              y: np.ndarray, p: np.ndarray, m: np.ndarray, rtol: float, atol: float,
+              h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
+              budget: int, stats: np.ndarray, *, order: int = 4,
+              reuse: int = 1) -> tuple[int, float, float, int]:
+        """RODAS3 (``order=3``), RODAS4 (``order=4``) or the W-method ROS34PW2
+        (``order=34``) of ``rosenbrock.c`` (stiffly accurate, L-stable Rosenbrock methods
+        on the exact Jacobian, factored on its sparsity), as :meth:`dopri5`; ``reuse``
+        >= 1: the most steps one Jacobian serves (1: a new one every step). ``stats``
+        needs 8 counters: [4] Jacobians, [5] factorisations, [6] dense fallbacks, [7]
+        L + U nonzeros."""
+        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        self._sizes(y, p)
+        if stats.shape[0] < 8:
+            raise ValueError("stats must hold 8 counters")
+        if order not in (3, 4, 34):
+            raise ValueError(f"order must be 3 (RODAS3), 4 (RODAS4) or 34 (ROS34PW2), got "
+                             f"{order!r}")
+        if int(reuse) < 1:
+            raise ValueError(f"reuse must be an integer >= 1, got {reuse!r}")
+        tr, hr, kr = _f64(), _f64(), _i64()
+        status = self._rodas(
+            _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
+            self.n_switches, float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
+            _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol),
+            float(atol), float(h), float(max_step), _ptr(t_out, np.float64, "t_out"),
+            t_out.shape[0], _ptr(Y_out, np.float64, "Y_out", True), int(k), int(budget),
+            int(order), int(reuse), _ptr(stats, np.int64, "stats", True), ctypes.byref(tr),
+            ctypes.byref(hr), ctypes.byref(kr))
         return _result(status, tr, hr, kr)
 
     def rk4(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float, y: np.ndarray,

@@ -3,6 +3,7 @@ progress."""
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import time
@@ -28,6 +29,7 @@ from winder.solve.budgets import (
     check_tolerances,
     default_max_rhs,
 )
+from winder.solve.cint import ROSENBROCK
 from winder.solve.system import MachineSystem
 
 __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "MAX_SAMPLES",
@@ -37,7 +39,7 @@ __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "
 DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
 #: Methods that run entirely compiled (generated code only); ROS2 is the Rosenbrock method
 #: of :mod:`winder.solve.rosenbrock` (stiff machines, exact Jacobian).
-COMPILED_METHODS = ("DOPRI5", "ROS2")
+COMPILED_METHODS = ("DOPRI5", "ROS2", "RODAS3", "RODAS4", "ROS34PW2")
 #: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
 #: Jacobians for scipy's implicit methods: ``exact`` (generated; ``pinocchio`` is its old
 #: name) or ``fd`` (the integrator's finite differences).
@@ -123,13 +125,16 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
     lib = system.kernels  # the C integrators of the machine's library
     dopri5, rk4, ros2 = lib.dopri5, lib.rk4, lib.ros2
+    runs = {"DOPRI5": dopri5, "ROS2": ros2, **{
+        name: functools.partial(lib.rodas, order=order, reuse=reuse)
+        for name, (order, reuse) in ROSENBROCK.items()}}
     for tb in breaks:
         while t < tb:
             budget = min(integ.CHUNK, guards.limit - int(stats[0]))
             if budget <= 0:
                 raise _Stop("max_rhs")
             if meth in COMPILED_METHODS:
-                run = dopri5 if meth == "DOPRI5" else ros2
+                run = runs[meth]
                 status, t, h, k = run(fns, table, t, tb, y, p, modes, rtol, atol, h, hmax,
                                       t_out, Ys, k, budget, stats)
             else:  # RK4: chunks of budget/4 steps
@@ -193,10 +198,13 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     ----------
     scene: from :func:`winder.load_scene`, or the path of a scene file.
     t_end: end time [s], finite and > 0 (default: ``[scene] duration``).
-    method: one of ``auto`` (:data:`DEFAULT_METHOD`), DOPRI5 (compiled Dormand–Prince
-        with contact events), RK4 (fixed step ``max_step``, default 1 ms), ROS2 (compiled
-        Rosenbrock on the exact Jacobian, for stiff scenes), or scipy's RK45, DOP853,
-        Radau, BDF, LSODA, RK23; default ``[solver] method``.
+    method: one of ``auto`` (compiled: DOPRI5 or RODAS4 by a short probe,
+        :func:`winder.solve.auto.choose_method`, its numbers in ``meta["auto"]``; else
+        :data:`DEFAULT_METHOD`), DOPRI5 (compiled Dormand–Prince with contact events), RK4
+        (fixed step ``max_step``, default 1 ms), ROS2 (compiled Rosenbrock on the exact
+        Jacobian), RODAS4, RODAS3, ROS34PW2 (compiled Rosenbrock methods on the exact
+        Jacobian factored on its sparsity, for machines with fast damped modes), or
+        scipy's RK45, DOP853, Radau, BDF, LSODA, RK23; default ``[solver] method``.
     rtol, atol: tolerances, rtol finite in (0, 0.1], atol finite in (0, 1e-3] [state
         units] (default ``[solver]``).
     progress: print a progress bar on stderr.
@@ -274,6 +282,13 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         from winder.io.progress import Progress
 
         bar = Progress(T, scene.name)
+    choice = None
+    if system.generated is not None and \
+            (scene.solver.method if method is None else method) == "auto":
+        from winder.solve.auto import choose_method  # the probe: compiled runs only
+
+        choice = choose_method(system, rtol, atol, t_s, y0, T)
+        meth = choice.method
     compiled_run = system.generated is not None and meth in (*COMPILED_METHODS, "RK4")
     limit = given_rhs if given_rhs is not None else default_max_rhs(
         stepwise=not compiled_run, backend=system.backend, n_states=system.n_states)
@@ -283,7 +298,7 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
         guards.alternatives, guards.faster = _compiled_instead(meth, system)
     breaks = sorted({b for b in system.breakpoints if t_s < b < T} | {T})
     Ys = np.empty((len(y0), len(t_out)))
-    stats = np.zeros(5, dtype=np.int64)
+    stats = np.zeros(8, dtype=np.int64)
     at: list[Any] = [t_s, None, 0]
     try:
         try:
@@ -338,6 +353,9 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     if bad:
         raise SimulationError(f"non-finite values in result channels {bad}")
     meta = _meta(scene, system, meth, rtol, atol, wall, n_events, t_s, T)
+    if choice is not None:
+        meta["auto"] = {"method": choice.method, "reason": choice.reason,
+                        "window": choice.window, "probe": choice.probe}
     slips = web_slips(system, t_out, channels)
     if slips:
         meta["slips"] = slips

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import time
@@ -15,7 +16,9 @@ from winder.io.result import Result
 from winder.scene import naming_of
 from winder.scene.load import Scene
 from winder.solve import integrators as integ
+from winder.solve.auto import choose_method
 from winder.solve.budgets import COMPILED_MAX_RHS, budget_error, check_budgets, check_tolerances
+from winder.solve.cint import ROSENBROCK
 from winder.solve.simulate import _as_scene
 from winder.solve.system import MachineSystem
 
@@ -66,12 +69,19 @@ class Stepper:
         finite in (0, 0.1], atol finite in (0, 1e-3] [state units].
     max_rhs, max_wall: budget of each :meth:`step`: evaluations and wall-clock seconds
         (default ``[solver] max_rhs``, else 50 million, and ``max_wall``).
+    method: the compiled integrator inside each step: ``DOPRI5`` (default), or one of the
+        Rosenbrock methods ``RODAS4``, ``RODAS3``, ``ROS34PW2`` (stiff machines: exact
+        sparse Jacobian), or ``auto`` (:func:`winder.solve.auto.choose_method`'s probe).
     """
 
     def __init__(self, scene: Scene | str | os.PathLike, *, rtol: float = 1e-8,
                  atol: float = 1e-10, max_rhs: int | None = None,
-                 max_wall: float | None = None) -> None:
+                 max_wall: float | None = None, method: str = "DOPRI5") -> None:
         scene = _as_scene(scene)
+        valid = ("auto", "DOPRI5", *ROSENBROCK)
+        if not isinstance(method, str) or method not in valid:
+            raise ArgumentError(f"method = {method!r} is not a Stepper method; valid: "
+                                f"{', '.join(valid)}")
         self.rtol, self.atol = check_tolerances(rtol, atol)
         self.max_rhs, self.max_wall = check_budgets(
             (scene.solver.max_rhs or COMPILED_MAX_RHS) if max_rhs is None else max_rhs,
@@ -85,6 +95,14 @@ class Stepper:
         self.free_drum = bool(self.system.torque_inputs())
         self._breaks = tuple(self.system.breakpoints)
         self.reset()
+        if method == "auto":
+            method = choose_method(self.system, self.rtol, self.atol, 0.0, self.y,
+                                   math.inf).method
+        #: the integrator inside each step
+        self.method = method
+        k = self.system.kernels
+        self._run = k.dopri5 if method == "DOPRI5" else functools.partial(
+            k.rodas, order=ROSENBROCK[method][0], reuse=ROSENBROCK[method][1])
 
     def reset(self) -> None:
         """Back to ``t = 0`` and the initial state of machines.md §7 (inputs keep their
@@ -92,7 +110,7 @@ class Stepper:
         self.t = 0.0
         self.y = self.system.initial_state()
         self._h = 0.0
-        self._stats = np.zeros(5, dtype=np.int64)
+        self._stats = np.zeros(8, dtype=np.int64)
         self.system.end = None
         self._outputs: dict[str, float] | None = None
 
@@ -147,7 +165,7 @@ class Stepper:
         sy = self.system
         nfev0, steps0, stiff0 = (int(x) for x in self._stats[[0, 1, 4]])
         wall0 = time.perf_counter()
-        dopri5 = sy.kernels.dopri5  # the C DOPRI5 of the machine's library
+        run = self._run  # the C integrator of the machine's library
         for tb in stops:
             while self.t < tb:
                 spent = int(self._stats[0]) - nfev0
@@ -156,10 +174,9 @@ class Stepper:
                 if over is not None:
                     raise self._over(over, t_start, t_end, spent, steps0, stiff0, wall0)
                 budget = min(integ.CHUNK, self.max_rhs - spent)
-                status, t, h, _ = dopri5(sy.fns, sy.table, self.t, tb, self.y,
-                                               sy.params, sy.modes, self.rtol, self.atol,
-                                               self._h, math.inf, empty_t, empty_y, 0,
-                                               budget, self._stats)
+                status, t, h, _ = run(sy.fns, sy.table, self.t, tb, self.y, sy.params,
+                                      sy.modes, self.rtol, self.atol, self._h, math.inf,
+                                      empty_t, empty_y, 0, budget, self._stats)
                 if status in (integ.NON_FINITE, integ.STEP_UNDERFLOW) or \
                         not np.all(np.isfinite(self.y)):
                     where = state_text(self.state)
@@ -170,7 +187,7 @@ class Stepper:
                 if status == integ.PENETRATED:  # a nip beyond its bound: stop there
                     self.t, self._h = t, h
                     self._outputs = None
-                    raise sy.penetration_error(t, self.y, method="DOPRI5", max_step=None,
+                    raise sy.penetration_error(t, self.y, method=self.method, max_step=None,
                                                atol=self.atol)
                 if status == integ.EXHAUSTED:  # the unwinding roll ran out of web
                     self.system.ended(t, self.y)
