@@ -13,6 +13,8 @@ block's text. The sources:
   drum's frequencies against the Timoshenko equation), written by
   ``benchmarks/readme_numbers.py --json`` (a minute or two: it runs the scenes where
   ``out/`` lacks them); a slow test checks it against a fresh run;
+- ``docs/guide_numbers.json``: the web-line page's loops and modes, written by
+  ``benchmarks/guide_numbers.py`` (a minute; renderers in ``doc_numbers_guide.py``);
 - the benchmarks' JSON beside their pages (``docs/cycle_speed.json``,
   ``docs/build_speed.json``, ...), written by ``make bench``;
 - cheap numbers computed here from the scene files, the code's constants and closed
@@ -436,6 +438,22 @@ RENDER: dict[str, Callable[[Sources], str]] = {
         f"{_calibration(s)['modes']['true_core']:.0f} Hz at "
         f"{_calibration(s)['modes']['core_radius']:.3f} m"),
 }
+
+
+def _more_renderers() -> dict[str, Callable[[Sources], str]]:
+    """The renderers of other modules (benchmarks/doc_numbers_guide.py: the guide's pages)."""
+    import importlib.util
+
+    out: dict = {}
+    for name in ("doc_numbers_guide",):
+        spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        out.update(module.RENDER)
+    return out
+
+
+RENDER.update(_more_renderers())
 
 
 # --- the blocks -----------------------------------------------------------------------
