@@ -552,6 +552,11 @@ _NUMBER = re.compile(r"(?<![\w.`])[−+-]?\d[\d,.]*(?:e[−-]?\d+)?(?:\s?(?:%|°
                      r"mm|m|GB|MB|min|t|µm|kg|rad/s|×|dB))?(?![\w`])")
 
 
+#: ``<!-- dated record: DATE, COMMIT -->``: a page kept as the record of a past measurement
+#: (its date and commit), whose numbers are not claims about today's code.
+DATED = re.compile(r"<!-- dated record: (?P<date>\d{4}-\d\d-\d\d), (?P<commit>[0-9a-f]{7,40}) -->")
+
+
 def unmarked(text: str) -> list[tuple[int, str]]:
     """``(line, number)`` of the numbers a page states outside its blocks, code spans and
     fences: the candidates to wire (a measured number) or to leave (an input). Bare
@@ -580,8 +585,13 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.unmarked is not None:
         for page in [ROOT / p for p in args.unmarked] or pages():
-            for line, token in unmarked(page.read_text("utf-8")):
-                print(f"{page.relative_to(ROOT).as_posix()}:{line}: {token}")
+            text, rel = page.read_text("utf-8"), page.relative_to(ROOT).as_posix()
+            if (m := DATED.search(text)) is not None:
+                print(f"{rel}: a dated record ({m['date']}, {m['commit']}): its numbers "
+                      "are that day's, left out", file=sys.stderr)
+                continue
+            for line, token in unmarked(text):
+                print(f"{rel}:{line}: {token}")
         return 0
     sources = Sources()
     stale: list[Stale] = []

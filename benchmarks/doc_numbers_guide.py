@@ -1,15 +1,18 @@
-"""The renderers of the user guide's web-line page (docs/guide/idlers-dancers-spans.md),
-merged into ``benchmarks/doc_numbers.py``'s ``RENDER``: from ``docs/guide_numbers.json``
-(``benchmarks/guide_numbers.py``), the shipped dancer line's scene file and the dancer
-design's closed form."""
+"""The renderers of the user guide's web-line page (docs/guide/idlers-dancers-spans.md)
+and of docs/control.md, merged into ``benchmarks/doc_numbers.py``'s ``RENDER``: from
+``docs/guide_numbers.json`` (``benchmarks/guide_numbers.py``), the shipped dancer line's
+scene file and the dancer design's closed form."""
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
+ROOT = Path(__file__).resolve().parents[1]
 DANCER_SCENE = "winder_line_dancer"
 
 
@@ -136,7 +139,85 @@ def _brake_tensions(s) -> str:  # noqa: ANN001
     return ", ".join(f"{round(1000.0 / radii[k], -2):.0f} N {k}" for k in ("full", "empty"))
 
 
+def _sci(x: float, digits: int = 2) -> str:
+    """``x`` to ``digits`` significant digits, the exponent short: 1.7e-3."""
+    mant, exp = f"{x:.{digits - 1}e}".split("e")
+    return f"{mant}e{int(exp)}"
+
+
+def _mpc(s) -> dict:  # noqa: ANN001
+    return _g(s)["tension_mpc"]
+
+
+def _n(x: float) -> str:
+    """An error [N] as the page writes it: two significant digits, small ones as 1.7e-3."""
+    return _sci(x) if x < 0.01 else f"{x:.2g}" if x < 1 else f"{x:.3g}" if x < 10 else f"{x:.0f}"
+
+
+def _mpc_steps(s) -> str:  # noqa: ANN001
+    m = _mpc(s)
+    return (f"{m['steps']} MPC steps, the line's step included, take "
+            f"{m['loop_cpu_time']:.1f} s of CPU ({1e3 * m['loop_cpu_time'] / m['steps']:.1f} ms "
+            f"each; {m['loop_wall_time']:.0f} s wall at a load average of "
+            f"{m['load_average']:.1f} on 2 cores)")
+
+
+@functools.cache
+def second_spectrum() -> float:
+    """The cutoff of Timoshenko's second spectrum, ``sqrt(κGA / ρI) / 2π`` [Hz], of the 6 m
+    drum of tests/parts/test_flex_rotary.py (model.md §9): the sections' own rotation
+    lies above it."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "test_flex_rotary", ROOT / "tests" / "parts" / "test_flex_rotary.py")
+    ft = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ft)
+    return math.sqrt(ft.KGA / ft.RHO_I) / (2 * math.pi)
+
+
+def _link(s) -> str:  # noqa: ANN001
+    """The link each machine adds to the integrators' objects [s] (docs/compiled_machine.json,
+    this tree's row)."""
+    cm = s.bench("compiled_machine")
+    tree = next(v for k, v in cm.items() if k.startswith("this tree"))
+    links = [m["link_only"] for m in tree["compile"]["machines"].values()]
+    return f"{min(links):.3f}–{max(links):.3f} s each"
+
+
+def _python_call(s) -> str:  # noqa: ANN001
+    """The generated rhs called from Python (ctypes) and inside the compiled loop [µs]
+    (docs/rhs_speed.json, its shipped scenes' rows)."""
+    rows = s.bench("rhs_speed")["rows"]
+    py, c = ([r[k] for r in rows] for k in ("rhs_python_us", "rhs_us"))
+    return (f"{min(py):.0f}–{max(py):.0f} µs a call against {min(c):.2f}–{max(c):.2f} µs "
+            "inside the compiled loop")
+
+
 RENDER: dict[str, Callable] = {
+    # docs/c-integrators.md (the benchmarks' JSON)
+    "cint.link": _link,
+    "cint.python_call": _python_call,
+    # docs/guide/modes.md: the sections' rotation modes
+    "modes.second_spectrum": lambda s: f"{second_spectrum() / 1e3:.2f} kHz",
+    # docs/control.md: casadi_model's build, the MPC example (examples/tension_mpc.py)
+    "control.casadi_build": lambda s: (
+        f"{_g(s)['casadi_model']['first_cpu_time']:.2f} s of CPU in a fresh process (its "
+        "machine's code from the disk cache), "
+        f"{_g(s)['casadi_model']['cached_cpu_time']:.2f} s once the machine is cached in "
+        "the process"),
+    "control.mpc_ramp": lambda s: (
+        f"{_n(_mpc(s)['mpc_ramp_max'])} N (rms {_n(_mpc(s)['mpc_ramp_rms'])} N), the built-in "
+        f"controller's {_n(_mpc(s)['builtin_ramp_max'])} N"),
+    "control.builtin_ramp_rms": lambda s: f"{_n(_mpc(s)['builtin_ramp_rms'])} N",
+    "control.torque_drop": lambda s: f"{round(_mpc(s)['torque_drop'], -2):.0f} N·m",
+    "control.mpc_end": lambda s: (f"{_n(_mpc(s)['mpc_end_max'])} N against "
+                                  f"{_n(_mpc(s)['builtin_end_max'])} N"),
+    "control.mpc_steps": _mpc_steps,
+    "control.move_scales": lambda s: "; ".join(
+        f"{k} N·m: {_n(_mpc(s)['move_scales'][k]['end_max'])} N"
+        + (" there" if k == "10" else "") for k in ("10", "1000")),
+    # docs/guide/idlers-dancers-spans.md
     "line.span_table": span_table,
     "line.span_settle": lambda s: f"{_g(s)['tension_span']['step']['settled']:.2f} s",
     "line.dancer_decay": lambda s: f"{-_g(s)['dancer_control']['decay']['rate']:.2f} 1/s",

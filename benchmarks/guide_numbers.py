@@ -1,6 +1,7 @@
-"""The numbers of the user guide's web-line page (docs/guide/idlers-dancers-spans.md) from
-the computations of its tests and example, written to ``docs/guide_numbers.json`` (raw,
-SI units), from which ``benchmarks/doc_numbers.py`` fills the page's blocks.
+"""The numbers of the user guide's web-line page (docs/guide/idlers-dancers-spans.md) and
+of docs/control.md from the computations of their tests and examples, written to
+``docs/guide_numbers.json`` (raw, SI units), from which ``benchmarks/doc_numbers.py``
+fills the pages' blocks.
 
 - ``tension_span``: the unwind holding span 1 behind a guide roller
   (``tests/test_tension_span.py``'s ``span_loop``: the linearised machine's closed-loop
@@ -12,9 +13,12 @@ SI units), from which ``benchmarks/doc_numbers.py`` fills the page's blocks.
   from 20 mm out (``tests/test_idler_line.py``'s ``dancer_decay``);
 - ``line_modes``: the shipped dancer line's mode map over the parent's radius
   (:func:`winder.mode_map`, ``roll="parent"``) at a full and an empty parent, under
-  ``dancer_control`` and under the brake of ``tests/test_line_modes.py``.
+  ``dancer_control`` and under the brake of ``tests/test_line_modes.py``;
 
-About a minute (the machines' builds cached). A slow test
+and of docs/control.md: ``casadi_model``'s build times, ``tension_mpc``: the MPC example's
+closed loops (``examples/tension_mpc.py``'s ``run``, three of them: a minute or two).
+
+A few minutes (the machines' builds cached). A slow test
 (``tests/test_doc_numbers.py``) compares the file with a fresh run.
 
 Run:  python benchmarks/guide_numbers.py [--json docs/guide_numbers.json]
@@ -25,6 +29,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -115,10 +120,65 @@ def line_mode_values() -> dict:
     return out
 
 
+def mpc_values() -> dict:
+    """``examples/tension_mpc.py``'s closed loops over the whole ramp (23 s): with the
+    default move scale (300 N·m) the largest and rms tension errors [N] of the MPC and the
+    built-in controller over the ramp and at its end, the built-in torque's fall where the
+    ramp ends [N·m] (±0.05 s), the MPC steps and their wall time [s]; with move scales 10
+    and 1000 N·m the MPC's largest error at the ramp's end [N]."""
+    ex = _module("examples", "tension_mpc")
+    out: dict = {"move_scales": {}}
+    for scale in (300.0, 10.0, 1000.0):
+        r = ex.run(23.0, 0.01, 20, scale)
+        ramp, end = ex.windows(r["t"], 23.0).values()
+        out["move_scales"][f"{scale:g}"] = {"end_max": float(np.max(np.abs(r["err_mpc"][end])))}
+        if scale != 300.0:
+            continue
+        ref = r["ref"]
+        drop = (np.interp(ex.RAMP_END - 0.05, ref.t, ref["parent_torque"])
+                - np.interp(ex.RAMP_END + 0.05, ref.t, ref["parent_torque"]))
+        out.update({
+            "ramp_end": ex.RAMP_END, "torque_drop": float(drop), "steps": r["steps"],
+            "loop_wall_time": r["t_loop"], "loop_cpu_time": r["cpu_loop"],
+            "load_average": os.getloadavg()[0],
+            **{f"{who}_{where}_{what}": float(f(r[key][w]))
+               for who, key in (("mpc", "err_mpc"), ("builtin", "err_ref"))
+               for where, w in (("ramp", ramp), ("end", end))
+               for what, f in (("max", lambda e: np.max(np.abs(e))),
+                               ("rms", lambda e: np.sqrt(np.mean(e ** 2))))}})
+    return out
+
+
+def casadi_build_values() -> dict:
+    """The CPU and wall times [s] of ``winder.casadi_model`` on the winder line in a fresh
+    process: the first call (the machine's compiled code from the disk cache, the CasADi
+    expressions built) and a second one (the machine cached in the process); the load
+    average."""
+    import json
+    import subprocess
+
+    import winder
+
+    code = ("import json, time, winder\n"
+            "m = 'models/winder_line.toml'\n"
+            "t = []\n"
+            "for _ in range(2):\n"
+            "    t0, c0 = time.perf_counter(), time.process_time(); winder.casadi_model(m)\n"
+            "    t += [time.perf_counter() - t0, time.process_time() - c0]\n"
+            "print(json.dumps(t))\n")
+    winder.casadi_model(ROOT / "models" / "winder_line.toml")  # its code built and cached
+    res = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                         text=True, check=True)
+    first, first_cpu, again, again_cpu = json.loads(res.stdout.strip().splitlines()[-1])
+    return {"first_wall_time": first, "cached_wall_time": again, "first_cpu_time": first_cpu,
+            "cached_cpu_time": again_cpu, "load_average": os.getloadavg()[0]}
+
+
 def guide_numbers() -> dict:
     return {"generated_by": "benchmarks/guide_numbers.py",
             "tension_span": tension_span_values(), "dancer_control": dancer_values(),
-            "line_modes": line_mode_values()}
+            "line_modes": line_mode_values(), "casadi_model": casadi_build_values(),
+            "tension_mpc": mpc_values()}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -156,8 +156,19 @@ def test_the_dancer_designs_phase_margin_against_python_control():
 
 @pytest.mark.slow
 def test_guide_numbers_json_against_a_fresh_run():
-    """docs/guide_numbers.json (the web-line page's loops and modes) against a fresh run of
-    benchmarks/guide_numbers.py (about a minute): every number within 1e-3 relative."""
+    """docs/guide_numbers.json (the web-line page's loops and modes, control.md's MPC)
+    against a fresh run of benchmarks/guide_numbers.py (a few minutes): every number within
+    1e-3 relative, the timings and the load not compared."""
     rn, gn = _load("readme_numbers"), _load("guide_numbers")
     old = json.loads((ROOT / "docs" / "guide_numbers.json").read_text("utf-8"))
     assert rn.differences(old, json.loads(json.dumps(gn.guide_numbers()))) == []
+
+
+def test_a_dated_record_names_its_date_and_commit_and_is_left_out():
+    """docs/speed.md is a dated record (its numbers of 2026-11-23, before the C
+    integrators): marked with its date and commit, left out of ``--unmarked``."""
+    text = (ROOT / "docs" / "speed.md").read_text("utf-8")
+    m = dn.DATED.search(text)
+    assert m is not None and (m["date"], m["commit"]) == ("2026-11-23", "c83a5c7")
+    assert m["date"] in text.split("-->", 2)[1] and m["commit"] in text
+    assert dn.DATED.search("<!-- dated record: 2026-11-23 -->") is None  # no commit
