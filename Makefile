@@ -166,8 +166,10 @@ scene-reference: $(STAMP)
 # results in $(OUT)/, each scene run where missing: minutes), printed as a table too; then
 # every page's <!-- numbers: NAME --> blocks filled from it, the benchmarks' JSON, the
 # scene files and closed forms. tests/test_doc_numbers.py fails while a page disagrees.
+# The guide's web-line loops and modes into docs/guide_numbers.json (a minute).
 readme-numbers: $(STAMP)
 	$(PY) benchmarks/readme_numbers.py --out $(OUT) --json docs/numbers.json
+	$(PY) benchmarks/guide_numbers.py --json docs/guide_numbers.json
 	$(PY) benchmarks/doc_numbers.py --write
 
 # The fill alone (seconds), after `make bench` or a new block (without --write: a check).

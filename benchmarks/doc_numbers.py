@@ -13,6 +13,8 @@ block's text. The sources:
   drum's frequencies against the Timoshenko equation), written by
   ``benchmarks/readme_numbers.py --json`` (a minute or two: it runs the scenes where
   ``out/`` lacks them); a slow test checks it against a fresh run;
+- ``docs/guide_numbers.json``: the web-line page's loops and modes, written by
+  ``benchmarks/guide_numbers.py`` (a minute; renderers in ``doc_numbers_guide.py``);
 - the benchmarks' JSON beside their pages (``docs/cycle_speed.json``,
   ``docs/build_speed.json``, ...), written by ``make bench``;
 - cheap numbers computed here from the scene files, the code's constants and closed
@@ -438,6 +440,22 @@ RENDER: dict[str, Callable[[Sources], str]] = {
 }
 
 
+def _more_renderers() -> dict[str, Callable[[Sources], str]]:
+    """The renderers of other modules (benchmarks/doc_numbers_guide.py: the guide's pages)."""
+    import importlib.util
+
+    out: dict = {}
+    for name in ("doc_numbers_guide",):
+        spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        out.update(module.RENDER)
+    return out
+
+
+RENDER.update(_more_renderers())
+
+
 # --- the blocks -----------------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -534,6 +552,11 @@ _NUMBER = re.compile(r"(?<![\w.`])[−+-]?\d[\d,.]*(?:e[−-]?\d+)?(?:\s?(?:%|°
                      r"mm|m|GB|MB|min|t|µm|kg|rad/s|×|dB))?(?![\w`])")
 
 
+#: ``<!-- dated record: DATE, COMMIT -->``: a page kept as the record of a past measurement
+#: (its date and commit), whose numbers are not claims about today's code.
+DATED = re.compile(r"<!-- dated record: (?P<date>\d{4}-\d\d-\d\d), (?P<commit>[0-9a-f]{7,40}) -->")
+
+
 def unmarked(text: str) -> list[tuple[int, str]]:
     """``(line, number)`` of the numbers a page states outside its blocks, code spans and
     fences: the candidates to wire (a measured number) or to leave (an input). Bare
@@ -562,8 +585,13 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.unmarked is not None:
         for page in [ROOT / p for p in args.unmarked] or pages():
-            for line, token in unmarked(page.read_text("utf-8")):
-                print(f"{page.relative_to(ROOT).as_posix()}:{line}: {token}")
+            text, rel = page.read_text("utf-8"), page.relative_to(ROOT).as_posix()
+            if (m := DATED.search(text)) is not None:
+                print(f"{rel}: a dated record ({m['date']}, {m['commit']}): its numbers "
+                      "are that day's, left out", file=sys.stderr)
+                continue
+            for line, token in unmarked(text):
+                print(f"{rel}:{line}: {token}")
         return 0
     sources = Sources()
     stale: list[Stale] = []

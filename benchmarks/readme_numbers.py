@@ -415,7 +415,7 @@ def differences(old, new, *, rtol: float = 1e-3, where: str = "") -> list[str]: 
     if isinstance(old, bool) or not isinstance(old, int | float) \
             or not isinstance(new, int | float):
         return [] if old == new else [f"{where}: {old!r} against {new!r}"]
-    if where.endswith(("wall_time", "generated_by")):
+    if where.endswith(("wall_time", "cpu_time", "load_average", "generated_by")):
         return []
     for key, atol in ROUND_OFF.items():  # numbers at round-off: absolute
         if where.endswith(key):

@@ -45,7 +45,10 @@ READS = ("t", "span_tension", "parent_radius", "parent_speed", "rear_speed", "re
 
 class TensionLaw:
     """The unwind's tension controller, from the FMU's outputs (gains by the rule of
-    ``winder.forces.tension_control``: three closed-loop poles at ``−ω_c``)."""
+    ``winder.forces.tension_control``). The rule puts the three poles of its two-state
+    design model (the span's compliance, the parent's speed) at ``−ω_c``; on the machine
+    the span's transport and the nips move them (``examples/tension_loop_design.py``
+    computes them for the winder line; docs/control.md quotes them)."""
 
     def __init__(self, scene: Any, tension: float, bandwidth: float,
                  feedforward: str = "profile") -> None:

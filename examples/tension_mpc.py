@@ -127,6 +127,57 @@ class TensionMPC:
         return float(np.ravel(sol.value(self.U))[0])
 
 
+RAMP_END = 41.7 / 2.0  #: [s] the drums reach 41.7 m/s at 2 m/s²
+
+
+def windows(ts: np.ndarray, t_end: float) -> dict[str, np.ndarray]:
+    """The two windows of the comparison: over the ramp (0.5 s ≤ t < 20.8 s) and at its
+    end (20.8 s ≤ t ≤ ``t_end``)."""
+    return {"over the ramp (0.5 s <= t < 20.8 s)": (ts >= 0.5) & (ts < RAMP_END - 0.05),
+            f"at the ramp's end (20.8 s <= t <= {t_end:g} s)": ts >= RAMP_END - 0.05}
+
+
+def run(t_end: float = 23.0, dt: float = 0.01, horizon: int = 20,
+        move_scale: float = 300.0) -> dict:
+    """The MPC in closed loop with the nonlinear line (Stepper) and the built-in
+    controller's run: the sample times ``t`` [s], the tension errors ``err_mpc`` and
+    ``err_ref`` [N] at them, the MPC's ``torque`` [N·m], the built-in run ``ref``, the
+    wall times [s] of building ``casadi_model`` (``t_model``), the MPC (``t_build``) and
+    the loop (``t_loop``, the line's steps included; its CPU time ``cpu_loop``) and its
+    ``steps``. Also the source
+    of docs/control.md's numbers (benchmarks/guide_numbers.py)."""
+    import winder
+
+    tension = 1000.0  # [N], the built-in controller's set-point in winder_line_small.toml
+    t0 = time.perf_counter()
+    model = winder.casadi_model(PLANT, inputs=["parent_torque"], outputs=["span_tension"])
+    t_model = time.perf_counter() - t0
+    mpc = TensionMPC(model, tension, dt, horizon, move_scale)
+    t_build = time.perf_counter() - t0 - t_model
+    sim = winder.Stepper(PLANT)
+    u = 0.0
+    for _ in range(10):  # the torque the MPC settles on at t = 0 (a bumpless start)
+        u = mpc(0.0, sim.y, u)
+        mpc.predicted, mpc.d[:] = None, 0.0
+    ts, Ts, us = [0.0], [sim.output("span_tension")], [u]
+    t1, c1 = time.perf_counter(), time.process_time()
+    steps = int(round(t_end / dt))
+    for _ in range(steps):
+        u = mpc(sim.t, sim.y, u)
+        sim.set_input("parent_torque", u)
+        sim.step(dt)
+        ts.append(sim.t)
+        Ts.append(sim.output("span_tension"))
+        us.append(u)
+    t_loop, c_loop = time.perf_counter() - t1, time.process_time() - c1
+    ts = np.array(ts)
+    ref = winder.simulate(BUILT_IN, t_end=t_end)
+    return {"t": ts, "err_mpc": tension - np.array(Ts),
+            "err_ref": np.interp(ts, ref.t, ref["tension_error"]), "torque": np.array(us),
+            "ref": ref, "t_model": t_model, "t_build": t_build, "t_loop": t_loop,
+            "steps": steps, "cpu_loop": c_loop}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=23.0,
@@ -146,41 +197,14 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    import winder
-
     t_end = 2.0 if args.quick else args.t_end
-    tension = 1000.0  # [N], the built-in controller's set-point in winder_line_small.toml
-    t0 = time.perf_counter()
-    model = winder.casadi_model(PLANT, inputs=["parent_torque"], outputs=["span_tension"])
-    t_model = time.perf_counter() - t0
-    mpc = TensionMPC(model, tension, args.dt, args.horizon, args.move_scale)
-    t_build = time.perf_counter() - t0 - t_model
-    sim = winder.Stepper(PLANT)
-    u = 0.0
-    for _ in range(10):  # the torque the MPC settles on at t = 0 (a bumpless start)
-        u = mpc(0.0, sim.y, u)
-        mpc.predicted, mpc.d[:] = None, 0.0
-    ts, Ts, us = [0.0], [sim.output("span_tension")], [u]
-    t1 = time.perf_counter()
-    steps = int(round(t_end / args.dt))
-    for _ in range(steps):
-        u = mpc(sim.t, sim.y, u)
-        sim.set_input("parent_torque", u)
-        sim.step(args.dt)
-        ts.append(sim.t)
-        Ts.append(sim.output("span_tension"))
-        us.append(u)
-    t_loop = time.perf_counter() - t1
-    ts, err_mpc = np.array(ts), tension - np.array(Ts)
-    ref = winder.simulate(BUILT_IN, t_end=t_end)
-    err_ref = np.interp(ts, ref.t, ref["tension_error"])
-    ramp_end = 41.7 / 2.0  # [s] the drums reach 41.7 m/s at 2 m/s²
-    windows = {"over the ramp (0.5 s <= t < 20.8 s)": (ts >= 0.5) & (ts < ramp_end - 0.05),
-               f"at the ramp's end (20.8 s <= t <= {t_end:g} s)": ts >= ramp_end - 0.05}
-    print(f"casadi_model {t_model:.2f} s, MPC built {t_build:.2f} s, {steps} MPC steps "
-          f"in {t_loop:.1f} s ({1e3 * t_loop / steps:.1f} ms each, the line's step "
-          "included)")
-    for what, w in windows.items():
+    r = run(t_end, args.dt, args.horizon, args.move_scale)
+    ts, err_mpc, err_ref, us, ref = r["t"], r["err_mpc"], r["err_ref"], r["torque"], r["ref"]
+    ramp_end = RAMP_END
+    print(f"casadi_model {r['t_model']:.2f} s, MPC built {r['t_build']:.2f} s, "
+          f"{r['steps']} MPC steps in {r['t_loop']:.1f} s "
+          f"({1e3 * r['t_loop'] / r['steps']:.1f} ms each, the line's step included)")
+    for what, w in windows(ts, t_end).items():
         if not w.any():
             continue
         for name, e in (("MPC", err_mpc), ("built-in controller", err_ref)):

@@ -140,3 +140,35 @@ def test_unmarked_lists_the_numbers_outside_blocks_and_code():
     page = ("a <!-- numbers: flex.segments -->8.5 s<!-- /numbers --> and `2.5 s` and 4.67 1/s"
             "\n\n```text\n3.5 s\n```\nsection 2. then 71.9° at 132.9 rad/s\n")
     assert dn.unmarked(page) == [(1, "4.67"), (6, "71.9°"), (6, "132.9 rad/s")]
+
+
+def test_the_dancer_designs_phase_margin_against_python_control():
+    """The closed form of the dancer design's phase margin (the page's "at every radius")
+    is python-control's margin of the design loop ``(3ω_c s² + 3ω_c² s + ω_c³)/s³``, at
+    two bandwidths."""
+    import control
+
+    guide = _load("doc_numbers_guide")
+    for wc in (2.0, 5.0):
+        _, pm, _, _ = control.margin(control.tf([3 * wc, 3 * wc**2, wc**3], [1, 0, 0, 0]))
+        assert guide.design_phase_margin() == pytest.approx(pm, abs=1e-6)
+
+
+@pytest.mark.slow
+def test_guide_numbers_json_against_a_fresh_run():
+    """docs/guide_numbers.json (the web-line page's loops and modes, control.md's MPC)
+    against a fresh run of benchmarks/guide_numbers.py (a few minutes): every number within
+    1e-3 relative, the timings and the load not compared."""
+    rn, gn = _load("readme_numbers"), _load("guide_numbers")
+    old = json.loads((ROOT / "docs" / "guide_numbers.json").read_text("utf-8"))
+    assert rn.differences(old, json.loads(json.dumps(gn.guide_numbers()))) == []
+
+
+def test_a_dated_record_names_its_date_and_commit_and_is_left_out():
+    """docs/speed.md is a dated record (its numbers of 2026-11-23, before the C
+    integrators): marked with its date and commit, left out of ``--unmarked``."""
+    text = (ROOT / "docs" / "speed.md").read_text("utf-8")
+    m = dn.DATED.search(text)
+    assert m is not None and (m["date"], m["commit"]) == ("2026-11-23", "c83a5c7")
+    assert m["date"] in text.split("-->", 2)[1] and m["commit"] in text
+    assert dn.DATED.search("<!-- dated record: 2026-11-23 -->") is None  # no commit

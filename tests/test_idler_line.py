@@ -370,13 +370,24 @@ def _dancer_controlled(offset: float, bandwidth: float) -> dict[str, Any]:
     return data
 
 
+def dancer_decay(d0: float = 0.02, bandwidth: float = 5.0) -> tuple[winder.Result, float]:
+    """The run of the dancer-controlled line from ``d0`` [m] out (8 s) and the error's
+    decay rate [1/s]: the slope of ``log|d| − 2 log t`` over 2–5 s (the design's three
+    poles at ``−ω_c`` give ``|d| t⁻² ∝ exp(−ω_c t)``). Also the source of
+    docs/guide/idlers-dancers-spans.md's rate (benchmarks/guide_numbers.py)."""
+    r = _run(_dancer_controlled(d0, bandwidth), 8.0)
+    d = r["dancer_position"]
+    k = (r.t > 2.0) & (r.t < 5.0)
+    return r, float(np.polyfit(r.t[k], np.log(np.abs(d[k])) - 2.0 * np.log(r.t[k]), 1)[0])
+
+
 def test_dancer_control_holds_the_dancer_at_its_centre() -> None:
     """Started 20 mm out, the unwind brings the carriage to ``d = 0`` (integral action)
     where it balances its load: both spans at ``F_load / 2``; the error decays at about
     the design's ``ω_c`` (three poles at ``−ω_c`` of the double-integrator model: ``|d|
     t⁻² ∝ exp(−ω_c t)``)."""
     wc, d0 = 5.0, 0.02
-    r = _run(_dancer_controlled(d0, wc), 8.0)
+    r, rate = dancer_decay(d0, wc)
     d = r["dancer_position"]
     np.testing.assert_array_equal(d, r["dancer_error"])
     assert d[0] == d0
@@ -385,8 +396,6 @@ def test_dancer_control_holds_the_dancer_at_its_centre() -> None:
     balance = (2 * T_SET + K_D * d0) / 2
     for name in ("span0_tension", "span1_tension"):  # measured 4.5e-9
         assert r[name][-1] == pytest.approx(balance, rel=5e-8)
-    k = (r.t > 2.0) & (r.t < 5.0)
-    rate = np.polyfit(r.t[k], np.log(np.abs(d[k])) - 2.0 * np.log(r.t[k]), 1)[0]
     # measured −4.67: the model leaves out the carriage's spring and the spans' strain
     assert rate == pytest.approx(-wc, rel=0.15)
 

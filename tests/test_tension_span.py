@@ -56,10 +56,14 @@ def _guided(radius: float, drive: dict[str, Any]) -> winder.Scene:
     return winder.scene_from_dict(d, source=str(MODEL))
 
 
-def _loop(radius: float, web_speed: float) -> dict[str, Any]:
-    """The span-1 loop at the parent's ``radius``: the closed loop's poles from the
-    linearised machine, and the open-loop plant (parent on a torque input) closed by the
-    documented rule (poles, and the loop broken at the torque: its margins)."""
+def span_loop(radius: float, web_speed: float | None) -> dict[str, Any]:
+    """The span-1 loop at the parent's ``radius`` [m] and ``web_speed`` [m/s] (None: the
+    scene's): the closed loop's poles from the linearised machine, and the open-loop plant
+    (parent on a torque input) closed by the documented rule (poles, and the loop broken
+    at the torque: its phase margin [°] at its crossover [rad/s], its gain margin [-] at
+    its phase crossover [rad/s], inf and nan where the phase never reaches −180°). Also
+    the source of docs/guide/idlers-dancers-spans.md's table
+    (benchmarks/guide_numbers.py)."""
     closed = winder.linearise(
         _guided(radius, {"kind": "tension_control", "tension": 1000.0, "bandwidth": WC,
                          "span": 1}), 0.3, inputs=["parent_tension_setpoint"],
@@ -87,9 +91,9 @@ def _loop(radius: float, web_speed: float) -> dict[str, Any]:
     cross = np.nonzero(np.diff(np.sign(mag - 1.0)))[0]  # |L| = 1
     pm = min(180.0 - np.abs(np.degrees(np.angle(loop[cross]))))  # the angle to −1
     turn = np.nonzero((np.diff(np.sign(loop.imag)) != 0) & (loop.real[:-1] < 0.0))[0]  # 180°
-    gm = min((1.0 / mag[i] for i in turn), default=math.inf)
+    gm, w_gm = min(((1.0 / mag[i], w[i]) for i in turn), default=(math.inf, math.nan))
     return {"closed": np.linalg.eigvals(np.asarray(closed.A)),
-            "rule": np.linalg.eigvals(Acl), "pm": pm, "gm": gm,
+            "rule": np.linalg.eigvals(Acl), "pm": pm, "gm": gm, "w_gm": w_gm,
             "crossover": w[cross[-1]], "J": J}
 
 
@@ -98,7 +102,7 @@ def _loop(radius: float, web_speed: float) -> dict[str, Any]:
                 ids=["full-5", "empty-5", "full", "empty"])
 def loop(request) -> dict[str, Any]:
     radius, speed = request.param
-    return {"radius": radius, **_loop(radius, speed)}
+    return {"radius": radius, **span_loop(radius, speed)}
 
 
 def test_the_machine_closes_the_loop_the_rule_designs(loop) -> None:
@@ -139,31 +143,43 @@ def _small(tension: float, span: int = 1) -> dict[str, Any]:
 DRAG = (0.01 * V / 0.1 + 0.5 * math.tanh(V / 0.1 / 0.1)) / 0.1
 
 
-def test_set_point_step_settles_as_designed() -> None:
-    """A 10 N set-point step on span 1 behind an idler (two runs from one state): the
-    response follows the design's closed loop and settles (2 %) when it does; span 1 sits
-    at its set-point, span 0 below it by the idler's drag over its radius."""
+def span_step(step: float = 10.0, t_end: float = 2.0) -> dict[str, Any]:
+    """A set-point step of ``step`` [N] on span 1 behind an idler (two runs from one
+    state, over ``t_end`` [s]): ``base`` the run without it, ``y`` the response per
+    newton of step, ``ref`` the design's closed loop
+    ``((3ω_c² − 3ω_c b + b²) s + ω_c³) / (s + ω_c)³``, ``settled`` and ``settled_ref``
+    the times [s] after which each stays within 2 % of the step (also the source of
+    docs/guide/idlers-dancers-spans.md's settling time, benchmarks/guide_numbers.py)."""
     import control
 
-    step, t_end = 10.0, 2.0
     runs = [winder.simulate(winder.scene_from_dict(_small(T_SET + DRAG + dt), source="<l>"),
                             t_end=t_end, output_step=0.01) for dt in (0.0, step)]
     base = runs[0]
-    # measured 1.5e-3 N from the set-point at 2 s (its integral still settling)
-    assert base["span1_tension"][-1] == pytest.approx(T_SET + DRAG, abs=1e-2)
-    assert base["span0_tension"][-1] == pytest.approx(T_SET, abs=1e-2)
     y = (runs[1]["span1_tension"] - base["span1_tension"]) / step
     b = V / (2 * L)  # the zone's transport: both spans strain together
     design = control.tf([3 * WC**2 - 3 * WC * b + b**2, WC**3], np.poly([-WC] * 3))
     _, ref = control.step_response(design, T=base.t)
-    # measured 0.0196 of the step (the roller, the roll's speed, the transport's detail)
-    assert np.max(np.abs(y - ref)) < 0.03
 
     def settled(s: np.ndarray) -> float:
         return float(base.t[np.nonzero(np.abs(s - 1.0) > 0.02)[0][-1] + 1])
 
+    return {"base": base, "y": y, "ref": ref, "settled": settled(y),
+            "settled_ref": settled(ref)}
+
+
+def test_set_point_step_settles_as_designed() -> None:
+    """A 10 N set-point step on span 1 behind an idler (two runs from one state): the
+    response follows the design's closed loop and settles (2 %) when it does; span 1 sits
+    at its set-point, span 0 below it by the idler's drag over its radius."""
+    s = span_step()
+    base = s["base"]
+    # measured 1.5e-3 N from the set-point at 2 s (its integral still settling)
+    assert base["span1_tension"][-1] == pytest.approx(T_SET + DRAG, abs=1e-2)
+    assert base["span0_tension"][-1] == pytest.approx(T_SET, abs=1e-2)
+    # measured 0.0196 of the step (the roller, the roll's speed, the transport's detail)
+    assert np.max(np.abs(s["y"] - s["ref"])) < 0.03
     # measured 0.75 s both
-    assert settled(y) == pytest.approx(settled(ref), abs=0.03)
+    assert s["settled"] == pytest.approx(s["settled_ref"], abs=0.03)
 
 
 REFUSALS = [
