@@ -11,7 +11,13 @@ Beside the wall time: the CPU seconds of the compiler processes (``RUSAGE_CHILDR
 of the Python process itself. ``--src DIR``: the children import winder from ``DIR`` (an
 older tree, for before/after).
 
-Run:  python benchmarks/build_speed.py [--pairs 3] [--src DIR] [--label TEXT] [--no-docs]
+``--before DIR``: an older tree built in the same rounds (before, then this tree, each
+round), so that both rows share the machine's load. With the Jacobian built on first use
+(issue #33) ``generate`` builds what an explicit run needs; the Jacobian's build is timed
+after it (``jac_wall``, ``jac_cpu``: compiler and Python CPU).
+
+Run:  python benchmarks/build_speed.py [--pairs 3] [--src DIR] [--label TEXT]
+      [--before DIR --before-label TEXT] [--no-docs]
 """
 
 from __future__ import annotations
@@ -51,9 +57,18 @@ def child(scene_path: str) -> dict[str, Any]:
     c1, s1 = resource.getrusage(resource.RUSAGE_CHILDREN), resource.getrusage(
         resource.RUSAGE_SELF)
     assert not g.from_cache
-    return {"wall": wall, "states": machine.n_states,
-            "compiler_cpu": c1.ru_utime + c1.ru_stime - c0.ru_utime - c0.ru_stime,
-            "python_cpu": s1.ru_utime + s1.ru_stime - s0.ru_utime - s0.ru_stime}
+    out = {"wall": wall, "states": machine.n_states,
+           "compiler_cpu": c1.ru_utime + c1.ru_stime - c0.ru_utime - c0.ru_stime,
+           "python_cpu": s1.ru_utime + s1.ru_stime - s0.ru_utime - s0.ru_stime}
+    if hasattr(g, "jacobian"):  # built on first use (issue #33): timed apart
+        t0 = time.perf_counter()
+        g.jacobian()
+        c2 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        s2 = resource.getrusage(resource.RUSAGE_SELF)
+        out.update(jac_wall=time.perf_counter() - t0,
+                   jac_cpu=c2.ru_utime + c2.ru_stime - c1.ru_utime - c1.ru_stime
+                   + s2.ru_utime + s2.ru_stime - s1.ru_utime - s1.ru_stime)
+    return out
 
 
 def run_child(scene: Path, src: Path) -> dict[str, Any]:
@@ -64,7 +79,7 @@ def run_child(scene: Path, src: Path) -> dict[str, Any]:
     if proc.returncode != 0:
         raise RuntimeError(proc.stderr[-2000:])
     out = json.loads(proc.stdout.strip().splitlines()[-1])
-    kb = [ln for ln in proc.stderr.splitlines() if "kB of C" in ln]
+    kb = [ln for ln in proc.stderr.splitlines() if "kB of C" in ln and "Jacobian built" not in ln]
     out["kB_of_C"] = float(kb[-1].split("(")[-1].split()[0]) if kb else float("nan")
     return out
 
@@ -75,21 +90,31 @@ def main() -> None:
     ap.add_argument("--src", type=Path, default=ROOT / "src", help="winder's source tree")
     ap.add_argument("--label", default="this tree", help="the row's label in the docs")
     ap.add_argument("--no-docs", action="store_true", help="print only")
+    ap.add_argument("--before", type=Path, default=None,
+                    help="an older tree's src/, built in the same rounds (side by side)")
+    ap.add_argument("--before-label", default="before", help="its row's label")
     args = ap.parse_args()
     load = os.getloadavg()
-    pairs = []
-    for _ in range(args.pairs):
-        pair = {label: run_child(path, args.src) for label, path in SCENES}
-        pair["ratio"] = pair["flexible"]["wall"] / pair["rigid"]["wall"]
-        pairs.append(pair)
-        print(json.dumps(pair), file=sys.stderr, flush=True)
-    med = sorted(pairs, key=lambda q: q["ratio"])[len(pairs) // 2]
-    row = {"label": args.label, "pairs": pairs, "median_pair": med,
-           "ratio_median": statistics.median(q["ratio"] for q in pairs),
-           "load_before": load, "load_after": os.getloadavg()}
-    print(json.dumps(row))
-    if not args.no_docs:
-        write_docs(row)
+    trees = [(args.label, args.src)]
+    if args.before is not None:
+        trees.insert(0, (args.before_label, args.before))
+    pairs: dict[str, list[dict[str, Any]]] = {label: [] for label, _ in trees}
+    for _ in range(args.pairs):  # each round: every tree's rigid and flexible in turn
+        for label, src in trees:
+            pair = {kind: run_child(path, src) for kind, path in SCENES}
+            pair["ratio"] = pair["flexible"]["wall"] / pair["rigid"]["wall"]
+            pairs[label].append(pair)
+            print(label, json.dumps(pair), file=sys.stderr, flush=True)
+    after = os.getloadavg()
+    for label, _ in trees:
+        ps = pairs[label]
+        med = sorted(ps, key=lambda q: q["ratio"])[len(ps) // 2]
+        row = {"label": label, "pairs": ps, "median_pair": med,
+               "ratio_median": statistics.median(q["ratio"] for q in ps),
+               "load_before": load, "load_after": after}
+        print(json.dumps(row))
+        if not args.no_docs:
+            write_docs(row)
 
 
 #: Where the flexible winder's build spends its time: measured once by hand (2026-11-27, gcc

@@ -226,9 +226,12 @@ class Generated:
     build_seconds: float = 0.0
     from_cache: bool = False
     route: str = "py"
+    #: CasADi instructions of each function (file) built in this process (empty when
+    #: loaded from the cache): ``rhs``, ``out``, ``sw``, and ``jac`` (``jac1``) once built
+    sizes: dict[str, int] = field(default_factory=dict)
     _lib: Any = field(default=None, repr=False)
     _jac_lib: Any = field(default=None, repr=False)
-    _make_jac: Callable[[], Path] | None = field(default=None, repr=False)
+    _make_jac: Callable[[dict[str, int]], Path] | None = field(default=None, repr=False)
 
     def jacobian(self) -> int:
         """The address of the Jacobian's flat entry point ``SYMBOL_jac_flat`` (dense,
@@ -239,7 +242,7 @@ class Generated:
         if self._jac_lib is None:
             if self._make_jac is None:
                 raise RuntimeError("this machine's Jacobian cannot be built (no builder)")
-            self._jac_lib = ctypes.CDLL(str(self._make_jac()))
+            self._jac_lib = ctypes.CDLL(str(self._make_jac(self.sizes)))
             self._make_jac = None  # frees the symbols it kept
         address = ctypes.cast(getattr(self._jac_lib, f"{self.symbol}_jac_flat"),
                               ctypes.c_void_p).value
@@ -549,6 +552,7 @@ def generate(machine: Machine, *, directory: Path | None = None,
     t0 = time.perf_counter()
     from_cache = lib.exists()
     kept: list[_Symbols] = []  # the symbols of this build, for the Jacobian
+    sizes: dict[str, int] = {}
     if not from_cache:
         root.mkdir(parents=True, exist_ok=True)
         compiled = not obj.exists()
@@ -557,14 +561,16 @@ def generate(machine: Machine, *, directory: Path | None = None,
                 _say(f"winder: building {name}'s code once ({machine.n_states} states, "
                      f"{machine.model.nbodies - 1} bodies; cached in {root})")
                 kept.append(_Symbols(machine, route))
-                srcs = _compile_sources(machine, symbol, Path(tmp), route, MAIN, kept[0])
+                srcs = _compile_sources(machine, symbol, Path(tmp), route, MAIN, kept[0],
+                                        sizes)
                 tmp_obj = Path(tmp) / obj.name  # one relocatable object of the three
                 run_compiler(["-r", "-nostdlib", *(str(s.with_suffix(".o")) for s in srcs),
                               "-o", str(tmp_obj)], "the generated model (-r)")
                 os.replace(tmp_obj, obj)
                 size = sum(s.stat().st_size for s in srcs)
                 _say(f"winder: {name}'s code built in {time.perf_counter() - t0:.1f} s "
-                     f"({size / 1024:.0f} kB of C; its Jacobian is built on first use)")
+                     f"({size / 1024:.0f} kB of C, {sum(sizes.values()):,} CasADi "
+                     "instructions; its Jacobian is built on first use)")
             tmp_lib = Path(tmp) / lib.name
             extra = [str(o) for o in link.objects] if link is not None else []
             run_compiler([*link_flags(), str(obj), *extra, "-o", str(tmp_lib), "-lm"],
@@ -578,26 +584,28 @@ def generate(machine: Machine, *, directory: Path | None = None,
                       ctypes.cast(getattr(handle, f"{symbol}_{k}_flat"), ctypes.c_void_p).value
                       for k in FUNCTIONS], dtype=np.int64)
 
-    def make_jac() -> Path:
+    def make_jac(into: dict[str, int]) -> Path:
         return _jacobian_library(machine, symbol, root, route, name,
-                                 kept[0] if kept else None)
+                                 kept[0] if kept else None, into)
 
     gen = Generated(key, lib, machine.n_states, len(machine.param_names),
                     len(machine.mode_names), len(machine.switch_names),
                     len(machine.channel_names), addrs, time.perf_counter() - t0, from_cache,
-                    route, handle, None, make_jac)
+                    route, sizes, handle, None, make_jac)
     if (root / f"{symbol}_jac.so").exists():  # built before: load it now (cheap)
         gen.jacobian()
     return gen
 
 
 def _compile_sources(machine: Machine, symbol: str, tmp: Path, route: str,
-                     which: tuple[str, ...], symbols: _Symbols | None) -> list[Path]:
+                     which: tuple[str, ...], symbols: _Symbols | None,
+                     sizes: dict[str, int]) -> list[Path]:
     """Write the C of the functions ``which`` into ``tmp`` and compile each into an object
     beside it (one compiler process each, started as soon as its file is written); the
-    sources' paths."""
+    sources' paths. ``sizes``: each file's CasADi instructions, by its function's name."""
     with _Compiles() as jobs:  # each function compiles while the next is made
         def ready(kind: str, src: Path, size: int) -> None:
+            sizes[src.stem.rsplit("_", 1)[1]] = size
             jobs.start([*function_flags(kind, size), "-c", str(src), "-o",
                         str(src.with_suffix(".o"))], "the generated model")
 
@@ -608,7 +616,7 @@ def _compile_sources(machine: Machine, symbol: str, tmp: Path, route: str,
 
 
 def _jacobian_library(machine: Machine, symbol: str, root: Path, route: str, name: str,
-                      symbols: _Symbols | None) -> Path:
+                      symbols: _Symbols | None, sizes: dict[str, int]) -> Path:
     """The Jacobian's library ``SYMBOL_jac.so`` in ``root``: from the cache, or generated
     (from ``symbols`` if kept, else the machine made on symbols again) and compiled (a
     line on stderr before and after); written atomically."""
@@ -621,13 +629,14 @@ def _jacobian_library(machine: Machine, symbol: str, root: Path, route: str, nam
     _say(f"winder: building {name}'s Jacobian once, on first use ({machine.n_states} "
          f"states{nnz}; cached in {root})")
     with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
-        srcs = _compile_sources(machine, symbol, Path(tmp), route, JACOBIAN, symbols)
+        srcs = _compile_sources(machine, symbol, Path(tmp), route, JACOBIAN, symbols, sizes)
         tmp_lib = Path(tmp) / lib.name
         run_compiler([*link_flags(), *(str(s.with_suffix(".o")) for s in srcs), "-o",
                       str(tmp_lib), "-lm"], "the machine's Jacobian")
         os.replace(tmp_lib, lib)
         size = sum(s.stat().st_size for s in srcs)
     stats["jacobians"] += 1
+    made = sum(v for k, v in sizes.items() if k.startswith("jac"))
     _say(f"winder: {name}'s Jacobian built in {time.perf_counter() - t0:.1f} s "
-         f"({size / 1024:.0f} kB of C)")
+         f"({size / 1024:.0f} kB of C, {made:,} CasADi instructions)")
     return lib
