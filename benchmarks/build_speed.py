@@ -157,30 +157,42 @@ dense Jacobian's 40,000 written zeros each behind a null check were most of the 
 
 What the build does now (`winder.model.codegen`): one C file per function, each handed to
 its own compiler process as soon as it is written (the rhs first: it compiles while the
-Jacobian is generated), the four objects joined into one relocatable object (`-r`, the
-cache keeps one `.o` per machine); no null checks (the functions are only called through
-their flat entry points, which pass every argument); the Jacobian on its nonzeros, moved
-to their dense column-major places by its flat entry point (every caller keeps the dense
-interface: the C integrators, `MachineSystem.jac`, the FMU's directional derivatives);
-optimisation by function: rhs and switching functions -O3, Jacobian -Og, channels -Og and
--O0 over 5,000 instructions (`OPTIMISE`, `LARGE`); a Jacobian of 2,000 nonzeros or more in
-two column blocks of about half the nonzeros each, two files compiled at once
-(`JAC_SPLIT`; the flexible winder's: 34,550 + 29,015 instructions, 1.08 times the one
-function's 58,825). Every result is bitwise the same as
-before (rhs, Jacobian, channels and switching functions of four shipped scenes at four
-states each). Run-time cost through the library, old and new libraries measured in turn
-(thread CPU, best of 30, two rounds each, the Jacobian in two blocks): two-drum rhs
-0.251/0.131 → 0.136/0.127 µs, Jacobian 1.20/0.70 → 0.83/0.82 µs; flexible rhs 3.47/2.44 →
-3.16/2.53 µs, Jacobian 51.5/35.2 → 51.0/36.2 µs (the rounds differ by the machine's load:
-compare within a round). At -O0 the flexible Jacobian compiled in 3.9 s rather than 7.8 s but ran in
-88 µs (13 against 5 µs at N = 8): not taken.
+Jacobian is generated), the objects joined into one relocatable object (`-r`, the cache
+keeps one `.o` per machine; the Jacobian now apart, below); no null checks (the functions
+are only called through their flat entry points, which pass every argument); the Jacobian on
+its nonzeros, moved to their dense column-major places by its flat entry point (every caller
+keeps the dense interface: the C integrators, `MachineSystem.jac`, the FMU's directional
+derivatives); optimisation by function: rhs and switching functions -O3, Jacobian -Og,
+channels -Og and -O0 over 5,000 instructions (`OPTIMISE`, `LARGE`); a Jacobian of 2,000
+nonzeros or more in two column blocks of about half the nonzeros each, two files compiled at
+once (`JAC_SPLIT`; the flexible winder's: 34,550 + 29,015 instructions, 1.08 times the one
+function's 58,825). Every result is bitwise the same as before (rhs, Jacobian, channels and
+switching functions of four shipped scenes at four states each). Run-time cost through the
+library, old and new libraries measured in turn (thread CPU, best of 30, two rounds each,
+the Jacobian in two blocks): two-drum rhs 0.251/0.131 → 0.136/0.127 µs, Jacobian 1.20/0.70 →
+0.83/0.82 µs; flexible rhs 3.47/2.44 → 3.16/2.53 µs, Jacobian 51.5/35.2 → 51.0/36.2 µs (the
+rounds differ by the machine's load: compare within a round). At -O0 the flexible Jacobian
+compiled in 3.9 s rather than 7.8 s but ran in 88 µs (13 against 5 µs at N = 8): not taken.
 
-What is left: the Jacobian is about 70 % of the flexible build's compiler time and is only
-called by implicit methods, linearisation, modes and the FMU's directional derivatives; built
-on first use (a second library), a machine run with DOPRI5 would not pay it. Split into
-column blocks it compiles on both cores of an idle machine (done; more blocks cost more
-instructions: 1.13 times for 3, 1.21 for 4). The symbolic build (2 s of Python) is the
-floor beyond that.
+The Jacobian on first use (issue #33, the next step): the machine's object and library
+hold the rhs, channels and switching functions, all an explicit run (DOPRI5, RK4, the
+Stepper, channels) needs; the Jacobian is generated and compiled when first asked for
+(ROS2 and the stiff methods, `MachineSystem.jac`, linearisation, modes) into its own
+library beside the first (`SYMBOL_jac.so`, the same key), and loaded with the machine
+whenever it is in the cache. The symbols of the first build are kept for it (else the
+machine is made on symbols again: 0.8 s for the flexible winder). Every result is bitwise
+the same as before (rhs, Jacobian, channels and switching functions of four shipped scenes,
+the flexible winder among them, at three states each: 291,600 values). The flexible
+two-drum winder (now 309 states: rotary inertia, issue #32) then builds, for an explicit
+run, rhs 10,675 instructions (-O3, 2.2 s CPU), channels 8,729 (-O0, 0.4 s), switching
+functions 889 (-O3, 0.2 s) after 0.8 s of symbolic build; its Jacobian (5,652 nonzeros,
+about 7 s CPU) only when used.
+
+What is left: the flexible winder's rhs (and channels) carry the flexible bodies' bending
+as dense N × N products (`flex_speed.md`: the part of the rhs that grows as N²; about half
+of the rhs at N = 8). Applying the condensed stiffness and the tilts' lag through banded
+matrices and a tridiagonal solve (O(N)) would halve the flexible rhs's compile and is the
+step to a ratio of 6 or less; the symbolic build (0.8 s) is the floor beyond that.
 """
 
 
@@ -201,14 +213,20 @@ def write_docs(row: dict[str, Any]) -> None:
              "less.", "",
              "| tree | rigid wall [s] | flexible wall [s] | flexible ÷ rigid (median of pairs) "
              "| rigid compiler CPU [s] | flexible compiler CPU [s] | flexible Python CPU [s] | "
-             "flexible C [kB] | load |", "|---|---|---|---|---|---|---|---|---|"]
+             "flexible ÷ rigid, CPU | flexible C [kB] | flexible Jacobian on first use, CPU "
+             "[s] | load |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         m = r["median_pair"]
         ratios = ", ".join(f"{q['ratio']:.1f}" for q in r["pairs"])
+        cpu = [(q["flexible"]["compiler_cpu"] + q["flexible"]["python_cpu"])
+               / (q["rigid"]["compiler_cpu"] + q["rigid"]["python_cpu"]) for q in r["pairs"]]
+        jac = m["flexible"].get("jac_cpu")
         lines.append(f"| {r['label']} | {m['rigid']['wall']:.1f} | {m['flexible']['wall']:.1f} "
                      f"| **{r['ratio_median']:.1f}** ({ratios}) | "
                      f"{m['rigid']['compiler_cpu']:.1f} | {m['flexible']['compiler_cpu']:.1f} | "
-                     f"{m['flexible']['python_cpu']:.1f} | {m['flexible']['kB_of_C']:.0f} | "
+                     f"{m['flexible']['python_cpu']:.1f} | {statistics.median(cpu):.1f} | "
+                     f"{m['flexible']['kB_of_C']:.0f} | "
+                     f"{'–' if jac is None else format(jac, '.1f')} | "
                      f"{r['load_before'][0]:.1f}–{r['load_after'][0]:.1f} |")
     text = "\n".join(lines) + "\n" + STUDY
     atomic_write(DOCS / "build_speed.md", lambda p: p.write_text(text, encoding="utf-8"))
