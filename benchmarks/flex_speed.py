@@ -317,27 +317,29 @@ def write_docs(rows: list[dict[str, Any]]) -> None:
 
 #: What grows faster than N, and why (measured 2026-11-27 by hand: the CasADi instructions
 #: of the single drum's rhs with the bending forces taken out).
-GROWTH = """## What grows faster than N
+GROWTH = """## What grew faster than N, and the fix
 
-The right-hand side's CasADi instructions (its compile time and run time follow them) at
-N = 8 / 16 / 32: 3,045 / 7,405 / 20,349 (slope 1.37). With the flexible drum's bending
-forces taken out (the tilts' rates kept, no force): 1,578 / 3,002 / 5,850 (slope 0.95,
-linear: the articulated-body algorithm on the chain of segments, the nip's slices, the
-torsion springs, CSE and the symbolic build all grow with N). The bending's own share,
-1,467 / 4,403 / 14,499, grows as N² (slopes 1.6, 1.7 → 2): `FlexBeam._rotary_bending`
-applies the condensed stiffness `K = K_ww + K_wψ T` and the tilts' lag `φ̇ = s − T ẇ` as
-dense N × N products (`T = −K_ψψ⁻¹ K_ψw` is dense; the parameters `K…_i_j`, `T…_i_j`
-are N² run-time inputs), 4 N² multiply–adds per axis. The channels function carries the
-same products (12,622 instructions at N = 32, 5,712 without them). The Jacobian's
-nonzeros grow faster than N for the same reason (the accelerations of a chain depend on
-every segment's deflection through `K` and `T`).
+Measured 2026-11-27 by hand (CasADi instructions, which the compile time and the run time
+follow). Before (afacf70), the rhs at N = 8 / 16 / 32 / 64: 3,045 / 7,405 / 20,349 / 63,133
+(slope 1.46, towards 2). With the flexible drum's bending forces taken out (the tilts'
+rates kept, no force): 1,578 / 3,002 / 5,850 at N = 8 / 16 / 32 (slope 0.95: the
+articulated-body algorithm on the chain of segments, the nip's slices, the torsion
+springs, CSE and the symbolic build all grow with N). The bending's own share, 1,467 /
+4,403 / 14,499, grew as N²: `FlexBeam._rotary_bending` applied the condensed stiffness
+`K = K_ww + K_wψ T` and the tilts' lag `φ̇ = s − T ẇ` as dense N × N products (`T =
+−K_ψψ⁻¹ K_ψw` is dense: N² run-time parameters `K…_i_j`, `T…_i_j`, read in N² Python
+steps too), and the channels function carried the same products.
 
-The fix left (it changes the physics' round-off, so a deliberate re-baseline of the flexible
-references): the same forces in O(N), without forming `K` and `T`: `K w + K_wψ φ = K_ww w +
-K_wψ ψ` with `ψ = φ + T w`, and `T v = −K_ψψ⁻¹ (K_ψw v)` by a tridiagonal solve whose
-factors (numbers of the beam, like `K` today) are run-time parameters: 2 banded products
-and one forward/back substitution per axis and per use instead of N² products. Without
-it the rhs and the build grow with slope about 1.4 from N = 8 to 32 and towards 2 beyond.
+Now (issue #33) neither is formed: `K w + K_wψ φ = K_ww w + K_wψ (φ + T w)` and `T v =
+−K_ψψ⁻¹ (K_ψw v)` with the tridiagonal blocks and the `L D Lᵀ` factors of `K_ψψ` as
+run-time parameters, a forward and a back substitution per use. The rhs: 2,801 / 5,553 /
+11,057 / 22,065 instructions (slope 0.99), the channels 2,302 / 4,465 / 8,786 / 17,426; the
+parameters 325 / 653 / 1,309 / 2,621 (were 465 / 1,313 / 4,161 / 16,705). The rates agree
+with the dense form to 1e-15 relative per state. The Jacobian's structural nonzeros still
+grow faster than N: the accelerations of a chain depend on every segment's deflection (the
+inverse of `K_ψψ` is dense), which is what it is; it is built only on first use. Left: the
+flexible body without rotary inertia (`rotary_inertia = false`) and the paper roll's
+bending still use their dense condensed `K` (the same substitution applies).
 """
 
 
