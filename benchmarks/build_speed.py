@@ -188,11 +188,21 @@ run, rhs 10,675 instructions (-O3, 2.2 s CPU), channels 8,729 (-O0, 0.4 s), swit
 functions 889 (-O3, 0.2 s) after 0.8 s of symbolic build; its Jacobian (5,652 nonzeros,
 about 7 s CPU) only when used.
 
-What is left: the flexible winder's rhs (and channels) carry the flexible bodies' bending
-as dense N × N products (`flex_speed.md`: the part of the rhs that grows as N²; about half
-of the rhs at N = 8). Applying the condensed stiffness and the tilts' lag through banded
-matrices and a tridiagonal solve (O(N)) would halve the flexible rhs's compile and is the
-step to a ratio of 6 or less; the symbolic build (0.8 s) is the floor beyond that.
+The flexible bodies' bending in O(N) (0998891, `flex_speed.md`): at the shipped winder's
+N = 8 it trims the rhs only from 10,675 to 9,943 instructions (the dense products were
+small at N = 8); it is the growth with N that it fixes.
+
+Side by side (the last two rows, load 8–11 on 2 cores): the flexible ÷ rigid wall ratio
+17 → 6.5 (pairs 7.7, 6.0, 6.5), CPU 16 → 8. The wall ratio moves with the load (the
+earlier pair of rows, the same code but the bending, gave 11.2 at load 5–8, its rigid wall
+1.0 against 1.7 s here): the CPU seconds are the steadier measure. What is left, for an
+explicit run of the flexible winder (CPU at load ~10): the rhs at -O3 (9,943 instructions,
+2.2 s at low load, 4.6 s at load 11), the symbolic build (0.8–1.5 s: the articulated-body
+and RNEA passes over 32 bodies, `spatial.py`; the channels' RNEA alone 0.7 s of 2.5 s under
+cProfile) and the channels at -O0 (0.4–0.5 s). The rigid winder's build is 0.6 s of CPU,
+so a CPU ratio of 6 needs the flexible build under 3.6 s: a cheaper symbolic pass (casadi
+`shape` checks are 0.4 s of it) or the rhs at -O2/-O1 above a size (measured 2.4 / 1.7 s
+against 2.7 s at -O3, run time not yet measured) are the next steps.
 """
 
 
