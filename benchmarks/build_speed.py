@@ -201,8 +201,12 @@ explicit run of the flexible winder (CPU at load ~10): the rhs at -O3 (9,943 ins
 and RNEA passes over 32 bodies, `spatial.py`; the channels' RNEA alone 0.7 s of 2.5 s under
 cProfile) and the channels at -O0 (0.4–0.5 s). The rigid winder's build is 0.6 s of CPU,
 so a CPU ratio of 6 needs the flexible build under 3.6 s: a cheaper symbolic pass (casadi
-`shape` checks are 0.4 s of it) or the rhs at -O2/-O1 above a size (measured 2.4 / 1.7 s
-against 2.7 s at -O3, run time not yet measured) are the next steps.
+`shape` checks are 0.4 s of it) or the rhs at -O2 above a size are the next steps. The
+flexible winder's rhs (9,943 instructions) measured in turn, compile CPU and the best of
+15 × 2000 calls in a C loop (thread CPU): -O3 3.59 / 3.98 / 3.26 s, -O2 2.64 / 3.58 /
+2.98 s (8–26 % less), -O1 2.08 s; run 3.35 / 3.43 / 3.19 / 3.21 µs at -O3 against 3.39 /
+3.44 / 3.21 / 3.20 µs at -O2 (the same), -O1 3.49–4.99 µs (slower). Not taken yet: the gain
+is 0.3–0.9 s of about 5 s, within this machine's noise.
 """
 
 
