@@ -38,7 +38,6 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -52,6 +51,8 @@ from typing import Any
 import numpy as np
 
 from winder._errors import WinderError
+from winder.model.c_entry import flat_entry as _flat_entry
+from winder.model.c_entry import unguarded as _unguarded
 from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
@@ -82,6 +83,8 @@ LARGE = 5000
 #: compiled at once (1.08 times the instructions of one for the flexible two-drum winder's
 #: 4800 nonzeros; a machine's Jacobian is most of its build).
 JAC_SPLIT = 2000
+#: A Jacobian's build (on first use) that took longer than this [s] says so again when done.
+SAY_AFTER = 5.0
 #: The layout of the generated code (in the cache key): one C file per function, the
 #: Jacobian on its nonzeros scattered by its flat entry point (beside it its nonzeros' entry
 #: point and CCS pattern) in a library of its own built on first use, CasADi's null checks
@@ -391,71 +394,6 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
     return files, patterns
 
 
-def _unguarded(code: str) -> str:
-    """CasADi's code without its null checks on each argument read (``arg[i]? arg[i][j] :
-    0``) and each result written (``if (res[0]!=0) ...``): the functions are only called
-    through their flat entry points, which pass every argument and the result. One branch
-    per element made the compiler's register allocation superlinear in the function's size
-    (the flexible two-drum winder's Jacobian: 4800 writes, MEASURED)."""
-    code = code.replace("if (res[0]!=0) ", "")
-    return re.sub(r"arg\[(\d+)\]\? (arg\[\1\]\[\d+\]) : 0", r"\2", code)
-
-
-def _flat_entry(symbol: str, k: str, f: Any, blocks: list[tuple[str, Any, int]] | None,
-                sparsity: Any) -> str:
-    """The flat, reentrant entry point ``SYMBOL_K_flat(t, x, p, m, out)`` of one generated
-    function. The Jacobian's (``blocks``: each column block's function name, function and
-    offset of its first nonzero; ``sparsity``: the CCS pattern): each block writes its
-    nonzeros to the front of ``out`` at its offset, the rest is set to 0 (one ``memset``)
-    and each nonzero moved to its dense column-major place, last first (the place of the
-    k-th nonzero is never before k, so none is overwritten before it moves)."""
-    head = (f"\n/* flat, reentrant entry point */\n"
-            f"int {symbol}_{k}_flat(const double* t, const double* x, const double* p, "
-            f"const double* m, double* out) {{\n")
-    if blocks is None:
-        return (head + f"  const casadi_real* arg[{max(f.sz_arg(), 4)}] = {{t, x, p, m}};\n"
-                f"  casadi_real* res[{max(f.sz_res(), 1)}] = {{out}};\n"
-                f"  casadi_int iw[{f.sz_iw() + 1}];\n  casadi_real w[{f.sz_w() + 1}];\n"
-                f"  return {symbol}_{k}(arg, res, iw, w, 0);\n}}\n")
-    n, nnz = sparsity.size1(), sparsity.nnz()
-    rows, cols = sparsity.get_triplet()
-    place = [int(r) + n * int(c) for r, c in zip(rows, cols, strict=True)]
-    ccs = [n, n, *map(int, sparsity.colind()), *map(int, sparsity.row())]
-
-    def table(values: list[int]) -> str:
-        lines = [", ".join(str(v) for v in values[i:i + 16]) for i in range(0, len(values), 16)]
-        return ",\n  ".join(lines or ["0"])
-
-    decls = "".join(f"int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, "
-                    "casadi_real* w, int mem);\n" for name, _, _ in blocks[1:])
-    calls = "".join(f"  res[0] = out + {off};\n  flag |= {name}(arg, res, iw, w, 0);\n"
-                    for name, _, off in blocks)
-    fs = [g for _, g, _ in blocks]
-    sig = "(const double* t, const double* x, const double* p, const double* m, double* out)"
-    return ("#include <string.h>\n" + decls
-            + f"static const casadi_int {symbol}_jac_place[{max(nnz, 1)}] = {{\n  "
-            + table(place) + "};\n"
-            + f"static const casadi_int {symbol}_jac_ccs[{len(ccs)}] = {{\n  " + table(ccs)
-            + "};\n\n/* the Jacobian's structural sparsity in CasADi's compressed column "
-            "format:\n * {rows, columns, colind[columns + 1], row[nonzeros]} */\n"
-            f"const casadi_int* {symbol}_jac_sparsity(void) {{\n"
-            f"  return {symbol}_jac_ccs;\n}}\n"
-            "\n/* the Jacobian's nonzeros only, in the order of its sparsity (CCS) */\n"
-            f"int {symbol}_jac_nz_flat{sig} {{\n"
-            f"  const casadi_real* arg[{max(4, *(g.sz_arg() for g in fs))}] = {{t, x, p, m}};\n"
-            f"  casadi_real* res[{max(1, *(g.sz_res() for g in fs))}];\n"
-            f"  casadi_int iw[{max(g.sz_iw() for g in fs) + 1}];\n"
-            f"  casadi_real w[{max(g.sz_w() for g in fs) + 1}];\n"
-            f"  int flag = 0;\n" + calls + "  return flag;\n}\n" + head
-            + f"  int flag = {symbol}_jac_nz_flat(t, x, p, m, out);\n  casadi_int k;\n"
-            f"  memset(out + {nnz}, 0, sizeof(double) * {n * n - nnz});\n"
-            f"  for (k = {nnz} - 1; k >= 0; k--) {{\n"
-            f"    double v = out[k];\n"
-            f"    out[k] = 0.;\n"
-            f"    out[{symbol}_jac_place[k]] = v;\n  }}\n"
-            f"  return flag;\n}}\n")
-
-
 def _say(line: str) -> None:
     """One line on stderr about a build (a build is never silent: it can take a minute)."""
     print(line, file=sys.stderr, flush=True)
@@ -619,15 +557,16 @@ def _jacobian_library(machine: Machine, symbol: str, root: Path, route: str, nam
                       symbols: _Symbols | None, sizes: dict[str, int]) -> Path:
     """The Jacobian's library ``SYMBOL_jac.so`` in ``root``: from the cache, or generated
     (from ``symbols`` if kept, else the machine made on symbols again) and compiled (a
-    line on stderr before and after); written atomically."""
+    line on stderr before, with its size, and one after if it took longer than
+    :data:`SAY_AFTER`); written atomically."""
     lib = root / f"{symbol}_jac.so"
     if lib.exists():
         return lib
     t0 = time.perf_counter()
     root.mkdir(parents=True, exist_ok=True)
-    nnz = "" if symbols is None else f", {symbols.jac.nnz()} nonzeros"
+    symbols = _Symbols(machine, route) if symbols is None else symbols
     _say(f"winder: building {name}'s Jacobian once, on first use ({machine.n_states} "
-         f"states{nnz}; cached in {root})")
+         f"states, {symbols.jac.nnz()} nonzeros; cached in {root})")
     with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
         srcs = _compile_sources(machine, symbol, Path(tmp), route, JACOBIAN, symbols, sizes)
         tmp_lib = Path(tmp) / lib.name
@@ -637,6 +576,7 @@ def _jacobian_library(machine: Machine, symbol: str, root: Path, route: str, nam
         size = sum(s.stat().st_size for s in srcs)
     stats["jacobians"] += 1
     made = sum(v for k, v in sizes.items() if k.startswith("jac"))
-    _say(f"winder: {name}'s Jacobian built in {time.perf_counter() - t0:.1f} s "
-         f"({size / 1024:.0f} kB of C, {made:,} CasADi instructions)")
+    if time.perf_counter() - t0 > SAY_AFTER:  # a short one said once (before it)
+        _say(f"winder: {name}'s Jacobian built in {time.perf_counter() - t0:.1f} s "
+             f"({size / 1024:.0f} kB of C, {made:,} CasADi instructions)")
     return lib
