@@ -192,10 +192,11 @@ The flexible bodies' bending in O(N) (0998891, `flex_speed.md`): at the shipped 
 N = 8 it trims the rhs only from 10,675 to 9,943 instructions (the dense products were
 small at N = 8); it is the growth with N that it fixes.
 
-Side by side (the last two rows, load 8–11 on 2 cores): the flexible ÷ rigid wall ratio
-17 → 6.5 (pairs 7.7, 6.0, 6.5), CPU 16 → 8. The wall ratio moves with the load (the
-earlier pair of rows, the same code but the bending, gave 11.2 at load 5–8, its rigid wall
-1.0 against 1.7 s here): the CPU seconds are the steadier measure. What is left, for an
+Side by side (the last four rows, two runs, load 6–11 on 2 cores): the flexible ÷ rigid
+wall ratio 17 → 6.5 (pairs 7.7, 6.0, 6.5) and 14 → 8.3 (8.7, 6.3, 8.3; its quietest pair:
+flexible 4.1 s, rigid 0.5 s), CPU 16 → 8 and 16 → 7.7. The wall ratio moves with the load
+(the earlier pair of rows, the same code but the bending, gave 11.2 at load 5–8): the CPU
+seconds are the steadier measure; the issue's goal (6) is not reached. What is left, for an
 explicit run of the flexible winder (CPU at load ~10): the rhs at -O3 (9,943 instructions,
 2.2 s at low load, 4.6 s at load 11), the symbolic build (0.8–1.5 s: the articulated-body
 and RNEA passes over 32 bodies, `spatial.py`; the channels' RNEA alone 0.7 s of 2.5 s under
