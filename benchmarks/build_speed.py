@@ -11,7 +11,13 @@ Beside the wall time: the CPU seconds of the compiler processes (``RUSAGE_CHILDR
 of the Python process itself. ``--src DIR``: the children import winder from ``DIR`` (an
 older tree, for before/after).
 
-Run:  python benchmarks/build_speed.py [--pairs 3] [--src DIR] [--label TEXT] [--no-docs]
+``--before DIR``: an older tree built in the same rounds (before, then this tree, each
+round), so that both rows share the machine's load. With the Jacobian built on first use
+(issue #33) ``generate`` builds what an explicit run needs; the Jacobian's build is timed
+after it (``jac_wall``, ``jac_cpu``: compiler and Python CPU).
+
+Run:  python benchmarks/build_speed.py [--pairs 3] [--src DIR] [--label TEXT]
+      [--before DIR --before-label TEXT] [--no-docs]
 """
 
 from __future__ import annotations
@@ -51,9 +57,18 @@ def child(scene_path: str) -> dict[str, Any]:
     c1, s1 = resource.getrusage(resource.RUSAGE_CHILDREN), resource.getrusage(
         resource.RUSAGE_SELF)
     assert not g.from_cache
-    return {"wall": wall, "states": machine.n_states,
-            "compiler_cpu": c1.ru_utime + c1.ru_stime - c0.ru_utime - c0.ru_stime,
-            "python_cpu": s1.ru_utime + s1.ru_stime - s0.ru_utime - s0.ru_stime}
+    out = {"wall": wall, "states": machine.n_states,
+           "compiler_cpu": c1.ru_utime + c1.ru_stime - c0.ru_utime - c0.ru_stime,
+           "python_cpu": s1.ru_utime + s1.ru_stime - s0.ru_utime - s0.ru_stime}
+    if hasattr(g, "jacobian"):  # built on first use (issue #33): timed apart
+        t0 = time.perf_counter()
+        g.jacobian()
+        c2 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        s2 = resource.getrusage(resource.RUSAGE_SELF)
+        out.update(jac_wall=time.perf_counter() - t0,
+                   jac_cpu=c2.ru_utime + c2.ru_stime - c1.ru_utime - c1.ru_stime
+                   + s2.ru_utime + s2.ru_stime - s1.ru_utime - s1.ru_stime)
+    return out
 
 
 def run_child(scene: Path, src: Path) -> dict[str, Any]:
@@ -64,7 +79,7 @@ def run_child(scene: Path, src: Path) -> dict[str, Any]:
     if proc.returncode != 0:
         raise RuntimeError(proc.stderr[-2000:])
     out = json.loads(proc.stdout.strip().splitlines()[-1])
-    kb = [ln for ln in proc.stderr.splitlines() if "kB of C" in ln]
+    kb = [ln for ln in proc.stderr.splitlines() if "kB of C" in ln and "Jacobian built" not in ln]
     out["kB_of_C"] = float(kb[-1].split("(")[-1].split()[0]) if kb else float("nan")
     return out
 
@@ -75,21 +90,31 @@ def main() -> None:
     ap.add_argument("--src", type=Path, default=ROOT / "src", help="winder's source tree")
     ap.add_argument("--label", default="this tree", help="the row's label in the docs")
     ap.add_argument("--no-docs", action="store_true", help="print only")
+    ap.add_argument("--before", type=Path, default=None,
+                    help="an older tree's src/, built in the same rounds (side by side)")
+    ap.add_argument("--before-label", default="before", help="its row's label")
     args = ap.parse_args()
     load = os.getloadavg()
-    pairs = []
-    for _ in range(args.pairs):
-        pair = {label: run_child(path, args.src) for label, path in SCENES}
-        pair["ratio"] = pair["flexible"]["wall"] / pair["rigid"]["wall"]
-        pairs.append(pair)
-        print(json.dumps(pair), file=sys.stderr, flush=True)
-    med = sorted(pairs, key=lambda q: q["ratio"])[len(pairs) // 2]
-    row = {"label": args.label, "pairs": pairs, "median_pair": med,
-           "ratio_median": statistics.median(q["ratio"] for q in pairs),
-           "load_before": load, "load_after": os.getloadavg()}
-    print(json.dumps(row))
-    if not args.no_docs:
-        write_docs(row)
+    trees = [(args.label, args.src)]
+    if args.before is not None:
+        trees.insert(0, (args.before_label, args.before))
+    pairs: dict[str, list[dict[str, Any]]] = {label: [] for label, _ in trees}
+    for _ in range(args.pairs):  # each round: every tree's rigid and flexible in turn
+        for label, src in trees:
+            pair = {kind: run_child(path, src) for kind, path in SCENES}
+            pair["ratio"] = pair["flexible"]["wall"] / pair["rigid"]["wall"]
+            pairs[label].append(pair)
+            print(label, json.dumps(pair), file=sys.stderr, flush=True)
+    after = os.getloadavg()
+    for label, _ in trees:
+        ps = pairs[label]
+        med = sorted(ps, key=lambda q: q["ratio"])[len(ps) // 2]
+        row = {"label": label, "pairs": ps, "median_pair": med,
+               "ratio_median": statistics.median(q["ratio"] for q in ps),
+               "load_before": load, "load_after": after}
+        print(json.dumps(row))
+        if not args.no_docs:
+            write_docs(row)
 
 
 #: Where the flexible winder's build spends its time: measured once by hand (2026-11-27, gcc
@@ -132,30 +157,57 @@ dense Jacobian's 40,000 written zeros each behind a null check were most of the 
 
 What the build does now (`winder.model.codegen`): one C file per function, each handed to
 its own compiler process as soon as it is written (the rhs first: it compiles while the
-Jacobian is generated), the four objects joined into one relocatable object (`-r`, the
-cache keeps one `.o` per machine); no null checks (the functions are only called through
-their flat entry points, which pass every argument); the Jacobian on its nonzeros, moved
-to their dense column-major places by its flat entry point (every caller keeps the dense
-interface: the C integrators, `MachineSystem.jac`, the FMU's directional derivatives);
-optimisation by function: rhs and switching functions -O3, Jacobian -Og, channels -Og and
--O0 over 5,000 instructions (`OPTIMISE`, `LARGE`); a Jacobian of 2,000 nonzeros or more in
-two column blocks of about half the nonzeros each, two files compiled at once
-(`JAC_SPLIT`; the flexible winder's: 34,550 + 29,015 instructions, 1.08 times the one
-function's 58,825). Every result is bitwise the same as
-before (rhs, Jacobian, channels and switching functions of four shipped scenes at four
-states each). Run-time cost through the library, old and new libraries measured in turn
-(thread CPU, best of 30, two rounds each, the Jacobian in two blocks): two-drum rhs
-0.251/0.131 → 0.136/0.127 µs, Jacobian 1.20/0.70 → 0.83/0.82 µs; flexible rhs 3.47/2.44 →
-3.16/2.53 µs, Jacobian 51.5/35.2 → 51.0/36.2 µs (the rounds differ by the machine's load:
-compare within a round). At -O0 the flexible Jacobian compiled in 3.9 s rather than 7.8 s but ran in
-88 µs (13 against 5 µs at N = 8): not taken.
+Jacobian is generated), the objects joined into one relocatable object (`-r`, the cache
+keeps one `.o` per machine; the Jacobian now apart, below); no null checks (the functions
+are only called through their flat entry points, which pass every argument); the Jacobian on
+its nonzeros, moved to their dense column-major places by its flat entry point (every caller
+keeps the dense interface: the C integrators, `MachineSystem.jac`, the FMU's directional
+derivatives); optimisation by function: rhs and switching functions -O3, Jacobian -Og,
+channels -Og and -O0 over 5,000 instructions (`OPTIMISE`, `LARGE`); a Jacobian of 2,000
+nonzeros or more in two column blocks of about half the nonzeros each, two files compiled at
+once (`JAC_SPLIT`; the flexible winder's: 34,550 + 29,015 instructions, 1.08 times the one
+function's 58,825). Every result is bitwise the same as before (rhs, Jacobian, channels and
+switching functions of four shipped scenes at four states each). Run-time cost through the
+library, old and new libraries measured in turn (thread CPU, best of 30, two rounds each,
+the Jacobian in two blocks): two-drum rhs 0.251/0.131 → 0.136/0.127 µs, Jacobian 1.20/0.70 →
+0.83/0.82 µs; flexible rhs 3.47/2.44 → 3.16/2.53 µs, Jacobian 51.5/35.2 → 51.0/36.2 µs (the
+rounds differ by the machine's load: compare within a round). At -O0 the flexible Jacobian
+compiled in 3.9 s rather than 7.8 s but ran in 88 µs (13 against 5 µs at N = 8): not taken.
 
-What is left: the Jacobian is about 70 % of the flexible build's compiler time and is only
-called by implicit methods, linearisation, modes and the FMU's directional derivatives; built
-on first use (a second library), a machine run with DOPRI5 would not pay it. Split into
-column blocks it compiles on both cores of an idle machine (done; more blocks cost more
-instructions: 1.13 times for 3, 1.21 for 4). The symbolic build (2 s of Python) is the
-floor beyond that.
+The Jacobian on first use (issue #33, the next step): the machine's object and library
+hold the rhs, channels and switching functions, all an explicit run (DOPRI5, RK4, the
+Stepper, channels) needs; the Jacobian is generated and compiled when first asked for
+(ROS2 and the stiff methods, `MachineSystem.jac`, linearisation, modes) into its own
+library beside the first (`SYMBOL_jac.so`, the same key), and loaded with the machine
+whenever it is in the cache. The symbols of the first build are kept for it (else the
+machine is made on symbols again: 0.8 s for the flexible winder). Every result is bitwise
+the same as before (rhs, Jacobian, channels and switching functions of four shipped scenes,
+the flexible winder among them, at three states each: 291,600 values). The flexible
+two-drum winder (now 309 states: rotary inertia, issue #32) then builds, for an explicit
+run, rhs 10,675 instructions (-O3, 2.2 s CPU), channels 8,729 (-O0, 0.4 s), switching
+functions 889 (-O3, 0.2 s) after 0.8 s of symbolic build; its Jacobian (5,652 nonzeros,
+about 7 s CPU) only when used.
+
+The flexible bodies' bending in O(N) (0998891, `flex_speed.md`): at the shipped winder's
+N = 8 it trims the rhs only from 10,675 to 9,943 instructions (the dense products were
+small at N = 8); it is the growth with N that it fixes.
+
+Side by side (the last four rows, two runs, load 6–11 on 2 cores): the flexible ÷ rigid
+wall ratio 17 → 6.5 (pairs 7.7, 6.0, 6.5) and 14 → 8.3 (8.7, 6.3, 8.3; its quietest pair:
+flexible 4.1 s, rigid 0.5 s), CPU 16 → 8 and 16 → 7.7. The wall ratio moves with the load
+(the earlier pair of rows, the same code but the bending, gave 11.2 at load 5–8): the CPU
+seconds are the steadier measure; the issue's goal (6) is not reached. What is left, for an
+explicit run of the flexible winder (CPU at load ~10): the rhs at -O3 (9,943 instructions,
+2.2 s at low load, 4.6 s at load 11), the symbolic build (0.8–1.5 s: the articulated-body
+and RNEA passes over 32 bodies, `spatial.py`; the channels' RNEA alone 0.7 s of 2.5 s under
+cProfile) and the channels at -O0 (0.4–0.5 s). The rigid winder's build is 0.6 s of CPU,
+so a CPU ratio of 6 needs the flexible build under 3.6 s: a cheaper symbolic pass (casadi
+`shape` checks are 0.4 s of it) or the rhs at -O2 above a size are the next steps. The
+flexible winder's rhs (9,943 instructions) measured in turn, compile CPU and the best of
+15 × 2000 calls in a C loop (thread CPU): -O3 3.59 / 3.98 / 3.26 s, -O2 2.64 / 3.58 /
+2.98 s (8–26 % less), -O1 2.08 s; run 3.35 / 3.43 / 3.19 / 3.21 µs at -O3 against 3.39 /
+3.44 / 3.21 / 3.20 µs at -O2 (the same), -O1 3.49–4.99 µs (slower). Not taken yet: the gain
+is 0.3–0.9 s of about 5 s, within this machine's noise.
 """
 
 
@@ -176,14 +228,20 @@ def write_docs(row: dict[str, Any]) -> None:
              "less.", "",
              "| tree | rigid wall [s] | flexible wall [s] | flexible ÷ rigid (median of pairs) "
              "| rigid compiler CPU [s] | flexible compiler CPU [s] | flexible Python CPU [s] | "
-             "flexible C [kB] | load |", "|---|---|---|---|---|---|---|---|---|"]
+             "flexible ÷ rigid, CPU | flexible C [kB] | flexible Jacobian on first use, CPU "
+             "[s] | load |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         m = r["median_pair"]
         ratios = ", ".join(f"{q['ratio']:.1f}" for q in r["pairs"])
+        cpu = [(q["flexible"]["compiler_cpu"] + q["flexible"]["python_cpu"])
+               / (q["rigid"]["compiler_cpu"] + q["rigid"]["python_cpu"]) for q in r["pairs"]]
+        jac = m["flexible"].get("jac_cpu")
         lines.append(f"| {r['label']} | {m['rigid']['wall']:.1f} | {m['flexible']['wall']:.1f} "
                      f"| **{r['ratio_median']:.1f}** ({ratios}) | "
                      f"{m['rigid']['compiler_cpu']:.1f} | {m['flexible']['compiler_cpu']:.1f} | "
-                     f"{m['flexible']['python_cpu']:.1f} | {m['flexible']['kB_of_C']:.0f} | "
+                     f"{m['flexible']['python_cpu']:.1f} | {statistics.median(cpu):.1f} | "
+                     f"{m['flexible']['kB_of_C']:.0f} | "
+                     f"{'–' if jac is None else format(jac, '.1f')} | "
                      f"{r['load_before'][0]:.1f}–{r['load_after'][0]:.1f} |")
     text = "\n".join(lines) + "\n" + STUDY
     atomic_write(DOCS / "build_speed.md", lambda p: p.write_text(text, encoding="utf-8"))

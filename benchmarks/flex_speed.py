@@ -1,17 +1,20 @@
-"""µs per evaluation and compile time of flexible machines (issue #25; writes
-docs/flex_speed.md and .json).
+"""µs per evaluation and build time of flexible machines (issues #25, #33; writes
+docs/flex_speed.md, .json and .png).
 
 The single-drum winder with a flexible drum of N segments (the roll rigid on it, the nip
-sliced): N = 1 is the rigid drum. For each N: the time to generate and compile its code
-into an empty cache, the generated right-hand side and exact Jacobian called the way the
-compiled integrators call them (the C loop of the machine's library), and the numeric
-Pinocchio path (``MachineSystem(scene, backend="pinocchio").rhs``). Best of repeats (the
-machine may be loaded). The build is timed in wall seconds and in CPU seconds (this
-process and the compiler processes: a loaded machine stretches the first, not the second);
-the slopes of log cost against log N between the two largest N (issue #33: at most
-log(4.5)/log(4) = 1.08 from N = 8 to 32).
+sliced): N = 1 is the rigid drum. For each N: the build of its code into an empty cache
+(what an explicit run needs: rhs, channels, switching functions) in wall seconds and in
+CPU seconds of this process (the symbolic build, CSE, the C written) and of the compiler
+processes, with each function's CasADi instructions; the Jacobian built on first use,
+timed apart (up to ``--jac-max`` segments); the generated right-hand side and exact
+Jacobian called the way the compiled integrators call them (the C loop of the machine's
+library, best of repeats in the thread's CPU time); the numeric Pinocchio path
+(``MachineSystem(scene, backend="pinocchio").rhs``, up to N = 32). The slopes of log cost
+against log N: fitted over N >= 8 (least squares) and the issue's two points (issue #33:
+at most log(4.5)/log(4) = 1.08 from N = 8 to 32); a log-log plot of them.
 
-Run:  python benchmarks/flex_speed.py [--quick] [--sizes 1 4 8 16 32] [--no-numeric]
+Run:  python benchmarks/flex_speed.py [--quick] [--sizes 1 4 8 16 32 64] [--no-numeric]
+      [--jac-max 32] [--from-json]
 """
 
 from __future__ import annotations
@@ -111,40 +114,63 @@ def _cpu() -> float:
                                                  resource.getrusage(resource.RUSAGE_CHILDREN)))
 
 
-def measure(n: int, quick: bool, numeric: bool = True) -> dict[str, float]:
+def _cpu_split() -> tuple[float, float]:
+    """CPU seconds of this process and of its finished children (the compilers) [s]."""
+    me, kids = (resource.getrusage(who) for who in (resource.RUSAGE_SELF,
+                                                    resource.RUSAGE_CHILDREN))
+    return me.ru_utime + me.ru_stime, kids.ru_utime + kids.ru_stime
+
+
+def measure(n: int, quick: bool, numeric: bool = True, jac_max: int = 32) -> dict[str, Any]:
     sc = scene(n)
+    nan = float("nan")
+    row: dict[str, Any] = {"segments": n}
     with tempfile.TemporaryDirectory() as cache:
         # the C integrators' objects are built once per cache, not per machine: copied in
         shutil.copytree(cache_dir() / "integrators", Path(cache) / "integrators")
         old = os.environ.get("WINDER_CACHE_DIR")
         os.environ["WINDER_CACHE_DIR"] = cache
         try:
-            t0, c0 = time.perf_counter(), _cpu()
+            t0, (p0, c0) = time.perf_counter(), _cpu_split()
             gen = MachineSystem(sc)
-            compile_s, compile_cpu = time.perf_counter() - t0, _cpu() - c0
+            (p1, c1), wall = _cpu_split(), time.perf_counter() - t0
+            g = gen.generated
+            row.update(states=gen.n_states, compile_s=wall, python_cpu_s=p1 - p0,
+                       compiler_cpu_s=c1 - c0, compile_cpu_s=p1 - p0 + c1 - c0,
+                       sizes=dict(g.sizes))
+            y = gen.initial_state()
+            fns, p, m = gen.fns, gen.params, gen.modes
+            calls, reps = (200, 3) if quick else (2000, 5)
+            out_rhs, out_jac = np.empty(gen.n_states), np.empty(gen.n_states ** 2)
+            loop = gen.kernels.repeat  # the machine library's C loop
+            loop(fns, integ.F_RHS, 1, 0.1, y, p, m, out_rhs)
+            row["rhs_us"] = best_cpu_us(lambda: loop(fns, integ.F_RHS, calls, 0.1, y, p, m,
+                                                     out_rhs), 1, 4 * reps) / calls
+            row.update(jac_build_s=nan, jac_build_cpu_s=nan, jac_us=nan, jac_nnz=nan,
+                       jac_structural=nan, jac_instructions=nan)
+            if n <= jac_max:
+                t0, (p0, c0) = time.perf_counter(), _cpu_split()
+                g.jacobian()  # built on first use
+                (p1, c1), wall = _cpu_split(), time.perf_counter() - t0
+                k = max(calls // 10, 1)
+                row.update(jac_build_s=wall, jac_build_cpu_s=p1 - p0 + c1 - c0,
+                           jac_us=best_cpu_us(lambda: loop(fns, integ.F_JAC, k, 0.1, y, p, m,
+                                                           out_jac), 1, 4 * reps) / k,
+                           jac_nnz=_jac_nnz(gen, y),
+                           jac_structural=int(g.jac_sparsity()[0][-1]),
+                           jac_instructions=sum(v for w, v in g.sizes.items()
+                                                if w.startswith("jac")))
         finally:
             if old is None:
                 del os.environ["WINDER_CACHE_DIR"]
             else:
                 os.environ["WINDER_CACHE_DIR"] = old
-        y = gen.initial_state()
-        fns, p, m = gen.fns, gen.params, gen.modes
-        calls, reps = (200, 3) if quick else (2000, 5)
-        out_rhs, out_jac = np.empty(gen.n_states), np.empty(gen.n_states ** 2)
-        loop = gen.kernels.repeat  # the machine library's C loop
-        loop(fns, integ.F_RHS, 1, 0.1, y, p, m, out_rhs)
-        rhs_us = best_cpu_us(lambda: loop(fns, integ.F_RHS, calls, 0.1, y, p, m, out_rhs),
-                             1, 4 * reps) / calls
-        jac_us = best_cpu_us(lambda: loop(fns, integ.F_JAC, calls // 10, 0.1, y, p, m,
-                                          out_jac), 1, 4 * reps) / (calls // 10)
-    num_us = float("nan")
-    if numeric:
+    row["numeric_rhs_us"] = nan
+    if numeric and n <= 32:
         num = MachineSystem(sc, backend="pinocchio")
-        k = 20 if quick else 100
-        num_us = best_us(lambda: [num.rhs(0.1, y) for _ in range(k)], k, reps)
-    return {"segments": n, "states": gen.n_states, "compile_s": compile_s,
-            "compile_cpu_s": compile_cpu, "jac_nnz": _jac_nnz(gen, y),
-            "rhs_us": rhs_us, "jac_us": jac_us, "numeric_rhs_us": num_us}
+        k = 20 if quick or n >= 16 else 100
+        row["numeric_rhs_us"] = best_us(lambda: [num.rhs(0.1, y) for _ in range(k)], k, reps)
+    return row
 
 
 def _jac_nnz(system: MachineSystem, y: np.ndarray) -> int:
@@ -152,77 +178,169 @@ def _jac_nnz(system: MachineSystem, y: np.ndarray) -> int:
     return int(np.count_nonzero(system.jac(0.1, y)))
 
 
-def _base(rows: list[dict[str, float]]) -> dict[str, float]:
-    """The row the slopes start from: N = 8 if measured (issue #33), else the second
-    largest."""
-    return next((r for r in rows if r["segments"] == 8 and r is not rows[-1]), rows[-2])
+#: The costs whose growth with N is fitted: (row key, label).
+COSTS = (("compile_cpu_s", "build CPU (explicit run)"), ("rhs_us", "rhs [µs]"),
+         ("rhs_instructions", "rhs instructions"), ("jac_build_cpu_s", "Jacobian build CPU"),
+         ("jac_us", "Jacobian [µs]"), ("jac_nnz", "Jacobian nonzeros"))
 
 
-def slopes(rows: list[dict[str, float]]) -> dict[str, float]:
-    """log-log slopes of the costs from N = 8 (or the second largest N) to the largest."""
-    a, b = _base(rows), rows[-1]
-    r = math.log(b["segments"] / a["segments"])
-    return {k: math.log(b[k] / a[k]) / r for k in ("compile_s", "compile_cpu_s", "rhs_us",
-                                                    "jac_us", "jac_nnz")}
+def _value(r: dict[str, Any], key: str) -> float:
+    if key == "rhs_instructions":
+        return float(r.get("sizes", {}).get("rhs", math.nan))
+    return float(r.get(key, math.nan))
+
+
+def slopes(rows: list[dict[str, Any]]) -> dict[str, dict[str, float]]:
+    """log-log slopes of each cost of :data:`COSTS`: ``fit``, least squares over N >= 8;
+    ``8-32``, the issue's two points; ``32-64`` where measured."""
+    out: dict[str, dict[str, float]] = {}
+    by_n = {r["segments"]: r for r in rows}
+    for key, _ in COSTS:
+        pts = [(math.log(r["segments"]), math.log(_value(r, key))) for r in rows
+               if r["segments"] >= 8 and _value(r, key) > 0]
+        res = {}
+        if len(pts) >= 2:
+            res["fit"] = float(np.polyfit(*zip(*pts, strict=True), 1)[0])
+        for a, b in ((8, 32), (32, 64)):
+            if a in by_n and b in by_n and _value(by_n[a], key) > 0 \
+                    and _value(by_n[b], key) > 0:
+                res[f"{a}-{b}"] = math.log(_value(by_n[b], key) / _value(by_n[a], key)) \
+                    / math.log(b / a)
+        out[key] = res
+    return out
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer calls and repeats")
-    ap.add_argument("--sizes", type=int, nargs="+", default=[1, 4, 8, 16, 32],
+    ap.add_argument("--sizes", type=int, nargs="+", default=[1, 4, 8, 16, 32, 64],
                     help="segments per drum")
     ap.add_argument("--no-numeric", action="store_true", help="skip the Pinocchio path")
+    ap.add_argument("--jac-max", type=int, default=32,
+                    help="build and time the Jacobian up to this many segments")
     ap.add_argument("--from-json", action="store_true",
-                    help="rewrite flex_speed.md from flex_speed.json (no measurement)")
+                    help="rewrite flex_speed.md and .png from flex_speed.json (no measurement)")
     args = ap.parse_args()
     if args.from_json:
         write_docs(json.loads((DOCS / "flex_speed.json").read_text())["rows"])
         return
     rows = []
     for n in args.sizes:
-        rows.append(measure(n, args.quick, not args.no_numeric))
-        print(rows[-1], flush=True)
+        rows.append(measure(n, args.quick, not args.no_numeric, args.jac_max))
+        print(json.dumps(rows[-1]), flush=True)
+        partial = Path(tempfile.gettempdir()) / "flex_speed.partial.json"
+        partial.write_text(json.dumps(rows))
     write_docs(rows)
 
 
-def write_docs(rows: list[dict[str, float]]) -> None:
+def _cell(v: float, fmt: str) -> str:
+    return "–" if not math.isfinite(v) else format(v, fmt)
+
+
+def plot(rows: list[dict[str, Any]], slope: dict[str, dict[str, float]], path: Path) -> None:
+    """Log-log plot of the costs of :data:`COSTS` against N (N >= 4), each normalised to
+    its value at N = 8, with the fitted slopes and the line of slope 1."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    base = next(r for r in rows if r["segments"] == 8) if any(
+        r["segments"] == 8 for r in rows) else rows[0]
+    for key, label in COSTS:
+        pts = [(r["segments"], _value(r, key) / _value(base, key)) for r in rows
+               if r["segments"] >= 4 and _value(r, key) > 0]
+        if len(pts) < 2:
+            continue
+        fit = slope.get(key, {}).get("fit", math.nan)
+        ax.loglog(*zip(*pts, strict=True), "o-", label=f"{label}: slope {fit:.2f}")
+    ns = np.array([4, max(r["segments"] for r in rows)], dtype=float)
+    ax.loglog(ns, ns / 8, "k--", lw=1, label="slope 1 (linear)")
+    ax.loglog(ns, (ns / 8) ** 2, "k:", lw=1, label="slope 2")
+    ax.set_xlabel("segments per flexible drum N")
+    ax.set_ylabel("cost ÷ cost at N = 8")
+    ax.set_title("Flexible drum: growth with N (fitted over N ≥ 8)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    atomic_write(path, lambda p: fig.savefig(p, dpi=110, format="png"))
+    plt.close(fig)
+
+
+def write_docs(rows: list[dict[str, Any]]) -> None:
     slope = slopes(rows) if len(rows) > 1 else {}
-    lines = ["# Flexible drum: cost per evaluation and compile time", "",
+    lines = ["# Flexible drum: cost per evaluation and build time", "",
              "`python benchmarks/flex_speed.py`: the single-drum winder with a flexible "
-             "drum of N segments (N = 1: rigid), its nip sliced; generated code called "
-             "in the C loop of its library (best of repeats in the thread's CPU time), the "
-             "numeric Pinocchio path from Python (wall time); the build (an empty cache) in "
-             "wall and CPU seconds (this process and the compilers); a shared 2-core "
-             "machine.", "",
-             "| N | states | build [s] | build CPU [s] | rhs [µs] | Jacobian nonzeros | "
-             "Jacobian [µs] | numeric rhs [µs] |",
-             "|---|---|---|---|---|---|---|---|"]
+             "drum of N segments (N = 1: rigid), its nip sliced. The build (an empty cache) "
+             "is what an explicit run needs (rhs, channels, switching functions), in wall "
+             "seconds and CPU seconds (Python: the symbolic build, CSE and C; the compiler "
+             "processes); the Jacobian is built on first use and timed apart. Generated code "
+             "called in the C loop of its library (best of repeats in the thread's CPU "
+             "time); the numeric Pinocchio path from Python (wall time). A shared 2-core "
+             "machine: wall seconds move with its load.", "",
+             "| N | states | build [s] | build CPU [s] (Python + compiler) | rhs / channels / "
+             "switches [CasADi instructions] | rhs [µs] | Jacobian build CPU [s] | Jacobian "
+             "instructions | Jacobian nonzeros (structural) | Jacobian [µs] | numeric rhs "
+             "[µs] |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {r['segments']} | {r['states']} | {r['compile_s']:.1f} | "
-                     f"{r['compile_cpu_s']:.1f} | {r['rhs_us']:.2f} | {r['jac_nnz']} | "
-                     f"{r['jac_us']:.1f} | {r['numeric_rhs_us']:.0f} |")
+        sz = r.get("sizes", {})
+        lines.append(
+            f"| {r['segments']} | {r['states']} | {r['compile_s']:.1f} | "
+            f"{r['compile_cpu_s']:.1f} ({_cell(r.get('python_cpu_s', math.nan), '.1f')} + "
+            f"{_cell(r.get('compiler_cpu_s', math.nan), '.1f')}) | "
+            f"{sz.get('rhs', '–')} / {sz.get('out', '–')} / {sz.get('sw', '–')} | "
+            f"{r['rhs_us']:.2f} | {_cell(r['jac_build_cpu_s'], '.1f')} | "
+            f"{_cell(r['jac_instructions'], '.0f')} | {_cell(r['jac_nnz'], '.0f')} "
+            f"({_cell(r['jac_structural'], '.0f')}) | {_cell(r['jac_us'], '.1f')} | "
+            f"{_cell(r['numeric_rhs_us'], '.0f')} |")
     if slope:
-        a, b = _base(rows)["segments"], rows[-1]["segments"]
-        lines += ["", f"log-log slopes from N = {a} to {b} (1: linear; issue #33 asks at "
-                  f"most {math.log(4.5) / math.log(4):.2f} from 8 to 32): build "
-                  f"{slope['compile_s']:.2f} (CPU {slope['compile_cpu_s']:.2f}), rhs "
-                  f"{slope['rhs_us']:.2f}, Jacobian {slope['jac_us']:.2f} (its nonzeros "
-                  f"{slope['jac_nnz']:.2f}). The Jacobian's nonzeros grow faster than N: "
-                  "along a chain of segments the accelerations depend on every segment's "
-                  "coordinates (the inverse mass matrix of a serial chain is full), and the "
-                  "build follows the nonzeros.", "",
-                  "Before issue #33's build changes (0ee43f2, the same script, another "
-                  "moment): build CPU 3.9 / 12.6 / 46.2 s, rhs 0.40 / 0.55 / 1.84 µs, "
-                  "Jacobian 2.5 / 5.2 / 15.9 µs at N = 4 / 8 / 16. The µs move by tens of "
-                  "per cent between runs on this shared machine (caches shared with other "
-                  "jobs); side by side the rhs and Jacobian cost the same as before "
-                  "(build_speed.md)."]
+        lines += ["", "![growth with N](flex_speed.png)", "",
+                  "log-log slopes (1: linear; issue #33 asks at most "
+                  f"{math.log(4.5) / math.log(4):.2f} from N = 8 to 32):", "",
+                  "| cost | fitted, N >= 8 | N = 8 → 32 | N = 32 → 64 |", "|---|---|---|---|"]
+        for key, label in COSTS:
+            sl = slope.get(key, {})
+            lines.append(f"| {label} | {_cell(sl.get('fit', math.nan), '.2f')} | "
+                         f"{_cell(sl.get('8-32', math.nan), '.2f')} | "
+                         f"{_cell(sl.get('32-64', math.nan), '.2f')} |")
+        lines += ["", GROWTH]
     text = "\n".join(lines) + "\n"
     atomic_write(DOCS / "flex_speed.md", lambda p: p.write_text(text, encoding="utf-8"))
     atomic_write(DOCS / "flex_speed.json",
                  lambda p: p.write_text(json.dumps({"rows": rows, "slopes": slope}, indent=1)
                                         + "\n", encoding="utf-8"))
+    if slope:
+        plot(rows, slope, DOCS / "flex_speed.png")
     print(text)
+
+
+#: What grows faster than N, and why (measured 2026-11-27 by hand: the CasADi instructions
+#: of the single drum's rhs with the bending forces taken out).
+GROWTH = """## What grew faster than N, and the fix
+
+Measured 2026-11-27 by hand (CasADi instructions, which the compile time and the run time
+follow). Before (afacf70), the rhs at N = 8 / 16 / 32 / 64: 3,045 / 7,405 / 20,349 / 63,133
+(slope 1.46, towards 2). With the flexible drum's bending forces taken out (the tilts'
+rates kept, no force): 1,578 / 3,002 / 5,850 at N = 8 / 16 / 32 (slope 0.95: the
+articulated-body algorithm on the chain of segments, the nip's slices, the torsion
+springs, CSE and the symbolic build all grow with N). The bending's own share, 1,467 /
+4,403 / 14,499, grew as N²: `FlexBeam._rotary_bending` applied the condensed stiffness
+`K = K_ww + K_wψ T` and the tilts' lag `φ̇ = s − T ẇ` as dense N × N products (`T =
+−K_ψψ⁻¹ K_ψw` is dense: N² run-time parameters `K…_i_j`, `T…_i_j`, read in N² Python
+steps too), and the channels function carried the same products.
+
+Now (issue #33) neither is formed: `K w + K_wψ φ = K_ww w + K_wψ (φ + T w)` and `T v =
+−K_ψψ⁻¹ (K_ψw v)` with the tridiagonal blocks and the `L D Lᵀ` factors of `K_ψψ` as
+run-time parameters, a forward and a back substitution per use. The rhs: 2,801 / 5,553 /
+11,057 / 22,065 instructions (slope 0.99), the channels 2,302 / 4,465 / 8,786 / 17,426; the
+parameters 325 / 653 / 1,309 / 2,621 (were 465 / 1,313 / 4,161 / 16,705). The rates agree
+with the dense form to 1e-15 relative per state. The Jacobian's structural nonzeros still
+grow faster than N: the accelerations of a chain depend on every segment's deflection (the
+inverse of `K_ψψ` is dense), which is what it is; it is built only on first use. Left: the
+flexible body without rotary inertia (`rotary_inertia = false`) and the paper roll's
+bending still use their dense condensed `K` (the same substitution applies).
+"""
 
 
 if __name__ == "__main__":

@@ -61,7 +61,7 @@ def test_functions_equal_casadi_bit_for_bit(split: int | None, tmp_path: Path,
         for which, w in zip(codegen.FUNCTIONS, want, strict=True):
             size = w.size
             out = np.full(size, np.nan)
-            fn = getattr(g._lib, f"{g.symbol}_{which}_flat")
+            fn = getattr(g.library(which), f"{g.symbol}_{which}_flat")
             dp = np.ctypeslib.ndpointer(dtype=float, flags="C_CONTIGUOUS")
             fn.argtypes = [dp] * 5
             fn(np.array([3.0]), x, p, modes, out)

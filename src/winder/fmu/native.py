@@ -26,6 +26,7 @@ from __future__ import annotations
 import hashlib
 import re
 import shutil
+import sys
 import uuid
 import zipfile
 from pathlib import Path
@@ -212,6 +213,10 @@ def build_fmu(scene_path: str | Path, out: str | Path, *, fmi_version: int = 2,
         guid = "{" + str(uuid.UUID(digest.hexdigest()[:32])) + "}"
         (src / "winder_model.h").write_text(_model_header(iface, symbol, guid, balance),
                                             encoding="utf-8")
+        kb = sum((src / f).stat().st_size for f in generated) / 1024
+        print(f"winder: building the FMU {model}'s binary ({len(generated)} generated C "
+              f"files, {kb:.0f} kB, and the integrators; the Jacobian included)",
+              file=sys.stderr, flush=True)
         _compile(src, model, stage / "binaries" / platform / f"{model}.so", symbol,
                  generated, wrappers, sanitize)
         sources = [*generated, f"{symbol}_balance.c", *_INTEGRATORS, *wrappers]

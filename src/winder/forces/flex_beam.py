@@ -115,20 +115,27 @@ class FlexBeam(ForceElement):
     def _declare_rotary(machine: Machine, body: str, segs: list[Any], axis: str,
                         bm: Any) -> None:
         """The parameters of a beam with its sections' rotary inertia along ``axis``
-        (:class:`~winder.model.beam.RotaryBeamMatrices`; the band ``|i − j| ≤ 1`` of
-        ``K̂``, ``C``) and each segment's states ``tilt_{axis}`` (``φ``) and
+        (:class:`~winder.model.beam.RotaryBeamMatrices`): the band ``|i − j| ≤ 1`` of
+        ``K̂`` (``Kww``, ``Kwp``, ``Kpp``) and ``C`` (``Cww``, ``Cwp``, ``Cpp``), and the
+        factors of ``K_ψψ = L D Lᵀ`` (``L`` unit lower bidiagonal: ``Pl_i = L[i, i−1]``,
+        ``Pd_i = 1/D[i]``), so that the condensed stiffness ``K = K_ww + K_wψ T`` and the
+        static rotations ``T w = −K_ψψ⁻¹ K_ψw w`` are applied in O(N) (never formed: they
+        are dense); and each segment's states ``tilt_{axis}`` (``φ``) and
         ``tilt_rate_{axis}`` (``s = ψ̇``), 0 at the start."""
         n = len(segs)
-        for kind, matrix, sym, band in (("K", bm.K, True, False), ("T", bm.T, False, False),
-                                        ("Kwp", bm.K_wp, False, True),
-                                        ("Kpp", bm.K_pp, True, True),
-                                        ("Cww", bm.C_ww, True, True),
-                                        ("Cwp", bm.C_wp, False, True),
-                                        ("Cpp", bm.C_pp, True, True)):
+        for kind, matrix, sym in (("Kww", bm.K_ww, True), ("Kwp", bm.K_wp, False),
+                                  ("Kpp", bm.K_pp, True), ("Cww", bm.C_ww, True),
+                                  ("Cwp", bm.C_wp, False), ("Cpp", bm.C_pp, True)):
             for i in range(n):
-                for j in range(i if sym else 0, n):
-                    if not band or abs(i - j) <= 1:
-                        machine.parameter(f"{body}.flex.{kind}{axis}_{i}_{j}", matrix[i, j])
+                for j in range(i if sym else max(i - 1, 0), min(i + 2, n)):
+                    machine.parameter(f"{body}.flex.{kind}{axis}_{i}_{j}", matrix[i, j])
+        d = float(bm.K_pp[0, 0])
+        machine.parameter(f"{body}.flex.Pd{axis}_0", 1.0 / d)
+        for i in range(1, n):  # LDLᵀ of the symmetric tridiagonal K_ψψ
+            low = float(bm.K_pp[i, i - 1]) / d
+            d = float(bm.K_pp[i, i]) - low * float(bm.K_pp[i - 1, i])
+            machine.parameter(f"{body}.flex.Pl{axis}_{i}", low)
+            machine.parameter(f"{body}.flex.Pd{axis}_{i}", 1.0 / d)
         for seg in segs:
             machine.state(f"{seg.name}.tilt_{axis}", 0.0)
             machine.state(f"{seg.name}.tilt_rate_{axis}", 0.0)
@@ -250,31 +257,49 @@ class FlexBeam(ForceElement):
         (:func:`~winder.model.beam.rotary_beam_matrices`): the rates of the segments'
         ``tilt_{axis}`` (``φ̇ = s − T ẇ``) and ``tilt_rate_{axis}`` (``ṡ = (−K_ψψ φ −
         C_ψw ẇ − C_ψψ s)/j_r``, ``j_r`` half the segment's polar inertia); returns the
-        forces on the segments ``−K w − K_wψ φ − C_ww ẇ − C_wψ s`` [N]."""
+        forces on the segments ``−K w − K_wψ φ − C_ww ẇ − C_wψ s`` [N]. ``K`` and ``T``
+        are dense: applied as ``K w = K_ww w + K_wψ T w`` and ``T w = −K_ψψ⁻¹ K_ψw w``
+        (banded products and the tridiagonal ``L D Lᵀ`` of ``K_ψψ``), so the cost grows
+        with N, not N² (issue #33)."""
         p, n = ev.p, len(segs)
 
         def par(kind: str, i: int, j: int, sym: bool = False) -> Any:
+            if j < 0:  # a vector: Pl_i, Pd_i
+                return p(f"{body}.flex.{kind}{axis}_{i}")
             a, b = (min(i, j), max(i, j)) if sym else (i, j)
             return p(f"{body}.flex.{kind}{axis}_{a}_{b}")
 
         phi = [ev.x(f"{s.name}.tilt_{axis}") for s in segs]
         rate = [ev.x(f"{s.name}.tilt_rate_{axis}") for s in segs]
+
+        def static_rotation(values: list[Any]) -> list[Any]:
+            """``−T values = K_ψψ⁻¹ K_ψw values`` (banded product, then ``L D Lᵀ``)."""
+            z = []
+            for i in range(n):
+                acc: Any = 0.0
+                for j in range(max(i - 1, 0), min(i + 2, n)):
+                    acc = acc + par("Kwp", j, i) * values[j]
+                z.append(acc)
+            for i in range(1, n):
+                z[i] = z[i] - par("Pl", i, -1) * z[i - 1]
+            z = [zi * par("Pd", i, -1) for i, zi in enumerate(z)]
+            for i in range(n - 2, -1, -1):
+                z[i] = z[i] - par("Pl", i + 1, -1) * z[i + 1]
+            return z
+
+        y = static_rotation(u)  # ψ − φ = T w = −y
+        lag = static_rotation(v)  # −T ẇ
         forces = []
         for i, seg in enumerate(segs):
             f: Any = 0.0
-            for j in range(n):
-                f = f - par("K", i, j, True) * u[j]
             g: Any = 0.0
             for j in range(max(i - 1, 0), min(i + 2, n)):
-                f = f - par("Kwp", i, j) * phi[j] - par("Cww", i, j, True) * v[j] \
-                    - par("Cwp", i, j) * rate[j]
+                f = f - par("Kww", i, j, True) * u[j] - par("Kwp", i, j) * (phi[j] - y[j]) \
+                    - par("Cww", i, j, True) * v[j] - par("Cwp", i, j) * rate[j]
                 g = g - par("Kpp", i, j, True) * phi[j] - par("Cwp", j, i) * v[j] \
                     - par("Cpp", i, j, True) * rate[j]
             forces.append(f)
-            lag: Any = rate[i]
-            for j in range(n):
-                lag = lag - par("T", i, j) * v[j]
-            ev.set_rate(f"{seg.name}.tilt_{axis}", lag)
+            ev.set_rate(f"{seg.name}.tilt_{axis}", rate[i] + lag[i])
             ev.set_rate(f"{seg.name}.tilt_rate_{axis}", 2.0 * g / p(f"{seg.name}.inertia"))
         return forces
 

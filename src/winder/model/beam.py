@@ -177,7 +177,8 @@ class RotaryBeamMatrices:
     [N·m/rad] the blocks ``K_wψ``, ``K_ψψ`` of ``K̂``; ``C_ww`` [N·s/m], ``C_wp``
     [N·s/rad] and ``C_pp`` [N·m·s/rad] those of ``C = β K̂ + C_b`` (``C_ψw = C_wpᵀ``);
     ``beta`` [s], ``omega1`` [rad/s], ``k_t`` [N·m/rad] and ``c_t`` [N·m·s/rad] as
-    :class:`BeamMatrices`."""
+    :class:`BeamMatrices`; ``K_ww`` [N/m] the block ``K_ww`` of ``K̂`` (tridiagonal:
+    ``K = K_ww + K_wψ T``)."""
 
     K: np.ndarray
     T: np.ndarray
@@ -190,6 +191,7 @@ class RotaryBeamMatrices:
     omega1: float
     k_t: float
     c_t: float
+    K_ww: np.ndarray
 
 
 def rotary_beam_matrices(n: int, length: float, mass: float, inertia: float, EI: float,
@@ -230,4 +232,4 @@ def rotary_beam_matrices(n: int, length: float, mass: float, inertia: float, EI:
     C = beta * Kh + Cb
     k_t = GJ / (length / n)
     return RotaryBeamMatrices(K, T, K_wp, K_pp, C[w, w], C[w, p], C[p, p], beta, omega1,
-                              k_t, beta * k_t)
+                              k_t, beta * k_t, K_ww)

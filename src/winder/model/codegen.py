@@ -5,15 +5,20 @@ The machine's dynamics (:meth:`~winder.model.machine.Machine.evaluate`) runs onc
 symbols; four functions of ``(t, x, p, m)`` (time, state, parameters, locked modes) are
 generated as C, one file each, wrapped with flat entry points ``int NAME(const double* t,
 const double* x, const double* p, const double* m, double* out)``. Each file goes to its
-own compiler process as soon as it is written (the right-hand side first: it compiles while
-the Jacobian is generated), at the optimisation level of its function (:data:`OPTIMISE`),
-and the objects are joined into one relocatable object. The Jacobian is generated on
-its structural nonzeros only (in two column blocks, two files, when it is large); its flat
-entry point scatters them into the dense column-major matrix its callers expect. CasADi's
-null checks on each argument read and result written are removed (the flat entry points
-pass them all): one branch per element made the compiler's time grow faster than the
-function. The cache key is everything that
-changes the generated code: the machine's structure
+own compiler process as soon as it is written (the right-hand side first), at the
+optimisation level of its function (:data:`OPTIMISE`). The right-hand side, channels and
+switching functions (:data:`MAIN`: all an explicit run needs) are joined into one
+relocatable object and the machine's library. The Jacobian (:data:`JACOBIAN`; most of a
+large machine's build) is generated and compiled on first use (:meth:`Generated.jacobian`:
+implicit methods, linearisation, modes) into a library of its own beside the first,
+``SYMBOL_jac.so``, under the same key. It is generated on its structural nonzeros only (in
+two column blocks, two files, when it is large); its flat entry point scatters them into
+the dense column-major matrix its callers expect (``SYMBOL_jac_nz_flat`` writes the
+nonzeros alone, ``SYMBOL_jac_sparsity`` gives their CCS pattern). CasADi's null checks on
+each argument read and result written are removed (the flat entry points pass them all):
+one branch per element made the compiler's time grow faster than the function. Every build
+longer than a moment says so on stderr (what, how big, how long). The cache key is
+everything that changes the generated code: the machine's structure
 (:meth:`~winder.model.machine.Machine.structure_key`), the source of the physics
 (:mod:`winder.model`, :mod:`winder.parts`, :mod:`winder.forces`), the CasADi version, the
 layout (:data:`LAYOUT`) and the compiler flags and levels.
@@ -33,7 +38,6 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -47,12 +51,15 @@ from typing import Any
 import numpy as np
 
 from winder._errors import WinderError
+from winder.model.c_entry import flat_entry as _flat_entry
+from winder.model.c_entry import unguarded as _unguarded
 from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
            "stats", "Link", "compile_flags", "link_flags", "run_compiler",
            "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash", "write_source",
-           "OPTIMISE", "function_flags", "LAYOUT", "LARGE", "level", "JAC_SPLIT"]
+           "OPTIMISE", "function_flags", "LAYOUT", "LARGE", "level", "JAC_SPLIT",
+           "MAIN", "JACOBIAN"]
 
 #: The generated functions, in the order of :attr:`Generated.addresses`.
 FUNCTIONS = ("rhs", "jac", "out", "sw")
@@ -76,16 +83,20 @@ LARGE = 5000
 #: compiled at once (1.08 times the instructions of one for the flexible two-drum winder's
 #: 4800 nonzeros; a machine's Jacobian is most of its build).
 JAC_SPLIT = 2000
+#: A Jacobian's build (on first use) that took longer than this [s] says so again when done.
+SAY_AFTER = 5.0
 #: The layout of the generated code (in the cache key): one C file per function, the
-#: Jacobian on its nonzeros scattered by its flat entry point, CasADi's null checks removed.
-LAYOUT = "split-sparse-jac-unguarded-3"
+#: Jacobian on its nonzeros scattered by its flat entry point (beside it its nonzeros' entry
+#: point and CCS pattern) in a library of its own built on first use, CasADi's null checks
+#: removed.
+LAYOUT = "lazy-jac-split-sparse-unguarded-4"
 #: ``WINDER_SANITIZE=1`` (``make test-asan``): AddressSanitizer and UBSan on every object
 #: and the link (Python then needs libasan preloaded; see the Makefile).
 SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
                    "-fno-omit-frame-pointer", "-g")
 #: Counters of this process: models compiled, libraries linked (the generated object
-#: cached), and libraries loaded from the cache.
-stats = {"compiled": 0, "linked": 0, "cached": 0}
+#: cached), libraries loaded from the cache, and Jacobians compiled (on first use).
+stats = {"compiled": 0, "linked": 0, "cached": 0, "jacobians": 0}
 
 
 class CompilerMissing(WinderError, RuntimeError):
@@ -201,7 +212,11 @@ def _compiler() -> str:
 
 @dataclass
 class Generated:
-    """A compiled machine: function addresses and sizes (keep it alive while in use)."""
+    """A compiled machine: function addresses and sizes (keep it alive while in use).
+
+    ``addresses`` holds the flat entry points of :data:`FUNCTIONS`; the Jacobian's is 0
+    until :meth:`jacobian` builds (or loads) its library, which writes it in place (every
+    holder of the array sees it)."""
 
     key: str
     path: Path
@@ -210,21 +225,64 @@ class Generated:
     n_modes: int
     n_switches: int
     n_channels: int
-    addresses: np.ndarray  # int64 addresses of FUNCTIONS
+    addresses: np.ndarray  # int64 addresses of FUNCTIONS (the Jacobian's 0 until built)
     build_seconds: float = 0.0
     from_cache: bool = False
     route: str = "py"
+    #: CasADi instructions of each function (file) built in this process (empty when
+    #: loaded from the cache): ``rhs``, ``out``, ``sw``, and ``jac`` (``jac1``) once built
+    sizes: dict[str, int] = field(default_factory=dict)
     _lib: Any = field(default=None, repr=False)
+    _jac_lib: Any = field(default=None, repr=False)
+    _make_jac: Callable[[dict[str, int]], Path] | None = field(default=None, repr=False)
+
+    def jacobian(self) -> int:
+        """The address of the Jacobian's flat entry point ``SYMBOL_jac_flat`` (dense,
+        column-major; beside it ``SYMBOL_jac_nz_flat``, its nonzeros only, and
+        ``SYMBOL_jac_sparsity``, their CCS pattern): its library loaded from the cache, or
+        generated and compiled on this first use (:func:`generate`). Writes it into
+        :attr:`addresses`."""
+        if self._jac_lib is None:
+            if self._make_jac is None:
+                raise RuntimeError("this machine's Jacobian cannot be built (no builder)")
+            self._jac_lib = ctypes.CDLL(str(self._make_jac(self.sizes)))
+            self._make_jac = None  # frees the symbols it kept
+        address = ctypes.cast(getattr(self._jac_lib, f"{self.symbol}_jac_flat"),
+                              ctypes.c_void_p).value
+        self.addresses[FUNCTIONS.index("jac")] = address
+        return int(address)
+
+    def library(self, which: str) -> Any:
+        """The loaded library holding the generated function ``which`` (one of
+        :data:`FUNCTIONS`; the Jacobian's built on first use)."""
+        if which == "jac":
+            self.jacobian()
+            return self._jac_lib
+        return self._lib
+
+    def jac_sparsity(self) -> tuple[np.ndarray, np.ndarray]:
+        """The Jacobian's structural sparsity (CCS): ``colind`` (n_states + 1) and ``row``
+        (one per nonzero), the order :meth:`call` ``("jac_nz", ...)`` writes them in."""
+        fn = getattr(self.library("jac"), f"{self.symbol}_jac_sparsity")
+        fn.restype = ctypes.POINTER(ctypes.c_int64)
+        sp = fn()
+        n = self.n_states
+        colind = np.array(sp[2:3 + n], dtype=np.int64)
+        return colind, np.array(sp[3 + n:3 + n + int(colind[-1])], dtype=np.int64)
 
     def call(self, which: str, t: float, x: np.ndarray, p: np.ndarray,
              m: np.ndarray) -> np.ndarray:
-        """Evaluate one generated function from Python (slow path, for tests/outputs)."""
+        """Evaluate one generated function from Python (slow path, for tests/outputs);
+        ``"jac_nz"``: the Jacobian's nonzeros (:meth:`jac_sparsity`)."""
+        lib = self.library("jac" if which == "jac_nz" else which)
         size = {"rhs": self.n_states, "jac": self.n_states ** 2, "out": self.n_channels,
-                "sw": self.n_switches}[which]
+                "sw": self.n_switches}.get(which)
+        if size is None:
+            size = int(self.jac_sparsity()[0][-1])
         out = np.empty(size)
         tb = np.array([t], float)
         xs, ps, ms = (np.ascontiguousarray(a, dtype=float) for a in (x, p, m))
-        fn = getattr(self._lib, f"{self.symbol}_{which}_flat")
+        fn = getattr(lib, f"{self.symbol}_{which}_flat")
         dp = ctypes.POINTER(ctypes.c_double)
         fn(*(a.ctypes.data_as(dp) for a in (tb, xs, ps, ms, out)))
         if which == "jac":
@@ -236,52 +294,88 @@ class Generated:
         return f"w{self.key}"
 
 
+class _Symbols:
+    """The machine's dynamics on CasADi symbols: ``(t, x, p, m)``, the evaluation and the
+    right-hand side ``xdot``; its Jacobian ``∂xdot/∂x`` made on first use (the lazy
+    Jacobian's library may never be asked for)."""
+
+    def __init__(self, machine: Machine, route: str) -> None:
+        import casadi as ca
+
+        from winder.model.backends import SymbolicBackend
+
+        self.t = ca.SX.sym("t")
+        self.x = ca.SX.sym("x", machine.n_states)
+        self.p = ca.SX.sym("p", len(machine.param_names))
+        self.m = ca.SX.sym("m", len(machine.mode_names))
+        self.ev = machine.evaluate(SymbolicBackend(machine.model, route), self.t, self.x,
+                                   self.p, self.m)
+        self.xdot = ca.vertcat(*[self.ev.rates[n] for n in machine.state_names])
+        self._jac: Any = None
+
+    @property
+    def jac(self) -> Any:
+        if self._jac is None:
+            import casadi as ca
+
+            self._jac = ca.jacobian(self.xdot, self.x)
+        return self._jac
+
+
+#: The functions of the machine's first object (everything an explicit run needs) and of
+#: its Jacobian's library (built on first use), in the order they are generated.
+MAIN, JACOBIAN = ("rhs", "out", "sw"), ("jac",)
+
+
 def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
               ready: Callable[[str, Path, int], None] | None = None, *,
-              pattern: bool = False
+              pattern: bool = False, which: tuple[str, ...] = ("rhs", "jac", "out", "sw"),
+              symbols: _Symbols | None = None
               ) -> tuple[list[tuple[str, Path, int]], dict[str, np.ndarray]]:
-    """Write one C file per generated function, ``SYMBOL_{rhs,jac,out,sw}.c`` (each with
-    its flat entry point), calling ``ready(which, path, size)`` (``size``: CasADi
-    instructions) as soon as each is written (so that its compilation starts while the
-    next one is generated). The Jacobian is generated on its structural nonzeros only (CCS)
-    and scattered into the dense column-major matrix by its flat entry point; one of
+    """Write one C file per generated function of ``which`` (default: all of
+    :data:`FUNCTIONS`; :data:`MAIN` or :data:`JACOBIAN`), ``SYMBOL_{rhs,jac,out,sw}.c``
+    (each with its flat entry point), calling ``ready(which, path, size)`` (``size``:
+    CasADi instructions) as soon as each is written (so that its compilation starts while
+    the next one is generated). The Jacobian is generated on its structural nonzeros only
+    (CCS) and scattered into the dense column-major matrix by its flat entry point; one of
     :data:`JAC_SPLIT` nonzeros or more is generated in two column blocks, the second in
     ``SYMBOL_jac1.c`` (compiled at once with the first). ``pattern``: also the structural
-    sparsity of dxdot/dx and dxdot/dp, ``(row, column)`` per nonzero (for an FMU). Returns
-    ``(which, path, size)`` per file and the patterns."""
+    sparsity of dxdot/dx and dxdot/dp, ``(row, column)`` per nonzero (for an FMU).
+    ``symbols``: the machine on CasADi symbols if already made (:class:`_Symbols`).
+    Returns ``(which, path, size)`` per file and the patterns."""
     import casadi as ca
 
-    from winder.model.backends import SymbolicBackend
-
-    t = ca.SX.sym("t")
-    x = ca.SX.sym("x", machine.n_states)
-    p = ca.SX.sym("p", len(machine.param_names))
-    m = ca.SX.sym("m", len(machine.mode_names))
-    ev = machine.evaluate(SymbolicBackend(machine.model, route), t, x, p, m)
-    xdot = ca.vertcat(*[ev.rates[n] for n in machine.state_names])
-    jac = ca.jacobian(xdot, x)
+    sym = _Symbols(machine, route) if symbols is None else symbols
+    t, x, p, m, ev, xdot = sym.t, sym.x, sym.p, sym.m, sym.ev, sym.xdot
     patterns = {}
     if pattern:  # the structural sparsity of dxdot/dx and dxdot/dp: (row, column) per nonzero
-        for name, sp in (("x", jac.sparsity()), ("p", ca.jacobian(xdot, p).sparsity())):
+        for name, sp in (("x", sym.jac.sparsity()), ("p", ca.jacobian(xdot, p).sparsity())):
             patterns[name] = np.array(sp.get_triplet(), dtype=np.int64).reshape(2, -1).T
-    colind = jac.sparsity().colind()
-    cuts = [0, machine.n_states]
-    if jac.nnz() >= JAC_SPLIT:  # two column blocks of about half the nonzeros each
-        cuts.insert(1, next(c for c in range(machine.n_states + 1)
-                            if colind[c] >= jac.nnz() / 2))
-    blocks = [(f"jac{i}" if i else "jac", colind[a], jac[:, a:b])
-              for i, (a, b) in enumerate(zip(cuts, cuts[1:], strict=False))]
+    outs: list[tuple[str, str, Any]] = []
+    blocks: list[tuple[str, int, Any]] = []
     # the order of generation: the rhs first (its compile is long for its size), the
     # Jacobian's file with the flat entry point last of its blocks
-    outs: list[tuple[str, str, Any]] = [("rhs", "rhs", lambda: ca.densify(xdot))]
-    outs += [("jac", name, lambda e=e: e) for name, _, e in reversed(blocks)]
-    outs += [("out", "out", lambda: ca.densify(ca.vertcat(*[ev.channels[n] for n in
-                                                             machine.channel_names]))),
-             ("sw", "sw", lambda: ca.densify(ca.vertcat(*[ev.switches[n] for n in
-                                                           machine.switch_names])))]
+    if "rhs" in which:
+        outs.append(("rhs", "rhs", lambda: ca.densify(xdot)))
+    if "jac" in which:
+        jac = sym.jac
+        colind = jac.sparsity().colind()
+        cuts = [0, machine.n_states]
+        if jac.nnz() >= JAC_SPLIT:  # two column blocks of about half the nonzeros each
+            cuts.insert(1, next(c for c in range(machine.n_states + 1)
+                                if colind[c] >= jac.nnz() / 2))
+        blocks = [(f"jac{i}" if i else "jac", colind[a], jac[:, a:b])
+                  for i, (a, b) in enumerate(zip(cuts, cuts[1:], strict=False))]
+        outs += [("jac", name, lambda e=e: e) for name, _, e in reversed(blocks)]
+    if "out" in which:
+        outs.append(("out", "out", lambda: ca.densify(ca.vertcat(
+            *[ev.channels[n] for n in machine.channel_names]))))
+    if "sw" in which:
+        outs.append(("sw", "sw", lambda: ca.densify(ca.vertcat(
+            *[ev.switches[n] for n in machine.switch_names]))))
     files: list[tuple[str, Path, int]] = []
     made: dict[str, Any] = {}
-    for which, name, expr in outs:
+    for kind, name, expr in outs:
         f = made[name] = ca.Function(f"{symbol}_{name}", [t, x, p, m], [expr()], {"cse": True})
         cg = ca.CodeGenerator(f"{symbol}_{name}.c", {"with_header": False})
         cg.add(f)
@@ -290,65 +384,14 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
         # refuses)
         path = directory / f"{symbol}_{name}.c"
         entry = "" if name.startswith("jac") and name != "jac" else _flat_entry(
-            symbol, which, f, [(f"{symbol}_{n}", made[n], off) for n, off, _ in blocks]
-            if name == "jac" else None, jac.sparsity())
+            symbol, kind, f, [(f"{symbol}_{n}", made[n], off) for n, off, _ in blocks]
+            if name == "jac" else None, sym.jac.sparsity() if name == "jac" else None)
         path.write_text(f"/* {symbol}_{name}: generated by CasADi {ca.__version__} for "
                         "winder */\n" + _unguarded(cg.dump()) + entry)
-        files.append((which, path, f.n_instructions()))
+        files.append((kind, path, f.n_instructions()))
         if ready is not None:
             ready(*files[-1])
     return files, patterns
-
-
-def _unguarded(code: str) -> str:
-    """CasADi's code without its null checks on each argument read (``arg[i]? arg[i][j] :
-    0``) and each result written (``if (res[0]!=0) ...``): the functions are only called
-    through their flat entry points, which pass every argument and the result. One branch
-    per element made the compiler's register allocation superlinear in the function's size
-    (the flexible two-drum winder's Jacobian: 4800 writes, MEASURED)."""
-    code = code.replace("if (res[0]!=0) ", "")
-    return re.sub(r"arg\[(\d+)\]\? (arg\[\1\]\[\d+\]) : 0", r"\2", code)
-
-
-def _flat_entry(symbol: str, k: str, f: Any, blocks: list[tuple[str, Any, int]] | None,
-                sparsity: Any) -> str:
-    """The flat, reentrant entry point ``SYMBOL_K_flat(t, x, p, m, out)`` of one generated
-    function. The Jacobian's (``blocks``: each column block's function name, function and
-    offset of its first nonzero; ``sparsity``: the CCS pattern): each block writes its
-    nonzeros to the front of ``out`` at its offset, the rest is set to 0 (one ``memset``)
-    and each nonzero moved to its dense column-major place, last first (the place of the
-    k-th nonzero is never before k, so none is overwritten before it moves)."""
-    head = (f"\n/* flat, reentrant entry point */\n"
-            f"int {symbol}_{k}_flat(const double* t, const double* x, const double* p, "
-            f"const double* m, double* out) {{\n")
-    if blocks is None:
-        return (head + f"  const casadi_real* arg[{max(f.sz_arg(), 4)}] = {{t, x, p, m}};\n"
-                f"  casadi_real* res[{max(f.sz_res(), 1)}] = {{out}};\n"
-                f"  casadi_int iw[{f.sz_iw() + 1}];\n  casadi_real w[{f.sz_w() + 1}];\n"
-                f"  return {symbol}_{k}(arg, res, iw, w, 0);\n}}\n")
-    n, nnz = sparsity.size1(), sparsity.nnz()
-    rows, cols = sparsity.get_triplet()
-    place = [int(r) + n * int(c) for r, c in zip(rows, cols, strict=True)]
-    lines = [", ".join(str(v) for v in place[i:i + 16]) for i in range(0, len(place), 16)]
-    decls = "".join(f"int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, "
-                    "casadi_real* w, int mem);\n" for name, _, _ in blocks[1:])
-    calls = "".join(f"  res[0] = out + {off};\n  flag |= {name}(arg, res, iw, w, 0);\n"
-                    for name, _, off in blocks)
-    fs = [g for _, g, _ in blocks]
-    return ("#include <string.h>\n" + decls
-            + f"static const casadi_int {symbol}_jac_place[{max(nnz, 1)}] = {{\n  "
-            + ",\n  ".join(lines or ["0"]) + "};\n" + head
-            + f"  const casadi_real* arg[{max(4, *(g.sz_arg() for g in fs))}] = {{t, x, p, m}};\n"
-            f"  casadi_real* res[{max(1, *(g.sz_res() for g in fs))}];\n"
-            f"  casadi_int iw[{max(g.sz_iw() for g in fs) + 1}];\n"
-            f"  casadi_real w[{max(g.sz_w() for g in fs) + 1}];\n"
-            f"  int flag = 0;\n  casadi_int k;\n" + calls
-            + f"  memset(out + {nnz}, 0, sizeof(double) * {n * n - nnz});\n"
-            f"  for (k = {nnz} - 1; k >= 0; k--) {{\n"
-            f"    double v = out[k];\n"
-            f"    out[k] = 0.;\n"
-            f"    out[{symbol}_jac_place[k]] = v;\n  }}\n"
-            f"  return flag;\n}}\n")
 
 
 def _say(line: str) -> None:
@@ -429,7 +472,11 @@ def generate(machine: Machine, *, directory: Path | None = None,
     :func:`~winder.model.backends.default_route`).
     ``link``: objects linked into the machine's library with the generated code (the
     integrators). Raises :class:`CompilerMissing` without a C compiler. A cached machine
-    loads without importing CasADi (its version comes from the package metadata)."""
+    loads without importing CasADi (its version comes from the package metadata).
+
+    The Jacobian is not in this library: it is generated and compiled on first use
+    (:meth:`Generated.jacobian`) into its own library beside it, ``SYMBOL_jac.so`` (the
+    same key; the symbols of this build kept for it, else made again)."""
     from winder.model.backends import default_route
 
     route = default_route() if route is None else route
@@ -439,31 +486,29 @@ def generate(machine: Machine, *, directory: Path | None = None,
     root = Path(directory) if directory is not None else cache_dir() / "generated"
     obj = root / f"{symbol}.o"
     lib = root / (f"{symbol}-{link.key}.so" if link is not None else f"{symbol}.so")
+    name = getattr(getattr(machine, "scene", None), "name", "the machine")
     t0 = time.perf_counter()
     from_cache = lib.exists()
+    kept: list[_Symbols] = []  # the symbols of this build, for the Jacobian
+    sizes: dict[str, int] = {}
     if not from_cache:
         root.mkdir(parents=True, exist_ok=True)
         compiled = not obj.exists()
         with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
             if compiled:
-                name = getattr(getattr(machine, "scene", None), "name", "the machine")
                 _say(f"winder: building {name}'s code once ({machine.n_states} states, "
                      f"{machine.model.nbodies - 1} bodies; cached in {root})")
-                with _Compiles() as jobs:  # each function compiles while the next is made
-                    def ready(which: str, src: Path, size: int) -> None:
-                        jobs.start([*function_flags(which, size), "-c", str(src), "-o",
-                                    str(src.with_suffix(".o"))], "the generated model")
-
-                    srcs = [f for _, f, _ in _c_source(machine, symbol, Path(tmp), route,
-                                                       ready)[0]]
-                    jobs.wait()
-                tmp_obj = Path(tmp) / obj.name  # one relocatable object of the four
+                kept.append(_Symbols(machine, route))
+                srcs = _compile_sources(machine, symbol, Path(tmp), route, MAIN, kept[0],
+                                        sizes)
+                tmp_obj = Path(tmp) / obj.name  # one relocatable object of the three
                 run_compiler(["-r", "-nostdlib", *(str(s.with_suffix(".o")) for s in srcs),
                               "-o", str(tmp_obj)], "the generated model (-r)")
                 os.replace(tmp_obj, obj)
                 size = sum(s.stat().st_size for s in srcs)
                 _say(f"winder: {name}'s code built in {time.perf_counter() - t0:.1f} s "
-                     f"({size / 1024:.0f} kB of C)")
+                     f"({size / 1024:.0f} kB of C, {sum(sizes.values()):,} CasADi "
+                     "instructions; its Jacobian is built on first use)")
             tmp_lib = Path(tmp) / lib.name
             extra = [str(o) for o in link.objects] if link is not None else []
             run_compiler([*link_flags(), str(obj), *extra, "-o", str(tmp_lib), "-lm"],
@@ -473,9 +518,65 @@ def generate(machine: Machine, *, directory: Path | None = None,
     else:
         stats["cached"] += 1
     handle = ctypes.CDLL(str(lib))
-    addrs = np.array([ctypes.cast(getattr(handle, f"{symbol}_{k}_flat"), ctypes.c_void_p).value
+    addrs = np.array([0 if k == "jac" else
+                      ctypes.cast(getattr(handle, f"{symbol}_{k}_flat"), ctypes.c_void_p).value
                       for k in FUNCTIONS], dtype=np.int64)
-    return Generated(key, lib, machine.n_states, len(machine.param_names),
-                     len(machine.mode_names), len(machine.switch_names),
-                     len(machine.channel_names), addrs, time.perf_counter() - t0, from_cache,
-                     route, handle)
+
+    def make_jac(into: dict[str, int]) -> Path:
+        return _jacobian_library(machine, symbol, root, route, name,
+                                 kept[0] if kept else None, into)
+
+    gen = Generated(key, lib, machine.n_states, len(machine.param_names),
+                    len(machine.mode_names), len(machine.switch_names),
+                    len(machine.channel_names), addrs, time.perf_counter() - t0, from_cache,
+                    route, sizes, handle, None, make_jac)
+    if (root / f"{symbol}_jac.so").exists():  # built before: load it now (cheap)
+        gen.jacobian()
+    return gen
+
+
+def _compile_sources(machine: Machine, symbol: str, tmp: Path, route: str,
+                     which: tuple[str, ...], symbols: _Symbols | None,
+                     sizes: dict[str, int]) -> list[Path]:
+    """Write the C of the functions ``which`` into ``tmp`` and compile each into an object
+    beside it (one compiler process each, started as soon as its file is written); the
+    sources' paths. ``sizes``: each file's CasADi instructions, by its function's name."""
+    with _Compiles() as jobs:  # each function compiles while the next is made
+        def ready(kind: str, src: Path, size: int) -> None:
+            sizes[src.stem.rsplit("_", 1)[1]] = size
+            jobs.start([*function_flags(kind, size), "-c", str(src), "-o",
+                        str(src.with_suffix(".o"))], "the generated model")
+
+        srcs = [f for _, f, _ in _c_source(machine, symbol, tmp, route, ready, which=which,
+                                           symbols=symbols)[0]]
+        jobs.wait()
+    return srcs
+
+
+def _jacobian_library(machine: Machine, symbol: str, root: Path, route: str, name: str,
+                      symbols: _Symbols | None, sizes: dict[str, int]) -> Path:
+    """The Jacobian's library ``SYMBOL_jac.so`` in ``root``: from the cache, or generated
+    (from ``symbols`` if kept, else the machine made on symbols again) and compiled (a
+    line on stderr before, with its size, and one after if it took longer than
+    :data:`SAY_AFTER`); written atomically."""
+    lib = root / f"{symbol}_jac.so"
+    if lib.exists():
+        return lib
+    t0 = time.perf_counter()
+    root.mkdir(parents=True, exist_ok=True)
+    symbols = _Symbols(machine, route) if symbols is None else symbols
+    _say(f"winder: building {name}'s Jacobian once, on first use ({machine.n_states} "
+         f"states, {symbols.jac.nnz()} nonzeros; cached in {root})")
+    with tempfile.TemporaryDirectory(dir=root, prefix=".build-") as tmp:
+        srcs = _compile_sources(machine, symbol, Path(tmp), route, JACOBIAN, symbols, sizes)
+        tmp_lib = Path(tmp) / lib.name
+        run_compiler([*link_flags(), *(str(s.with_suffix(".o")) for s in srcs), "-o",
+                      str(tmp_lib), "-lm"], "the machine's Jacobian")
+        os.replace(tmp_lib, lib)
+        size = sum(s.stat().st_size for s in srcs)
+    stats["jacobians"] += 1
+    made = sum(v for k, v in sizes.items() if k.startswith("jac"))
+    if time.perf_counter() - t0 > SAY_AFTER:  # a short one said once (before it)
+        _say(f"winder: {name}'s Jacobian built in {time.perf_counter() - t0:.1f} s "
+             f"({size / 1024:.0f} kB of C, {made:,} CasADi instructions)")
+    return lib

@@ -15,7 +15,9 @@ Adding an integrator:
 
 1. write it in ``solve/c/NAME.c`` with the contract of ``winder_dopri5`` (``events.h``
    holds the modes, events and guard);
-2. add the file to :data:`SOURCES` and its prototype to :meth:`Kernels.__init__`;
+2. add the file to :data:`SOURCES` and its prototype to :meth:`Kernels.__init__`; one that
+   calls the Jacobian (``fns[F_JAC]``) calls :meth:`Kernels.jacobian` first (the Jacobian is
+   built on first use: until then its address is 0, and ``_check`` refuses it);
 3. call it from :mod:`winder.solve.simulate` and test it against a closed form.
 """
 
@@ -108,6 +110,7 @@ class Kernels:
         self.n_channels = generated.n_channels
         self.n_states = generated.n_states
         self.n_params = generated.n_params
+        self._generated = generated
         adaptive = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
                     _f64, _dp, _i64, _dp, _i64, _i64, _ip]
         self._dopri5 = self._fn(lib.winder_dopri5, [*adaptive, _i64, _dp, _dp, _ip])
@@ -139,13 +142,20 @@ class Kernels:
         fn.argtypes = argtypes
         return fn
 
+    def jacobian(self, fns: np.ndarray) -> np.ndarray:
+        """``fns`` with the Jacobian's address (``fns[F_JAC]``, written in place): its
+        library built on first use (:meth:`winder.model.codegen.Generated.jacobian`)."""
+        if fns[1] == 0:
+            fns[1] = self._generated.jacobian()
+        return fns
+
     def dopri5(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float,
                y: np.ndarray, p: np.ndarray, m: np.ndarray, rtol: float, atol: float,
                h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
                budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
         """DOPRI5 from ``t0`` towards ``t1`` [s] until done, an event that ends the run,
         or ``budget`` evaluations (``PAUSED``); ``h <= 0``: it picks the first step."""
-        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        n = _check(fns, table, y, m, t_out, Y_out, stats, jacobian=False)
         self._sizes(y, p)
         tr, hr, kr = _f64(), _f64(), _i64()
         status = self._dopri5(
@@ -163,8 +173,8 @@ class Kernels:
              max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int, budget: int,
              stats: np.ndarray) -> tuple[int, float, float, int]:
         """The Rosenbrock ROS2 on the exact Jacobian, as :meth:`dopri5` (``stats`` needs
-        5 counters: ``stats[4]`` counts Jacobians)."""
-        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        5 counters: ``stats[4]`` counts Jacobians; the Jacobian built on first use)."""
+        n = _check(self.jacobian(fns), table, y, m, t_out, Y_out, stats)
         self._sizes(y, p)
         if stats.shape[0] < 5:
             raise ValueError("stats must hold 5 counters")
@@ -217,7 +227,7 @@ class Kernels:
         ``[t0, t1]``."""
         if not (math.isfinite(h) and h > 0.0):
             raise ValueError(f"h must be a finite step > 0 s, got {h!r}")
-        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        n = _check(fns, table, y, m, t_out, Y_out, stats, jacobian=False)
         self._sizes(y, p)
         tr, hr, kr = _f64(), _f64(), _i64()
         status = self._rk4(
@@ -254,6 +264,8 @@ class Kernels:
         evaluation); ``out`` holds the last result. Returns the sum of ``out[0]``."""
         if not 0 <= which < 4:
             raise ValueError(f"which must be 0–3 (rhs, jac, out, sw), got {which}")
+        if which == 1:
+            self.jacobian(fns)
         y = np.ascontiguousarray(y, dtype=np.float64)
         self._sizes(y, p)
         size = (self.n_states, self.n_states ** 2, self.n_channels, self.n_switches)[which]
@@ -285,7 +297,10 @@ class Kernels:
 
 
 def _check(fns: np.ndarray, table: np.ndarray, y: np.ndarray, m: np.ndarray,
-           t_out: np.ndarray, Y_out: np.ndarray, stats: np.ndarray) -> int:
+           t_out: np.ndarray, Y_out: np.ndarray, stats: np.ndarray, *,
+           jacobian: bool = True) -> int:
+    """The arrays' shapes; ``jacobian``: the kernel calls the Jacobian, whose address must
+    be there (:meth:`Kernels.jacobian`)."""
     n = y.shape[0]
     if stats.shape[0] < 4:
         raise ValueError("stats must hold at least 4 counters")
@@ -295,6 +310,9 @@ def _check(fns: np.ndarray, table: np.ndarray, y: np.ndarray, m: np.ndarray,
         raise ValueError("table must be (slots, 5) with one mode per slot")
     if fns.shape[0] < 4:
         raise ValueError("fns must hold the 4 generated functions' addresses")
+    if jacobian and fns[1] == 0:
+        raise ValueError("fns[F_JAC] is 0: the Jacobian is built on first use; "
+                         "Kernels.jacobian(fns) builds it")
     return n
 
 

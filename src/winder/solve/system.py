@@ -64,9 +64,7 @@ class MachineSystem:
         self.fns = self.generated.addresses if self.generated is not None else None
         #: the C integrators of the machine's library (None on the numeric path)
         self.kernels = Kernels(self.generated) if self.generated is not None else None
-        self._flat = {} if self.generated is None else {
-            which: ctypes.CFUNCTYPE(ctypes.c_int, *[ctypes.c_void_p] * 5)(int(address))
-            for which, address in enumerate(self.generated.addresses)}
+        self._flat: dict[int, Any] = {}  # ctypes callers of the generated functions
         rows = [mode.table_row(m) for mode in m.modes]
         self.table = np.array(rows, dtype=np.int64).reshape(len(rows), 5)
         self.modes = np.array([mode.kind.automatic for mode in m.modes], dtype=float)
@@ -171,13 +169,19 @@ class MachineSystem:
             self._ybuf = np.empty(self.n_states)
             self._addrs = [a.ctypes.data for a in (self._tb, self._ybuf, self.params,
                                                     self.modes)]
+        fn = self._flat.get(which)
+        if fn is None:  # the Jacobian's library is built on first use
+            address = (self.generated.jacobian() if which == integ.F_JAC
+                       else int(self.generated.addresses[which]))
+            fn = self._flat[which] = ctypes.CFUNCTYPE(ctypes.c_int,
+                                                      *[ctypes.c_void_p] * 5)(address)
         buf = self._bufs.get(which)
         if buf is None:
             out = np.empty(size)
             buf = self._bufs[which] = (out, out.ctypes.data)
         self._tb[0] = t
         self._ybuf[:] = y
-        self._flat[which](*self._addrs, buf[1])
+        fn(*self._addrs, buf[1])
         return buf[0].copy()
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -193,8 +197,9 @@ class MachineSystem:
         return dy
 
     def jac(self, t: float, y: np.ndarray) -> np.ndarray:
-        """The exact Jacobian ``∂(dy/dt)/∂y`` (generated), or central differences on the
-        numeric path."""
+        """The exact Jacobian ``∂(dy/dt)/∂y`` (generated: its library built on the first
+        call, :meth:`~winder.model.codegen.Generated.jacobian`), or central differences on
+        the numeric path."""
         if self.generated is not None:
             n = self.n_states
             return self._call(integ.F_JAC, t, y, n * n).reshape(n, n, order="F")
