@@ -200,7 +200,7 @@ class Kernels:
         >= 1: the most steps one Jacobian serves (1: a new one every step). ``stats``
         needs 8 counters: [4] Jacobians, [5] factorisations, [6] dense fallbacks, [7]
         L + U nonzeros."""
-        n = _check(fns, table, y, m, t_out, Y_out, stats)
+        n = _check(self.jacobian(fns), table, y, m, t_out, Y_out, stats)
         self._sizes(y, p)
         if stats.shape[0] < 8:
             raise ValueError("stats must hold 8 counters")
