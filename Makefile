@@ -147,6 +147,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/sweep_scaling.py
 	$(PY) benchmarks/flex_speed.py
 	$(PY) benchmarks/flex_cycle.py
+	$(PY) benchmarks/event_cost.py
 
 # Side by side with MuJoCo (docs/peers.md, docs/peers.png; about 5 min of CPU time).
 peers: $(STAMP)
