@@ -149,6 +149,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/sweep_scaling.py
 	$(PY) benchmarks/flex_speed.py
 	$(PY) benchmarks/flex_cycle.py
+	$(PY) benchmarks/event_cost.py
 	$(PY) benchmarks/fit_speed.py
 	$(PY) benchmarks/doc_numbers.py --write
 

@@ -159,6 +159,7 @@ int winder_dopri5(const int64_t* fns, const int64_t* table, int64_t nslots,
         if (status != DONE)
             break;
         if (switched) {
+            cx->start_ok = 0;
             h = hh;
             rejected_last = 0;
             continue;
@@ -167,6 +168,7 @@ int winder_dopri5(const int64_t* fns, const int64_t* table, int64_t nslots,
             y[i] = y1[i];
             k1[i] = k7[i];
         }
+        step_continues(cx, t + hh < t1);
         t = t + hh < t1 ? t + hh : t1;
         double fac = 0.9 * pow(pmax(err, 1e-10), -0.2);
         fac = rejected_last ? pmin(fac, 1.0) : pmin(fac, 10.0);
@@ -174,6 +176,11 @@ int winder_dopri5(const int64_t* fns, const int64_t* table, int64_t nslots,
         rejected_last = 0;
     }
     stats[0] += nfev;
+    if (nstats > 7) {  /* where asked for: the switches' cost (events.h, Ctx) */
+        stats[5] += cx->n_sw;
+        stats[6] += cx->n_sw_locate;
+        stats[7] += cx->n_locate;
+    }
     free(cx->g);
     *t_res = t;
     *h_res = h;

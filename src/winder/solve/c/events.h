@@ -53,6 +53,17 @@ typedef struct {
     double* yt;
     double* ye;  /* guard_step's end of a cut step */
     double* rl;  /* _chord's straight path as a dense output (5 x n) */
+    int64_t ns;  /* the switch buffers' length */
+    /* the switches at an accepted step's end (next_event's, before any probe), kept as the
+     * next step's switches at its start: g_end written by this step, g_start the last
+     * step's, valid where start_ok (set by the integrator: the step began at that end) */
+    double* g_end;
+    double* g_start;
+    int start_ok;
+    int64_t n_sw;        /* switch evaluations: all of them */
+    int64_t n_sw_locate; /* of which in locate (the event's root finding) */
+    int64_t n_locate;    /* locate calls (candidate switches in accepted steps) */
+    int legacy_probe;    /* guard_step probes after a chord that found nothing (RK4) */
 } Ctx;
 
 #define TAB(s, c) (cx->table[(s) * 5 + (c)])
@@ -63,7 +74,18 @@ static inline void evaluate(Ctx* cx, int which, double t, const double* y, doubl
 }
 
 static inline void switches(Ctx* cx, double t, const double* y, double* g) {
+    cx->n_sw++;
     evaluate(cx, F_SW, t, y, g);
+}
+
+/* After an accepted step with no event that ends where the next one starts (t = t + hh
+ * exactly, y = y1): its end's switches are the next step's start's (the same function of
+ * the same t, y and modes: the same bits), so guard_step does not evaluate them again. */
+static inline void step_continues(Ctx* cx, int continues) {
+    double* g = cx->g_start;
+    cx->g_start = cx->g_end;
+    cx->g_end = g;
+    cx->start_ok = continues;
 }
 
 static inline void modes_of(Ctx* cx, double t, const double* y, int contact_auto) {
@@ -102,6 +124,8 @@ static inline double locate(Ctx* cx, int64_t gi, int new_pos, const double* rc, 
     int64_t n = cx->n;
     double* yt = cx->yt;
     double* g = cx->g;
+    int64_t before = cx->n_sw;
+    cx->n_locate++;
     dense(rc, n, 1.0, yt);
     double gb = switch_at(cx, gi, t + hh, yt, g);
     dense(rc, n, 0.0, yt);
@@ -135,6 +159,7 @@ static inline double locate(Ctx* cx, int64_t gi, int new_pos, const double* rc, 
             side = 1;
         }
     }
+    cx->n_sw_locate += cx->n_sw - before;
     return tb_;
 }
 
@@ -155,6 +180,7 @@ static inline double next_event(Ctx* cx, const double* rc, double t, double hh, 
                          int located, int64_t* slot_out, double* new_out) {
     double* g = cx->g;
     switches(cx, t + hh, y1, g);
+    memcpy(cx->g_end, g, sizeof(double) * (size_t)cx->ns);
     double best = 2.0, newm = 0.0;
     int64_t slot = -1;
     for (int64_t s = 0; s < cx->nslots; s++) {
@@ -287,7 +313,10 @@ static inline double guard_step(Ctx* cx, const double* rc, double t, double hh, 
     }
     double best = 2.0;
     int straight = 0;
-    switches(cx, t, y0, g0);
+    if (cx->start_ok)
+        memcpy(g0, cx->g_start, sizeof(double) * (size_t)cx->ns);
+    else
+        switches(cx, t, y0, g0);
     if (!(fresh && th_end >= 1.0))
         switches(cx, t + th_end * hh, ye, g);
     if (beyond_bound(cx, g) >= 0) {
@@ -295,7 +324,13 @@ static inline double guard_step(Ctx* cx, const double* rc, double t, double hh, 
         switches(cx, t + th_end * hh, ye, g);
     }
     double th = chord(cx, t, th_end * hh, y0, ye, g0, g);
-    if (th * th_end < best) {
+    /* only where the chord crosses (th <= 1; 2 is none): with th = 2 and a step cut at an
+     * event (th_end < 1) the test 2 th_end < best held, and every located event probed the
+     * dense output at 64 points for nothing (DOPRI5, ROS2: the results then discarded, y0
+     * is moved to the event and the guard's 2 th_end lies past it). RK4 keeps the old test
+     * (legacy_probe): its core events interpolate from the y0 this moves (see
+     * docs/c-integrators.md, pitfalls), recorded in its traces. */
+    if ((th <= 1.0 || cx->legacy_probe) && th * th_end < best) {
         best = th * th_end;
         straight = 1;
         for (int j = 1; j < 65; j++) {
@@ -435,12 +470,14 @@ static inline int ctx_init(Ctx* cx, const int64_t* fns, const int64_t* table, in
     for (int j = 0; j < 4; j++)
         cx->fns[j] = (wfn)(intptr_t)fns[j];
     cx->table = table; cx->nslots = nslots; cx->n = n; cx->p = p; cx->m = m;
-    double* buf = malloc(sizeof(double) * (size_t)(2 * ns + 7 * n + n_extra * n));
+    double* buf = malloc(sizeof(double) * (size_t)(4 * ns + 7 * n + n_extra * n));
     if (!buf)
         return 0;
     cx->g = buf; cx->g0 = buf + ns; cx->yt = buf + 2 * ns; cx->ye = cx->yt + n;
     cx->rl = cx->ye + n;
-    double* e = cx->rl + 5 * n;
+    cx->ns = ns; cx->g_end = cx->rl + 5 * n; cx->g_start = cx->g_end + ns; cx->start_ok = 0;
+    cx->n_sw = 0; cx->n_sw_locate = 0; cx->n_locate = 0; cx->legacy_probe = 0;
+    double* e = cx->g_start + ns;
     for (int64_t j = 0; j < n_extra; j++)
         extra[j] = e + j * n;
     return 1;

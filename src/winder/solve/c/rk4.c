@@ -26,6 +26,7 @@ int winder_rk4(const int64_t* fns, const int64_t* table, int64_t nslots,
     double* v[10];
     if (!ctx_init(cx, fns, table, nslots, n_switches, n, p, m, v, 10))
         return NO_MEMORY;
+    cx->legacy_probe = 1; /* bit-equal to its recorded traces (events.h, guard_step) */
     double *k1 = v[0], *k2 = v[1], *k3 = v[2], *k4 = v[3], *y1 = v[4], *rc = v[5];
     double* yt = cx->yt;
     modes_of(cx, t0, y, 1);
