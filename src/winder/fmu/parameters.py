@@ -125,6 +125,8 @@ def _parameters(scene: Scene) -> dict[str, tuple[ParameterPath, str, str]]:
         sub = ("span",) if web.span is not None else ()
         for path, k, unit in _flagged(".".join(("web", *sub)),
                                       web.span if sub else web):
+            if k.name == "mu":  # the capstan limit's: only a line's rollers use it
+                continue
             who = " ".join(("web", *sub)) + ": " if sub else ""
             out[k.fmu] = (("web", None, (*sub, *path)), f"{who}{k.doc} [{unit}]", unit)
     elif web is not None:  # a web line (machines.md §11): each span's, named as its channels
