@@ -16,7 +16,7 @@ with the run-time parameters ``NAME.flex.Kx_i_j`` [N/m], ``NAME.flex.Cx_i_j`` [N
 the default; issue #32) each segment has the states ``NAME_s{i}.tilt_x``, ``.tilt_z``
 [rad] and ``.tilt_rate_x``, ``.tilt_rate_z`` [rad/s] and the bending is that of
 :func:`~winder.model.beam.rotary_beam_matrices` (parameters ``Kx`` as above, ``Tx``,
-``Kwpx``, ``Kppx``, ``Cwwx``, ``Cwpx``, ``Cppx`` and their ``z``:
+``Kwpx``, ``Kppx``, ``Cwwx``, ``Cwpx``, ``Cppx``, ``beta_bendx`` and their ``z``:
 :meth:`_rotary_bending`). The bearings hold the axes a segment lists in
 ``bearing_axes`` (a drum: ``x`` and ``z``; a rider: ``x``; a roll on chucks: its free
 axes); along the others the beam is free–free (it rests on its nip). A paper roll's
@@ -119,10 +119,12 @@ class FlexBeam(ForceElement):
         ``K̂``, ``C``) and each segment's states ``tilt_{axis}`` (``φ``) and
         ``tilt_rate_{axis}`` (``s = ψ̇``), 0 at the start."""
         n = len(segs)
+        bend = bm.beta - bm.beta_rock  # on K w: C_ww = bend K + its band (module text)
+        machine.parameter(f"{body}.flex.beta_bend{axis}", bend)
         for kind, matrix, sym, band in (("K", bm.K, True, False), ("T", bm.T, False, False),
                                         ("Kwp", bm.K_wp, False, True),
                                         ("Kpp", bm.K_pp, True, True),
-                                        ("Cww", bm.C_ww, True, True),
+                                        ("Cww", bm.C_ww - bend * bm.K, True, True),
                                         ("Cwp", bm.C_wp, False, True),
                                         ("Cpp", bm.C_pp, True, True)):
             for i in range(n):
@@ -250,7 +252,9 @@ class FlexBeam(ForceElement):
         (:func:`~winder.model.beam.rotary_beam_matrices`): the rates of the segments'
         ``tilt_{axis}`` (``φ̇ = s − T ẇ``) and ``tilt_rate_{axis}`` (``ṡ = (−K_ψψ φ −
         C_ψw ẇ − C_ψψ s)/j_r``, ``j_r`` half the segment's polar inertia); returns the
-        forces on the segments ``−K w − K_wψ φ − C_ww ẇ − C_wψ s`` [N]."""
+        forces on the segments ``−K (w + b ẇ) − K_wψ φ − C'_ww ẇ − C_wψ s`` [N]: the
+        damping ``C_ww = b K + C'_ww`` split into the dense ``b K`` (``b = β − β_φ``,
+        parameter ``beta_bend{axis}``) and the band ``C'_ww = β_φ K_ww + C_b``."""
         p, n = ev.p, len(segs)
 
         def par(kind: str, i: int, j: int, sym: bool = False) -> Any:
@@ -259,11 +263,13 @@ class FlexBeam(ForceElement):
 
         phi = [ev.x(f"{s.name}.tilt_{axis}") for s in segs]
         rate = [ev.x(f"{s.name}.tilt_rate_{axis}") for s in segs]
+        bend = p(f"{body}.flex.beta_bend{axis}")
+        lead = [uj + bend * vj for uj, vj in zip(u, v, strict=True)]
         forces = []
         for i, seg in enumerate(segs):
             f: Any = 0.0
             for j in range(n):
-                f = f - par("K", i, j, True) * u[j]
+                f = f - par("K", i, j, True) * lead[j]
             g: Any = 0.0
             for j in range(max(i - 1, 0), min(i + 2, n)):
                 f = f - par("Kwp", i, j) * phi[j] - par("Cww", i, j, True) * v[j] \
