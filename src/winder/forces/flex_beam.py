@@ -16,7 +16,7 @@ with the run-time parameters ``NAME.flex.Kx_i_j`` [N/m], ``NAME.flex.Cx_i_j`` [N
 the default; issue #32) each segment has the states ``NAME_s{i}.tilt_x``, ``.tilt_z``
 [rad] and ``.tilt_rate_x``, ``.tilt_rate_z`` [rad/s] and the bending is that of
 :func:`~winder.model.beam.rotary_beam_matrices` (parameters ``Kx`` as above, ``Tx``,
-``Kwpx``, ``Kppx``, ``Cwwx``, ``Cwpx``, ``Cppx`` and their ``z``:
+``Kwpx``, ``Kppx``, ``Cwwx``, ``Cwpx``, ``Cppx``, ``beta_bendx`` and their ``z``:
 :meth:`_rotary_bending`). The bearings hold the axes a segment lists in
 ``bearing_axes`` (a drum: ``x`` and ``z``; a rider: ``x``; a roll on chucks: its free
 axes); along the others the beam is free–free (it rests on its nip). A paper roll's
@@ -123,8 +123,10 @@ class FlexBeam(ForceElement):
         are dense); and each segment's states ``tilt_{axis}`` (``φ``) and
         ``tilt_rate_{axis}`` (``s = ψ̇``), 0 at the start."""
         n = len(segs)
+        bend = bm.beta - bm.beta_rock  # on K w: C_ww = bend K + its band (module text)
+        machine.parameter(f"{body}.flex.beta_bend{axis}", bend)
         for kind, matrix, sym in (("Kww", bm.K_ww, True), ("Kwp", bm.K_wp, False),
-                                  ("Kpp", bm.K_pp, True), ("Cww", bm.C_ww, True),
+                                  ("Kpp", bm.K_pp, True), ("Cww", bm.C_ww - bend * bm.K, True),
                                   ("Cwp", bm.C_wp, False), ("Cpp", bm.C_pp, True)):
             for i in range(n):
                 for j in range(i if sym else max(i - 1, 0), min(i + 2, n)):
@@ -257,8 +259,10 @@ class FlexBeam(ForceElement):
         (:func:`~winder.model.beam.rotary_beam_matrices`): the rates of the segments'
         ``tilt_{axis}`` (``φ̇ = s − T ẇ``) and ``tilt_rate_{axis}`` (``ṡ = (−K_ψψ φ −
         C_ψw ẇ − C_ψψ s)/j_r``, ``j_r`` half the segment's polar inertia); returns the
-        forces on the segments ``−K w − K_wψ φ − C_ww ẇ − C_wψ s`` [N]. ``K`` and ``T``
-        are dense: applied as ``K w = K_ww w + K_wψ T w`` and ``T w = −K_ψψ⁻¹ K_ψw w``
+        forces on the segments ``−K (w + b ẇ) − K_wψ φ − C'_ww ẇ − C_wψ s`` [N]: the
+        damping ``C_ww = b K + C'_ww`` split into the dense ``b K`` (``b = β − β_φ``,
+        parameter ``beta_bend{axis}``) and the band ``C'_ww = β_φ K_ww + C_b``. ``K`` and
+        ``T`` are dense: applied as ``K w = K_ww w + K_wψ T w`` and ``T w = −K_ψψ⁻¹ K_ψw w``
         (banded products and the tridiagonal ``L D Lᵀ`` of ``K_ψψ``), so the cost grows
         with N, not N² (issue #33)."""
         p, n = ev.p, len(segs)
@@ -271,6 +275,8 @@ class FlexBeam(ForceElement):
 
         phi = [ev.x(f"{s.name}.tilt_{axis}") for s in segs]
         rate = [ev.x(f"{s.name}.tilt_rate_{axis}") for s in segs]
+        bend = p(f"{body}.flex.beta_bend{axis}")
+        lead = [uj + bend * vj for uj, vj in zip(u, v, strict=True)]
 
         def static_rotation(values: list[Any]) -> list[Any]:
             """``−T values = K_ψψ⁻¹ K_ψw values`` (banded product, then ``L D Lᵀ``)."""
@@ -287,14 +293,14 @@ class FlexBeam(ForceElement):
                 z[i] = z[i] - par("Pl", i + 1, -1) * z[i + 1]
             return z
 
-        y = static_rotation(u)  # ψ − φ = T w = −y
+        y = static_rotation(lead)  # −T (w + b ẇ): b K rides on K's product
         lag = static_rotation(v)  # −T ẇ
         forces = []
         for i, seg in enumerate(segs):
             f: Any = 0.0
             g: Any = 0.0
             for j in range(max(i - 1, 0), min(i + 2, n)):
-                f = f - par("Kww", i, j, True) * u[j] - par("Kwp", i, j) * (phi[j] - y[j]) \
+                f = f - par("Kww", i, j, True) * lead[j] - par("Kwp", i, j) * (phi[j] - y[j]) \
                     - par("Cww", i, j, True) * v[j] - par("Cwp", i, j) * rate[j]
                 g = g - par("Kpp", i, j, True) * phi[j] - par("Cwp", j, i) * v[j] \
                     - par("Cpp", i, j, True) * rate[j]

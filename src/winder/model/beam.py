@@ -50,8 +50,8 @@ coupling of shear and rotary inertia, the ``ρA ρI ω⁴/kGA`` of the Timoshenk
 equation: it converges with ``N`` to a limit 4.5e-5 and 6.7e-4 above the first two
 frequencies of a 6 m × Ø 1 m × 30 mm drum). So the stations keep their ``ψ`` as degrees
 of freedom of mass ``j_r``; only the massless bearing nodes are condensed, which is exact,
-giving ``K̂`` (2N × 2N, block tridiagonal) on the stations' ``(w, ψ)``; ``C = β K̂ + C_b``
-likewise, ``β = 2ζ/ω₁`` with ``ω₁`` of ``K̂ v = ω² diag(m/N, j_r) v``. The states are
+giving ``K̂`` (2N × 2N, block tridiagonal) on the stations' ``(w, ψ)``, ``ω₁`` the lowest
+non-zero ``ω`` of ``K̂ v = ω² diag(m/N, j_r) v`` and ``β = 2ζ/ω₁``. The states are
 ``φ = ψ − T w`` (the rotation beyond its static value for the deflections, ``T =
 −K_ψψ⁻¹ K_ψw``: zero in any static balance, so the balance and the start are those of the
 condensed beam) and the rotation rate ``s = ψ̇``:
@@ -63,6 +63,23 @@ condensed beam) and the rotation rate ``s = ψ̇``:
 exactly the lumped-mass Timoshenko beam (the stiffness exact, the masses ``m/N`` and
 ``j_r`` lumped at the stations), which converges to the Timoshenko frequency equation
 with rotary inertia as ``N⁻²``.
+
+**Damping of the rocking** (issue #33). In ``(w, φ)`` the stiffness is block diagonal,
+``½ wᵀ K w + ½ φᵀ K_ψψ φ``: the bending (the rotations following the deflections
+statically) and the sections' rocking ``φ`` between the stations (``j_r φ̈ ≈ −K_ψψ φ``,
+the Timoshenko beam's second spectrum, from ``ω_φ = √(μ₁(K_ψψ)/j_r)``, 1.1–1.5 kHz on the
+shipped drums and rider). Each takes its own Rayleigh damping with the one ``ζ``: ``β K``
+on the bending, ``β_φ K_ψψ`` on the rocking with ``β_φ = 2ζ/ω_φ``, so the dissipation is
+``½ β ẇᵀ K ẇ + ½ β_φ φ̇ᵀ K_ψψ φ̇``. On ``(ẇ, ψ̇)`` (``φ̇ = ψ̇ − T ẇ``)::
+
+    C_ww = (β − β_φ) K + β_φ K_ww + C_b,   C_wψ = β_φ K_wψ,   C_ψψ = β_φ K_ψψ
+
+(``β_φ = β``: ``C = β K̂ + C_b``). One ``β K̂`` on all of ``(w, ψ)`` gave the rocking the
+damping ratios ``β ω/2`` = 3.6–5 on the shipped rider (ω₁ = 20 Hz): overdamped, with
+eigenvalues to −1.3e5 1/s, which held DOPRI5's step; now they oscillate with ζ at ``ω_φ``
+(``ζ ω/ω_φ`` above), ``|λ|`` within the undamped spectrum, and the first two bending and
+torsion orders keep their frequencies within 1.6e-5 and damping ratios within 6.5e-4 of
+``β K̂`` (docs/model.md §9).
 """
 
 from __future__ import annotations
@@ -175,10 +192,11 @@ class RotaryBeamMatrices:
     ``K`` [N/m] the condensed stiffness (as :class:`BeamMatrices`), ``T`` [rad/m] the
     static rotations per deflection (``ψ = T w`` at rest), ``K_wp`` [N/rad] and ``K_pp``
     [N·m/rad] the blocks ``K_wψ``, ``K_ψψ`` of ``K̂``; ``C_ww`` [N·s/m], ``C_wp``
-    [N·s/rad] and ``C_pp`` [N·m·s/rad] those of ``C = β K̂ + C_b`` (``C_ψw = C_wpᵀ``);
-    ``beta`` [s], ``omega1`` [rad/s], ``k_t`` [N·m/rad] and ``c_t`` [N·m·s/rad] as
-    :class:`BeamMatrices`; ``K_ww`` [N/m] the block ``K_ww`` of ``K̂`` (tridiagonal:
-    ``K = K_ww + K_wψ T``)."""
+    [N·s/rad] and ``C_pp`` [N·m·s/rad] those of ``C`` (``C_ψw = C_wpᵀ``, the module
+    text's *damping of the rocking*); ``beta`` [s], ``omega1`` [rad/s], ``k_t``
+    [N·m/rad] and ``c_t`` [N·m·s/rad] as :class:`BeamMatrices`; ``K_ww`` [N/m] the block
+    ``K_ww`` of ``K̂`` (tridiagonal: ``K = K_ww + K_wψ T``); ``beta_rock`` [s] the
+    rocking's Rayleigh coefficient ``2ζ/ω_φ``, ``omega_rock`` [rad/s] its ``ω_φ``."""
 
     K: np.ndarray
     T: np.ndarray
@@ -192,6 +210,8 @@ class RotaryBeamMatrices:
     k_t: float
     c_t: float
     K_ww: np.ndarray
+    beta_rock: float = 0.0
+    omega_rock: float = 0.0
 
 
 def rotary_beam_matrices(n: int, length: float, mass: float, inertia: float, EI: float,
@@ -229,7 +249,13 @@ def rotary_beam_matrices(n: int, length: float, mass: float, inertia: float, EI:
     bending = w2[w2 > 1e-9 * scale]
     omega1 = float(np.sqrt(bending[0])) if bending.size else 0.0
     beta = 2.0 * damping_ratio / omega1 if omega1 > 0.0 else 0.0
-    C = beta * Kh + Cb
+    j_r = inertia / (2 * n)
+    omega_rock = float(np.sqrt(np.linalg.eigvalsh(K_pp)[0] / j_r))
+    beta_rock = 2.0 * damping_ratio / omega_rock
+    # β K on the deflections (the rotations following them statically), β_φ K_ψψ on the
+    # rocking φ = ψ − T w, written on (ẇ, ψ̇): the module text
+    C = beta_rock * Kh + Cb
+    C_ww = C[w, w] + (beta - beta_rock) * K
     k_t = GJ / (length / n)
-    return RotaryBeamMatrices(K, T, K_wp, K_pp, C[w, w], C[w, p], C[p, p], beta, omega1,
-                              k_t, beta * k_t, K_ww)
+    return RotaryBeamMatrices(K, T, K_wp, K_pp, C_ww, C[w, p], C[p, p], beta, omega1,
+                              k_t, beta * k_t, K_ww, beta_rock, omega_rock)

@@ -52,7 +52,8 @@ FLEX_KEYS = Table((
         doc="damping of each end bearing, per direction"),
     Key(name="damping_ratio", unit="-", lo=0.0, hi=1.0,
         doc="damping ratio ζ of the first bending mode (Rayleigh, stiffness-proportional "
-            "β = 2ζ/ω₁; torsion takes the same β)"),
+            "β = 2ζ/ω₁; torsion takes the same β; with rotary_inertia the sections' "
+            "rocking takes its own, β_φ = 2ζ/ω_φ from its lowest frequency ω_φ)"),
 ))
 
 

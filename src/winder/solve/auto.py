@@ -7,8 +7,9 @@ the spectral radius of the exact Jacobian at the start (power iteration, from be
 low ``ρ`` errs towards the second probe). A mean step above :data:`STIFF_RATIO` times the
 stable one: the step is the accuracy's, an explicit method is the right one, DOPRI5.
 (DOPRI5's own stiffness test, ``h·|Δf|/|Δy| > 3.25``, flags none of the flexible two-drum
-winder's steps, held at 0.8 of the stable step by eigenvalues near −1.3e5 s⁻¹: measured,
-so it is not used.) Otherwise the same window is integrated with RODAS4 (the exact sparse
+winder's steps, held at 0.8–0.9 of the stable step by eigenvalues near −1.0e5 s⁻¹, the
+set's torsion at its core (−1.3e5, the rider's rocking, before issue #33): measured, so it
+is not used.) Otherwise the same window is integrated with RODAS4 (the exact sparse
 Jacobian, ``rosenbrock.c``) and the faster of the two by this thread's CPU time
 (``time.thread_time``: what other processes on the machine do does not count) is chosen
 (a DOPRI5 probe under :data:`MIN_PROBE_CPU` keeps DOPRI5: nothing measurable to gain),
