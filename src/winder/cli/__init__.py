@@ -163,6 +163,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
         from winder.plots.figures import CLOSEUP_STEP, closeup_end, collected
         from winder.plots.run import run_figures
 
+        if progress:  # the figures of a large machine take several seconds: say so
+            print(f"{scene.name}: drawing the figures into {plots} ...", file=sys.stderr,
+                  flush=True)
         end = closeup_end(result)  # Fig. 8's close-up of the first lift-off, finely sampled
         closeup = None if end is None else simulate(scene, t_end=end, output_step=CLOSEUP_STEP)
         with collected() as pngs:
@@ -248,7 +251,10 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if html is not None:
         path = export_html(graph, result, html, playback=args.playback)
         print(f"animation ({args.playback:g} s playback) written to {path}")
-    if snaps is not None:
+    if snaps is not None:  # about 2 s a picture: say so before the first
+        n = len(snapshot_names(float(result.t[-1]), args.every))
+        print(f"taking {n} snapshot{'s' if n > 1 else ''} with headless Chromium into "
+              f"{snaps} (about 2 s each) ...", file=sys.stderr, flush=True)
         for path in snapshots(graph, result, snaps, every=args.every):
             print(f"  snapshot {path}")
     if html is None and snaps is None:
@@ -309,8 +315,23 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     from winder.analysis.modes import mode_map
     from winder.io.files import atomic_write, csv_writer
 
-    mm = mode_map(scene, web_speed=args.web_speed, n=args.points, radius_min=args.radius_min,
-                  radius_max=args.radius_max, _names=("--radius-min", "--radius-max"))
+    bar: list = []  # on a terminal: a bar over the map's radii (a flexible machine's take a minute)
+
+    def progress(done: int, total: int) -> None:
+        if not bar:
+            from winder.io.progress import CountProgress
+
+            bar.append(CountProgress(total, f"{scene.name} modes", units="radii"))
+        bar[0].update()
+
+    try:
+        mm = mode_map(scene, web_speed=args.web_speed, n=args.points,
+                      radius_min=args.radius_min, radius_max=args.radius_max,
+                      progress=progress if sys.stderr.isatty() else None,
+                      _names=("--radius-min", "--radius-max"))
+    finally:
+        for b in bar:
+            b.close()
     if mm.initial_state:  # no wound roll, or contact off: one row
         where = "" if math.isnan(mm.radius[0]) else \
             f", the wound roll at r = {mm.radius[0]:.3f} m"
