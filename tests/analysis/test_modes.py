@@ -268,11 +268,12 @@ def test_single_drum_scene_keeps_the_old_numbers(models_dir) -> None:
 
 
 def test_mode_map_reports_each_radius_and_the_same_map(paper_scene) -> None:
-    """``progress`` (the CLI's bar over a map's radii) is called once per radius, in order,
-    with the total, and changes nothing of the map (the oracle: the map without it)."""
+    """``progress`` (the CLI's bar over a map's radii) is called before the first radius and
+    once after each, in order, with the total, and changes nothing of the map (the oracle:
+    the map without it)."""
     calls: list[tuple[int, int]] = []
     mm = mode_map(paper_scene, n=6, progress=lambda done, total: calls.append((done, total)))
-    assert calls == [(k, 6) for k in range(1, 7)]
+    assert calls == [(k, 6) for k in range(7)]
     ref = mode_map(paper_scene, n=6)
     np.testing.assert_array_equal(mm.bounce_frequency, ref.bounce_frequency)
     np.testing.assert_array_equal(mm.radius, ref.radius)

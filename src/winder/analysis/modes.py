@@ -407,8 +407,8 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     one caliper per revolution at no slip: ``r² = r₀² + h L/π`` with ``L`` the paper brought
     in by the drive's ramp and full speed)) at ``web_speed`` [m/s] (``> 0``; default the
     scene's). Each radius starts from the operating point of the one before (continuation).
-    ``progress``: a callable ``(done, total)`` called after each radius (a progress bar), or
-    None.
+    ``progress``: a callable ``(done, total)`` called before the first radius (``done`` 0)
+    and after each (a progress bar), or None.
     A scene without a winding operating point (no wound roll, or ``[effects] contact =
     false``) gives one row, the modes of its initial state (:attr:`ModeMap.initial_state`;
     ``n`` checked and unused, ``web_speed`` [m/s] ``>= 0`` only for the drums' rotation,
@@ -453,6 +453,8 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
                             f"valid: finite radii >= {key} = {rc:g} m")
     rows = []
     prev = None
+    if progress is not None:
+        progress(0, len(radii))
     for r in radii:  # continued in radius from the previous point
         if prev is None:
             start, guess = None, None
