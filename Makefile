@@ -120,8 +120,9 @@ demo-two-drum: $(STAMP)
 	$(PY) -m winder view $(OUT)/winder_line.npz --html $(OUT)/winder_line.html --snapshots $(OUT)/snapshots_line --every 100
 
 # the flexible two-drum winder (issue #25): its first 5 s with the deflection, line-load
-# and twist figures, the animation, and its modes over the whole cycle's radii (0.05-0.6 m;
-# about 1.5 min here, plus about a minute compiling the machine's code the first time)
+# and twist figures, the animation, and its modes over the whole cycle's radii (0.05-0.6 m):
+# 67 s of CPU with an empty cache (its code's build 13 s of g++, half of it the Jacobian;
+# the modes 16 s with one BLAS thread, 80 s with two on the loaded machine)
 demo-flexible: $(STAMP)
 	$(PY) -m winder run models/two_drum_winder_flexible.toml --out $(OUT)/two_drum_winder_flexible.npz --plots $(OUT)/plots --progress
 	$(CHROMIUM_READY)
