@@ -8,14 +8,14 @@ OUT    ?= out
 .PHONY: demo test test-slow bench peers fmu docs-figures lint chromium libtbb clean venv pin-casadi \
 	scene-reference readme-numbers docs
 
-# pip --no-compile: Python compiles each module to bytecode on its first import instead of
-# pip compiling all of the 1.7 GB (a run imports a small part of it): 40 % less CPU for pip
-# (56 -> 34 s measured on the loaded 2-core machine), 0.3 s more for the first import.
+# pip compiles every module to bytecode (not --no-compile: where PYTHONDONTWRITEBYTECODE
+# is set, as in many containers, every process would then compile what it imports again:
+# measured 1.3-1.6x the CPU of each demo step, more than the 25 s pip saves once).
 $(STAMP): pyproject.toml
-	@echo "creating $(VENV) and installing winder with its dependencies (pip: 1-2 min the first time, silent for about half a minute while it unpacks)"
+	@echo "creating $(VENV) and installing winder with its dependencies (pip: 1-2 min the first time, silent for up to a minute while it unpacks and compiles)"
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --progress-bar off --no-compile -e '.[test,fmu,peers]'
+	$(PY) -m pip install --progress-bar off -e '.[test,fmu,peers]'
 	touch $(STAMP)
 
 # The pin_casadi generator (Pinocchio's C++ headers on casadi::SX, winder/model/_pin_casadi.cpp):
