@@ -8,8 +8,11 @@ OUT    ?= out
 .PHONY: demo test test-slow bench peers fmu docs-figures lint chromium libtbb clean venv pin-casadi \
 	scene-reference readme-numbers docs-numbers docs
 
+# pip compiles every module to bytecode (not --no-compile: where PYTHONDONTWRITEBYTECODE
+# is set, as in many containers, every process would then compile what it imports again:
+# measured 1.3-1.6x the CPU of each demo step, more than the 25 s pip saves once).
 $(STAMP): pyproject.toml
-	@echo "creating $(VENV) and installing winder with its dependencies (pip; about 2 min the first time)"
+	@echo "creating $(VENV) and installing winder with its dependencies (pip: 1-2 min the first time, silent for up to a minute while it unpacks and compiles)"
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --progress-bar off -e '.[test,fmu,peers]'
@@ -62,14 +65,24 @@ libtbb:
 	    || echo "warning: could not install libtbb12; the ecospy host test will be skipped"; \
 	else echo "warning: libtbb12 not found and not root; the ecospy host test will be skipped"; fi
 
-# make demo: the first result first (the paper's winding cycle), then the rest in five
-# groups, two at a time (-j2: the machine's two cores; the longest first); Chromium (for
-# the snapshots) is installed before the first group that draws them. Each group's
-# commands name their scene.
-DEMO_GROUPS := demo-flexible demo-control demo-paper demo-two-drum demo-paper-maps
+# make demo: the first result first (the paper's winding cycle, about 10 s), then the rest in
+# five groups, two at a time (-j2: the machine's two cores; the longest first, and no group
+# waits for another). BLAS runs one thread per process (two processes already fill the two
+# cores; OpenBLAS's second thread made the flexible machine's modes 6x slower on the loaded
+# machine); set OPENBLAS_NUM_THREADS to override. Chromium (for the snapshots) is installed
+# just before the first snapshots of whichever group gets there first (the others wait on
+# its lock), never before a group's simulations. Each group's commands name their scene.
+DEMO_GROUPS := demo-flexible demo-control demo-two-drum demo-paper-maps demo-paper
+CHROMIUM_READY = @if command -v flock >/dev/null 2>&1; then \
+	  flock $(VENV)/.chromium-lock $(MAKE) --no-print-directory chromium; \
+	else $(MAKE) --no-print-directory chromium; fi
 
+demo: export OPENBLAS_NUM_THREADS ?= 1
+demo: export OMP_NUM_THREADS ?= 1
 demo: $(STAMP)
+	@echo "demo: the first result, the paper's winding cycle (figures in $(OUT)/plots/)"
 	$(PY) -m winder run models/paper_winding.toml --out $(OUT)/paper_winding.csv --plots $(OUT)/plots --progress
+	@echo "demo: the other scenes, two at a time (about 4 min; out/ fills as they finish)"
 	@$(MAKE) --no-print-directory -j2 $(DEMO_GROUPS)
 	@echo "demo outputs in $(OUT)/"
 
@@ -91,15 +104,17 @@ demo-control: $(STAMP)
 	$(PY) examples/calibrate_nip.py --out $(OUT)
 	$(PY) -m winder fit models/paper_winding.toml --data $(OUT)/calibrate_nip_record.csv --param contact.stiffness --param contact.damping --out $(OUT)/fit.json --plot $(OUT)/plots/fit.png --scene-out $(OUT)/paper_winding_fitted.toml
 
-demo-paper-maps: $(STAMP) chromium
+demo-paper-maps: $(STAMP)
+	$(CHROMIUM_READY)
 	$(PY) -m winder view $(OUT)/paper_winding.npz --html $(OUT)/paper_winding.html --snapshots $(OUT)/snapshots --every 100
 	$(PY) -m winder modes models/paper_winding.toml --plot $(OUT)/plots/resonance_map.png --csv $(OUT)/modes.csv
 	$(PY) -m winder sweep models/paper_winding.toml --vary drum.drive.web_speed=10:30:11 --output-step 2e-3 --workers 1 --out $(OUT)/sweep --plot $(OUT)/plots/runnability_map.png
 
-demo-two-drum: $(STAMP) chromium
+demo-two-drum: $(STAMP)
 	$(PY) -m winder run models/two_drum_winder.toml --out $(OUT)/two_drum_winder.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder run models/winder_line_dancer.toml --t-end 60 --out $(OUT)/winder_line_dancer.npz --plots $(OUT)/plots --progress
 	$(PY) -m winder modes models/winder_line_dancer.toml --roll parent --points 60 --plot $(OUT)/plots/winder_line_dancer_modes.png --csv $(OUT)/winder_line_dancer_modes.csv
+	$(CHROMIUM_READY)
 	$(PY) -m winder view $(OUT)/winder_line_dancer.npz --html $(OUT)/winder_line_dancer.html --snapshots $(OUT)/snapshots_line_dancer --every 20
 	$(PY) -m winder view $(OUT)/two_drum_winder.npz --html $(OUT)/two_drum_winder.html --snapshots $(OUT)/snapshots_two_drum --every 100
 	$(PY) -m winder modes models/two_drum_winder.toml --plot $(OUT)/plots/two_drum_modes.png --csv $(OUT)/two_drum_modes.csv
@@ -107,10 +122,12 @@ demo-two-drum: $(STAMP) chromium
 	$(PY) -m winder view $(OUT)/winder_line.npz --html $(OUT)/winder_line.html --snapshots $(OUT)/snapshots_line --every 100
 
 # the flexible two-drum winder (issue #25): its first 5 s with the deflection, line-load
-# and twist figures, the animation, and its modes over the whole cycle's radii (0.05-0.6 m;
-# about 1.5 min here, plus about a minute compiling the machine's code the first time)
-demo-flexible: $(STAMP) chromium
+# and twist figures, the animation, and its modes over the whole cycle's radii (0.05-0.6 m):
+# 67 s of CPU with an empty cache (its code's build 13 s of g++, half of it the Jacobian;
+# the modes 16 s with one BLAS thread, 80 s with two on the loaded machine)
+demo-flexible: $(STAMP)
 	$(PY) -m winder run models/two_drum_winder_flexible.toml --out $(OUT)/two_drum_winder_flexible.npz --plots $(OUT)/plots --progress
+	$(CHROMIUM_READY)
 	$(PY) -m winder view $(OUT)/two_drum_winder_flexible.npz --html $(OUT)/two_drum_winder_flexible.html --snapshots $(OUT)/snapshots_flexible --every 1
 	$(PY) -m winder modes models/two_drum_winder_flexible.toml --radius-max 0.6 --points 40 --no-simulate --plot $(OUT)/plots/two_drum_flexible_modes.png --csv $(OUT)/two_drum_flexible_modes.csv
 

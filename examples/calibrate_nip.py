@@ -21,6 +21,7 @@ record ``calibrate_nip_record.csv`` (units in its header, for ``winder fit --dat
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
@@ -62,6 +63,9 @@ def main() -> None:
     ap.add_argument("--out", default="out", type=Path)
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
+    if sys.stderr.isatty():  # what the next tens of seconds are
+        print("calibrate_nip: simulating a record of the paper scene, then fitting the nip's "
+              "stiffness and damping to it ...", file=sys.stderr, flush=True)
     true = winder.load_scene(SCENE)
     data = record(true)
     header = ",".join(data)

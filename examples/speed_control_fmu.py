@@ -105,6 +105,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, default=ROOT / "out", help="output folder")
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
+    if sys.stderr.isatty():  # the FMU's compile takes seconds
+        print("speed_control_fmu: building the paper scene's FMU (its C code compiled) ...",
+              file=sys.stderr, flush=True)
     fmu_file = build(args.out)
     log, wall = closed_loop(fmu_file, args.t_end, args.step, progress=True)
     names, step, t_end = NAMES, args.step, args.t_end

@@ -266,6 +266,18 @@ def test_single_drum_scene_keeps_the_old_numbers(models_dir) -> None:
     np.testing.assert_array_equal(mm.slip_damping, 1.0)
 
 
+
+def test_mode_map_reports_each_radius_and_the_same_map(paper_scene) -> None:
+    """``progress`` (the CLI's bar over a map's radii) is called before the first radius and
+    once after each, in order, with the total, and changes nothing of the map (the oracle:
+    the map without it)."""
+    calls: list[tuple[int, int]] = []
+    mm = mode_map(paper_scene, n=6, progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(k, 6) for k in range(7)]
+    ref = mode_map(paper_scene, n=6)
+    np.testing.assert_array_equal(mm.bounce_frequency, ref.bounce_frequency)
+    np.testing.assert_array_equal(mm.radius, ref.radius)
+
 def _crossing_scene(paper_scene) -> winder.Scene:
     """A heavy core on a soft nip at a constant 15 m/s: the roll's once-per-revolution
     excitation crosses the bounce mode near r = 0.27 m."""

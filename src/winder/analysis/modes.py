@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -468,6 +469,7 @@ def _radius_range(where: str, lin: _Linearisation, scene: Scene, v: float,
 def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
              web_speed: float | None = None, n: int = 200, radius_min: float | None = None,
              radius_max: float | None = None, roll: str | None = None,
+             progress: Callable[[int, int], object] | None = None,
              _names: tuple[str, str] = ("radius_min", "radius_max")) -> ModeMap:
     """The resonance map over ``radii`` [m] of the wound roll (each ``>=`` its core
     radius; default: ``n`` points, 2 … 10 000, from ``radius_min`` [m] (default its initial
@@ -475,6 +477,8 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
     one caliper per revolution at no slip: ``r² = r₀² + h L/π`` with ``L`` the paper brought
     in by the drive's ramp and full speed)) at ``web_speed`` [m/s] (``> 0``; default the
     scene's). Each radius starts from the operating point of the one before (continuation).
+    ``progress``: a callable ``(done, total)`` called before the first radius (``done`` 0)
+    and after each (a progress bar), or None.
     A scene without a winding operating point (no wound roll, or ``[effects] contact =
     false``) gives one row, the modes of its initial state (:attr:`ModeMap.initial_state`;
     ``n`` checked and unused, ``web_speed`` [m/s] ``>= 0`` only for the drums' rotation,
@@ -526,6 +530,8 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
                             f"valid: finite radii >= {key} = {rc:g} m")
     rows = []
     prev = None
+    if progress is not None:
+        progress(0, len(radii))
     for r in radii:  # continued in radius from the previous point
         if prev is None:
             start, guess = None, None
@@ -534,6 +540,8 @@ def mode_map(scene: Scene, radii: np.ndarray | None = None, *,
         y = lin.solve(float(r), where, start)
         prev = (y, guess if guess is not None else lin.guess(float(r)))
         rows.append(lin.modes(y))
+        if progress is not None:
+            progress(len(rows), len(radii))
     drums = {b.segment_of or b.name: b.operating_speed(v) / (2 * math.pi)
              for b in lin.machine.bodies if b.prescribed}  # a flexible drum by its name
     surface = lin.machine.entry.a.surface_speed(v)  # the roll's surface: ratio · v

@@ -118,6 +118,13 @@ def _balance_text(residual: float, scale: float) -> str:
     return f"initial static balance: residual {residual:.1e} N of {scale:.1e} N"
 
 
+def _say(line: str) -> None:
+    """What a long step is doing, on stderr where it is a terminal (as the progress bars):
+    a log or a test's captured stderr keeps only the results and the errors."""
+    if sys.stderr.isatty():
+        print(line, file=sys.stderr, flush=True)
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     from winder.io.files import check_output_dir, check_output_file
 
@@ -163,6 +170,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
         from winder.plots.figures import CLOSEUP_STEP, closeup_end, collected
         from winder.plots.run import run_figures
 
+        if progress:  # the figures of a large machine take several seconds: say so
+            print(f"{scene.name}: drawing the figures into {plots} ...", file=sys.stderr,
+                  flush=True)
         end = closeup_end(result)  # Fig. 8's close-up of the first lift-off, finely sampled
         closeup = None if end is None else simulate(scene, t_end=end, output_step=CLOSEUP_STEP)
         with collected() as pngs:
@@ -248,7 +258,10 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if html is not None:
         path = export_html(graph, result, html, playback=args.playback)
         print(f"animation ({args.playback:g} s playback) written to {path}")
-    if snaps is not None:
+    if snaps is not None:  # about 2 s a picture: say so before the first
+        n = len(snapshot_names(float(result.t[-1]), args.every))
+        _say(f"taking {n} snapshot{'s' if n > 1 else ''} with headless Chromium into "
+             f"{snaps} (about 2 s each) ...")
         for path in snapshots(graph, result, snaps, every=args.every):
             print(f"  snapshot {path}")
     if html is None and snaps is None:
@@ -285,6 +298,7 @@ def _cmd_fmu(args: argparse.Namespace) -> int:
     out = check_output_file(args.out, "-o/--out", suffixes=(".fmu",))
     from winder.fmu.native import FMI_VERSIONS, build_fmu
 
+    _say(f"building the FMU of {args.scene} (its C code compiled; a few seconds) ...")
     out = build_fmu(args.scene, out, fmi_version=args.fmi_version,
                     speed_profile=args.speed_profile)
     print(f"FMI {args.fmi_version}.0 co-simulation and model-exchange FMU (native: no Python "
@@ -309,9 +323,24 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     from winder.analysis.modes import mode_map
     from winder.io.files import atomic_write, csv_writer
 
-    mm = mode_map(scene, web_speed=args.web_speed, n=args.points, radius_min=args.radius_min,
-                  radius_max=args.radius_max, roll=args.roll,
-                  _names=("--radius-min", "--radius-max"))
+    bar: list = []  # on a terminal: a bar over the map's radii (a flexible machine's take a minute)
+
+    def progress(done: int, total: int) -> None:
+        if not bar:
+            from winder.io.progress import CountProgress
+
+            bar.append(CountProgress(total, f"{scene.name} modes", units="radii"))
+        if done:
+            bar[0].update()
+
+    try:
+        mm = mode_map(scene, web_speed=args.web_speed, n=args.points,
+                      radius_min=args.radius_min, radius_max=args.radius_max, roll=args.roll,
+                      progress=progress if sys.stderr.isatty() else None,
+                      _names=("--radius-min", "--radius-max"))
+    finally:
+        for b in bar:
+            b.close()
     if mm.initial_state:  # no wound roll, or contact off: one row
         where = "" if math.isnan(mm.radius[0]) else \
             f", the wound roll at r = {mm.radius[0]:.3f} m"
@@ -330,6 +359,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         atomic_write(csv, csv_writer(mm.as_columns(), fmt="%.10g"))
         print(f"  table written to {csv}")
     if plot is not None:
+        _say(f"  drawing the resonance map into {plot} ...")
         from winder.plots.campbell import campbell_figure
         from winder.plots.figures import nip_colours
         from winder.solve.simulate import simulate

@@ -1,4 +1,4 @@
-"""Progress bars on stderr (tqdm): a simulation's time, a sweep's runs.
+"""Progress bars on stderr (tqdm): a simulation's time, a sweep's runs, a count of steps.
 
 On a terminal a bar is redrawn in place at most every 0.2 s; when stderr is a log file or a
 pipe each update is one whole line (no carriage returns), at most every 5 s.
@@ -13,7 +13,7 @@ from typing import TextIO
 
 from tqdm import tqdm
 
-__all__ = ["Progress", "SweepProgress"]
+__all__ = ["Progress", "SweepProgress", "CountProgress"]
 
 _TTY_INTERVAL = 0.2  # [s] between redraws on a terminal
 _LOG_INTERVAL = 5.0  # [s] between lines on a log or pipe
@@ -104,4 +104,22 @@ class SweepProgress:
 
     def close(self) -> None:
         self._postfix()
+        self.bar.close()
+
+
+class CountProgress:
+    """Progress of ``total`` steps of one computation (e.g. a resonance map's radii;
+    ``units``: what they are, plural):
+    ``update()`` after each, ``close()`` at the end."""
+
+    def __init__(self, total: int, label: str, *, units: str = "steps",
+                 stream: TextIO | None = None) -> None:
+        self.bar = _bar(stream, total=int(total), desc=label,
+                        bar_format="{desc}: {n}/{total} " + units + " |{bar:30}| {elapsed} "
+                                   "wall, {remaining} left")
+
+    def update(self) -> None:
+        self.bar.update(1)
+
+    def close(self) -> None:
         self.bar.close()
