@@ -68,9 +68,10 @@ def beam_sag(n: int) -> np.ndarray:
 def test_lone_flexible_drum_starts_in_its_sag_without_contact(n: int) -> None:
     """Contact off, no nip: every station of the drum starts in the beam's sag (measured
     relative error 2.2e-15 at N = 5, 1.0e-14 at N = 8), ``x`` on the bearings' line, and the
-    run of the speed profile stays there (measured largest deviation 4.2e-19 m against a
-    4.1e-5 m sag at N = 8, 1.0e-14 of it; before the fix it started straight and swung
-    through 7.9e-5 m)."""
+    run of the speed profile stays there (measured largest deviation 1.9e-13 m against a
+    4.1e-5 m sag at N = 8, 4.6e-9 of it: the sections' rocking, damped at its own
+    frequency since #33 (4.2e-19 m when it was overdamped), answers the spin-up; before
+    the fix it started straight and swung through 7.9e-5 m)."""
     sc = lone_drum(n)
     sys_ = MachineSystem(sc, backend="pinocchio")
     y = sys_.initial_state()
@@ -81,7 +82,7 @@ def test_lone_flexible_drum_starts_in_its_sag_without_contact(n: int) -> None:
     res = winder.simulate(sc, t_end=0.05)
     z = np.array([res[f"front_s{i}_z"] for i in range(n)])
     deviation = float(np.max(np.abs(z + want[:, None])))
-    assert deviation < 1e-12 * float(np.max(want)), (deviation, float(np.max(want)))
+    assert deviation < 5e-8 * float(np.max(want)), (deviation, float(np.max(want)))
 
 
 def test_contact_on_or_off_the_same_sag() -> None:

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["LineCoordinates", "line_coordinates", "LINE_SHARE"]
+__all__ = ["LineCoordinates", "line_coordinates", "line_summary", "LINE_SHARE"]
 
 #: The least share of its energy measure a line coordinate has in the mode it names.
 LINE_SHARE = 0.05
@@ -157,3 +157,26 @@ def line_coordinates(machine: Any, params: np.ndarray, fast: list[str],
             W[j, i] = w_
     return LineCoordinates(tuple(labels), W, np.array(moving, dtype=bool), kinetic, elastic,
                            states)
+
+
+def line_summary(mm: Any) -> list[str]:
+    """The summary lines of a map ``mm`` (:class:`~winder.analysis.modes.ModeMap`) over an
+    unwinding roll's radius: each line mode from the first to the last radius, then where
+    a harmonic of the roll's rotation meets one."""
+    out = []
+    for c, f in mm.line.items():
+        z, nat = mm.line_damping[c], mm.line_natural[c]
+        ok = np.nonzero(np.isfinite(f))[0]
+        if not len(ok):
+            out.append(f"line mode {c}: no mode of this shape over the map")
+            continue
+        i, j = ok[0], ok[-1]
+        kind = "real (no oscillation): |λ|/2π" if np.all(f[ok] == 0) else "damped"
+        shown = nat if np.all(f[ok] == 0) else f
+        out.append(f"line mode {c} {kind} {shown[i]:.2f} -> {shown[j]:.2f} Hz, damping "
+                   f"ratio {z[i]:.3f} -> {z[j]:.3f}" + ("" if len(ok) == len(f) else
+                                                        f" (at {len(ok)} of {len(f)} radii)"))
+    crossings = mm.crossings(mm.line_shown)
+    out += [f"{h} rotation of {mm.roll} meets {c} at r = {rc:.4f} m"
+            for c, h, rc in crossings]
+    return out or ["no line mode over the map"]

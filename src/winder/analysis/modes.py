@@ -45,6 +45,7 @@ import numpy as np
 
 from winder._args import integer, number, show
 from winder._errors import ArgumentError, ArgumentTypeError
+from winder.analysis.line_modes import line_summary
 from winder.analysis.operating_point import (
     WEB_SPEED_MAX,
     Mode,
@@ -350,25 +351,8 @@ class ModeMap:
         return out
 
     def _line_summary(self) -> list[str]:
-        """The lines of a map over an unwinding roll's radius: each line mode from the
-        first to the last radius, then where a harmonic of the roll's rotation meets one."""
-        out = []
-        for c, f in self.line.items():
-            z, nat = self.line_damping[c], self.line_natural[c]
-            ok = np.nonzero(np.isfinite(f))[0]
-            if not len(ok):
-                out.append(f"line mode {c}: no mode of this shape over the map")
-                continue
-            i, j = ok[0], ok[-1]
-            kind = "real (no oscillation): |λ|/2π" if np.all(f[ok] == 0) else "damped"
-            shown = nat if np.all(f[ok] == 0) else f
-            out.append(f"line mode {c} {kind} {shown[i]:.2f} -> {shown[j]:.2f} Hz, damping "
-                       f"ratio {z[i]:.3f} -> {z[j]:.3f}" + ("" if len(ok) == len(f) else
-                                                            f" (at {len(ok)} of {len(f)} radii)"))
-        crossings = self.crossings(self.line_shown)
-        out += [f"{h} rotation of {self.roll} meets {c} at r = {rc:.4f} m"
-                for c, h, rc in crossings]
-        return out or ["no line mode over the map"]
+        """The lines of a map over an unwinding roll's radius (:func:`line_summary`)."""
+        return line_summary(self)
 
     def _initial_summary(self) -> list[str]:
         """The lines of a map of the initial state: each bounce or bending mode (a flexible

@@ -244,7 +244,7 @@ class Generated:
         :attr:`addresses`."""
         if self._jac_lib is None:
             if self._make_jac is None:
-                raise RuntimeError("this machine's Jacobian cannot be built (no builder)")
+                raise CompileError("this machine's Jacobian cannot be built (no builder)")
             self._jac_lib = ctypes.CDLL(str(self._make_jac(self.sizes)))
             self._make_jac = None  # frees the symbols it kept
         address = ctypes.cast(getattr(self._jac_lib, f"{self.symbol}_jac_flat"),

@@ -116,14 +116,14 @@ def choose_method(system: Any, rtol: float, atol: float, t0: float, y0: np.ndarr
     if window <= 0.0:
         return Choice("DOPRI5", "no window to probe", 0.0)
     d = _probe(system, "DOPRI5", rtol, atol, t0, t0 + window, y0)
+    if d["cpu"] < MIN_PROBE_CPU:  # decided before the Jacobian is needed (built lazily)
+        return Choice("DOPRI5", f"DOPRI5's probe took {1e3 * d['cpu']:.2g} ms of CPU: "
+                      "nothing measurable to gain", window, {"DOPRI5": d})
     rho = spectral_radius(system.jac(t0, np.asarray(y0, dtype=float)))
     h_mean = (d["reached"] - t0) / max(d["steps"], 1)
     h_stable = DOPRI5_BOUNDARY / rho if rho > 0.0 else math.inf
     d["rho"], d["h_mean"], d["h_stable"] = rho, h_mean, h_stable
     ratio = h_mean / h_stable
-    if d["cpu"] < MIN_PROBE_CPU:
-        return Choice("DOPRI5", f"DOPRI5's probe took {1e3 * d['cpu']:.2g} ms of CPU: "
-                      "nothing measurable to gain", window, {"DOPRI5": d})
     if ratio > STIFF_RATIO:
         return Choice("DOPRI5", f"DOPRI5's mean step {h_mean:.3g} s is {ratio:.3g} times "
                       f"its stable step 3.3/rho = {h_stable:.3g} s: the accuracy's",
