@@ -182,15 +182,18 @@ def test_speed_profile_drum_keeps_its_speed_and_drive_torque() -> None:
 def test_torque_drum_keeps_its_torque_and_speed() -> None:
     """The drive torque is the input (exactly); the drive end's speed after the start the
     rigid drum's to the integrator's tolerance (rtol 1e-6; measured 2.1e-6 at 1× and 10×
-    the stiffness); its angle leads the rigid one by the twist, ∝ 1/stiffness (measured
-    5.7e-7 and 6.2e-8: 9.3 ×)."""
+    the stiffness); its angle leads the rigid one by the twist, ∝ 1/stiffness, once the
+    start has rung out (t ≥ 0.05 s; measured 5.77e-7 and 6.13e-8: 9.4 ×; over the start
+    the soft drum's first swing, ζ = 0.2 on its first torsion mode since issue #33, gives
+    7.6e-7: 12.4 ×)."""
     rigid = winder.simulate(drum_under_roll(TORQUE, rigid=True), t_end=0.3)
     flex = winder.simulate(drum_under_roll(TORQUE), t_end=0.3)
     stiff = winder.simulate(drum_under_roll(TORQUE, scale=10.0), t_end=0.3)
     assert np.all(flex["drum_torque"] == 2000.0) and np.all(rigid["drum_torque"] == 2000.0)
     assert _err(rigid, flex, "drum_speed", after=0.1) < 2e-5
     assert _err(rigid, stiff, "drum_speed", after=0.1) < 2e-5
-    ratio = _err(rigid, flex, "drum_angle") / _err(rigid, stiff, "drum_angle")
+    ratio = _err(rigid, flex, "drum_angle", after=0.05) / \
+        _err(rigid, stiff, "drum_angle", after=0.05)
     assert 7.0 < ratio < 12.0, ratio
 
 

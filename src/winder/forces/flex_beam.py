@@ -12,7 +12,9 @@ machine without flexible bodies never builds it. Per flexible body ``NAME`` with
 
 with the run-time parameters ``NAME.flex.Kx_i_j`` [N/m], ``NAME.flex.Cx_i_j`` [N·s/m]
 (``i ≤ j``, symmetric; ``Kz``, ``Cz`` likewise), ``NAME.flex.k_t`` [N·m/rad] and
-``NAME.flex.c_t`` [N·m·s/rad]. With the sections' rotary inertia (``flex.rotary_inertia``,
+``NAME.flex.c_t = β_t k_t`` [N·m·s/rad] (the chain's own Rayleigh ``β_t = 2ζ/ω_t1``,
+:func:`~winder.model.beam.torsion_damping`; a paper roll's ``β_t(r)`` from its ``J(r)`` at
+run time). With the sections' rotary inertia (``flex.rotary_inertia``,
 the default; issue #32) each segment has the states ``NAME_s{i}.tilt_x``, ``.tilt_z``
 [rad] and ``.tilt_rate_x``, ``.tilt_rate_z`` [rad/s] and the bending is that of
 :func:`~winder.model.beam.rotary_beam_matrices` (parameters ``Kx`` as above, ``Tx``,
@@ -144,7 +146,12 @@ class FlexBeam(ForceElement):
 
     def declare(self, machine: Machine) -> None:
         # NumPy: not for checking a scene
-        from winder.model.beam import beam_matrices, rotary_beam_matrices
+        from winder.model.beam import (
+            beam_matrices,
+            rotary_beam_matrices,
+            torsion_damping,
+            torsion_eigenvalue,
+        )
 
         self.groups = {}
         self.rotary = {}
@@ -176,6 +183,8 @@ class FlexBeam(ForceElement):
                 machine.parameter(f"{body}.flex.core_EI", flex.core_EI)
                 machine.parameter(f"{body}.flex.paper_E", flex.paper_E)
                 machine.parameter(f"{body}.flex.k_t", unit.k_t)
+                machine.parameter(f"{body}.flex.nu_t1",
+                                  torsion_eigenvalue(n, held=first.prescribed))
                 machine.channel(TWIST, body)
                 continue
             self.rotary[body] = flex.rotary_inertia
@@ -196,7 +205,9 @@ class FlexBeam(ForceElement):
                             machine.parameter(f"{body}.flex.{kind}{axis}_{i}_{j}",
                                               matrix[i, j])
             machine.parameter(f"{body}.flex.k_t", bm.k_t)  # the same for x and z
-            machine.parameter(f"{body}.flex.c_t", bm.c_t)
+            _, c_t = torsion_damping(n, bm.k_t, part.inertia / n, flex.damping_ratio,
+                                     held=first.prescribed)
+            machine.parameter(f"{body}.flex.c_t", c_t)
             machine.channel(TWIST, body)
         self.sliced = {}
         for nip in machine.nips:
@@ -215,7 +226,9 @@ class FlexBeam(ForceElement):
         """A paper roll's bending, ``EI(r) K₁ (u + β u̇)`` with ``EI(r) = core_EI +
         paper_E·π (r⁴ − r_c⁴)/4`` [N·m²] and ``β = 2ζ/ω₁(r)``, ``ω₁² = EI μ₁ / (m/N)``
         (``K₁``, ``μ₁``: the free–free chain of unit ``EI`` and unit segment mass); its
-        torsion spring and damper ``(k_t, β k_t)``."""
+        torsion spring and damper ``(k_t, β_t k_t)``, ``β_t = 2ζ/ω_t1(r)``, ``ω_t1² = ν₁
+        k_t/I_d(r)`` (``I_d`` a segment's share of ``J(r)``, ``ν₁`` parameter ``nu_t1``:
+        :func:`~winder.model.beam.torsion_damping`)."""
         p = ev.p
         r, rc = states[0].r, p(f"{body}.core_radius")
         r2, rc2 = r * r, rc * rc
@@ -250,7 +263,9 @@ class FlexBeam(ForceElement):
                 fz = fz - k * (uz[j] + beta * vz[j])
             ev.add_force(seg.name, fx if "x" in free else 0.0, fz if "z" in free else 0.0)
         kt = p(f"{body}.flex.k_t")
-        return kt, beta * kt
+        beta_t = 2.0 * p(f"{body}.flex.damping_ratio") \
+            / ev.mathns.sqrt(p(f"{body}.flex.nu_t1") * kt / states[0].inertia)
+        return kt, beta_t * kt
 
     @staticmethod
     def _rotary_bending(ev: Evaluation, body: str, segs: list[Any], axis: str,

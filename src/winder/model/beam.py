@@ -35,11 +35,17 @@ bearing deflections ``w_b = T w`` (``T = −K_cc⁻¹ K_cr``, its bearing rows):
 onto the stations, ``C_b = c_b Σ_ends t_endᵀ t_end``. The beam's own damping is
 stiffness-proportional (Rayleigh, ``β K``) with ``β = 2 ζ / ω₁``: the first bending mode
 (the lowest non-zero ``ω`` of ``K w = ω² (m/N) w``) has the damping ratio ``ζ``
-(``damping_ratio``); the rigid-body modes of a free beam are not damped. Torsion uses the
-same ``β``.
+(``damping_ratio``); the rigid-body modes of a free beam are not damped.
 
-**Torsion.** Neighbouring segments are joined by a spring ``k_t = GJ / h`` [N·m/rad]; a
-chain of ``N`` free disks ``I_d`` has ``ω_k = 2 √(k_t / I_d) sin(k π / 2N)``.
+**Torsion** (:func:`torsion_damping`). Neighbouring segments are joined by a spring ``k_t =
+GJ / h`` [N·m/rad]; a chain of ``N`` free disks ``I_d`` has ``ω_k = 2 √(k_t / I_d) sin(k π /
+2N)``, held at its driven segment 0 (a speed profile) the ``N − 1`` others ``ω_k = 2 √(k_t /
+I_d) sin((2k − 1) π / (2 (2N − 1)))``. Its damper ``c_t = β_t k_t`` between neighbours is
+Rayleigh on the chain with its own ``β_t = 2ζ/ω_t1`` (issue #33), ``ω_t1`` the chain's first
+torsion frequency (held or free as the body is driven): its first mode has the damping ratio
+``ζ``, mode ``k`` ``ζ ω_k/ω_t1``. (The bending's ``β``, first used here too, gave the chain
+``ζ ω_k/ω₁``: on the shipped paper set at its core 2.3 on its top modes, eigenvalues to
+−1.0e5 1/s.)
 
 **Rotary inertia** (issue #32, :func:`rotary_beam_matrices`). The cross-section's inertia
 about a bending axis, ``j_r = J/(2N)`` [kg·m²] per station (half the segment's polar
@@ -84,12 +90,14 @@ torsion orders keep their frequencies within 1.6e-5 and damping ratios within 6.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = ["BeamMatrices", "beam_matrices", "element_stiffness", "station_flexibility",
-           "RotaryBeamMatrices", "rotary_beam_matrices"]
+           "RotaryBeamMatrices", "rotary_beam_matrices", "torsion_eigenvalue",
+           "torsion_damping"]
 
 
 @dataclass(frozen=True)
@@ -97,15 +105,14 @@ class BeamMatrices:
     """The condensed matrices of a flexible body: ``K`` [N/m] and ``C`` [N·s/m] (N × N,
     on the stations' deflections, ``C = β K + C_b``), ``beta`` [s] the Rayleigh
     coefficient, ``omega1`` [rad/s] the first bending frequency (``0``: none),
-    ``k_t`` [N·m/rad] and ``c_t = β k_t`` [N·m·s/rad] the torsion spring and damper
-    between neighbouring segments."""
+    ``k_t`` [N·m/rad] the torsion spring between neighbouring segments (its damper:
+    :func:`torsion_damping`)."""
 
     K: np.ndarray
     C: np.ndarray
     beta: float
     omega1: float
     k_t: float
-    c_t: float
 
 
 def element_stiffness(EI: float, kGA: float | None, length: float) -> np.ndarray:
@@ -163,7 +170,7 @@ def beam_matrices(n: int, length: float, mass: float, EI: float, kGA: float | No
     omega1 = float(np.sqrt(bending[0])) if bending.size else 0.0
     beta = 2.0 * damping_ratio / omega1 if omega1 > 0.0 else 0.0
     k_t = GJ / (length / n)
-    return BeamMatrices(K, beta * K + Cb, beta, omega1, k_t, beta * k_t)
+    return BeamMatrices(K, beta * K + Cb, beta, omega1, k_t)
 
 
 def station_flexibility(n: int, length: float, EI: float, kGA: float | None,
@@ -193,8 +200,8 @@ class RotaryBeamMatrices:
     static rotations per deflection (``ψ = T w`` at rest), ``K_wp`` [N/rad] and ``K_pp``
     [N·m/rad] the blocks ``K_wψ``, ``K_ψψ`` of ``K̂``; ``C_ww`` [N·s/m], ``C_wp``
     [N·s/rad] and ``C_pp`` [N·m·s/rad] those of ``C`` (``C_ψw = C_wpᵀ``, the module
-    text's *damping of the rocking*); ``beta`` [s], ``omega1`` [rad/s], ``k_t``
-    [N·m/rad] and ``c_t`` [N·m·s/rad] as :class:`BeamMatrices`; ``K_ww`` [N/m] the block
+    text's *damping of the rocking*); ``beta`` [s], ``omega1`` [rad/s] and ``k_t``
+    [N·m/rad] as :class:`BeamMatrices`; ``K_ww`` [N/m] the block
     ``K_ww`` of ``K̂`` (tridiagonal: ``K = K_ww + K_wψ T``); ``beta_rock`` [s] the
     rocking's Rayleigh coefficient ``2ζ/ω_φ``, ``omega_rock`` [rad/s] its ``ω_φ``."""
 
@@ -208,7 +215,6 @@ class RotaryBeamMatrices:
     beta: float
     omega1: float
     k_t: float
-    c_t: float
     K_ww: np.ndarray
     beta_rock: float = 0.0
     omega_rock: float = 0.0
@@ -258,4 +264,24 @@ def rotary_beam_matrices(n: int, length: float, mass: float, inertia: float, EI:
     C_ww = C[w, w] + (beta - beta_rock) * K
     k_t = GJ / (length / n)
     return RotaryBeamMatrices(K, T, K_wp, K_pp, C_ww, C[w, p], C[p, p], beta, omega1,
-                              k_t, beta * k_t, K_ww, beta_rock, omega_rock)
+                              k_t, K_ww, beta_rock, omega_rock)
+
+
+def torsion_eigenvalue(n: int, *, held: bool) -> float:
+    """``ν₁`` [-]: the least non-zero eigenvalue of the torsion chain of ``n`` ≥ 2 disks at
+    unit ``k_t`` and unit disk inertia (its first frequency ``ω_t1 = √(ν₁ k_t/I_d)``):
+    ``4 sin²(π/(2n))`` free, ``4 sin²(π/(2 (2n − 1)))`` held at segment 0 (the module text)."""
+    if n < 2:
+        raise ValueError(f"torsion_eigenvalue: n must be at least 2, got {n}")
+    angle = math.pi / (2 * (2 * n - 1)) if held else math.pi / (2 * n)
+    return 4.0 * math.sin(angle) ** 2
+
+
+def torsion_damping(n: int, k_t: float, disk_inertia: float, damping_ratio: float, *,
+                    held: bool) -> tuple[float, float]:
+    """The torsion chain's own Rayleigh damping (the module text): ``(ω_t1, c_t)``, its first
+    frequency [rad/s] and the damper ``c_t = β_t k_t`` [N·m·s/rad] between neighbours,
+    ``β_t = 2ζ/ω_t1``, for ``n`` segments of polar inertia ``disk_inertia`` [kg·m²] joined
+    by ``k_t`` [N·m/rad], ``held`` at segment 0 (a speed profile) or free."""
+    omega = math.sqrt(torsion_eigenvalue(n, held=held) * k_t / disk_inertia)
+    return omega, 2.0 * damping_ratio / omega * k_t

@@ -52,8 +52,11 @@ FLEX_KEYS = Table((
         doc="damping of each end bearing, per direction"),
     Key(name="damping_ratio", unit="-", lo=0.0, hi=1.0,
         doc="damping ratio ζ of the first bending mode (Rayleigh, stiffness-proportional "
-            "β = 2ζ/ω₁; torsion takes the same β; with rotary_inertia the sections' "
-            "rocking takes its own, β_φ = 2ζ/ω_φ from its lowest frequency ω_φ)"),
+            "β = 2ζ/ω₁), of the first torsion mode (the chain's own β_t = 2ζ/ω_t1, ω_t1 "
+            "the chain's first torsion frequency, held at the drive end under a speed "
+            "profile, else free; a paper roll's from its J(r) at run time) and, with "
+            "rotary_inertia, of the sections' rocking (β_φ = 2ζ/ω_φ from its lowest "
+            "frequency ω_φ); higher modes of each grow with their frequency"),
 ))
 
 

@@ -8,10 +8,12 @@ low ``ρ`` errs towards the second probe). A mean step above :data:`STIFF_RATIO`
 stable one: the step is the accuracy's, an explicit method is the right one, DOPRI5.
 (DOPRI5's own stiffness test, ``h·|Δf|/|Δy| > 3.25``, flags none of the flexible two-drum
 winder's steps, held at 0.8–0.9 of the stable step by eigenvalues near −1.0e5 s⁻¹, the
-set's torsion at its core (−1.3e5, the rider's rocking, before issue #33): measured, so it
-is not used.) Otherwise the same window is integrated with RODAS4 (the exact sparse
-Jacobian, ``rosenbrock.c``) and the faster of the two by this thread's CPU time
-(``time.thread_time``: what other processes on the machine do does not count) is chosen
+set's torsion at its core before it had its own Rayleigh β_t (−1.3e5, the rider's
+rocking, before its β_φ; both issue #33; now −8.9e3, the rider nip's friction
+relaxation): measured, so it is not used.) Otherwise the same window is integrated with
+RODAS4 (the exact sparse Jacobian, ``rosenbrock.c``) and the faster of the two by this
+thread's CPU time (``time.thread_time``: what other processes on the machine do does not
+count) is chosen
 (a DOPRI5 probe under :data:`MIN_PROBE_CPU` keeps DOPRI5: nothing measurable to gain),
 RODAS4 only where it takes less than :data:`MARGIN` of DOPRI5's time (a close call stays
 with DOPRI5, whose results are the shipped references'). ``docs/work_precision.md``
