@@ -1,9 +1,9 @@
 """The integrators in C, linked into every machine's library (issue #23).
 
 ``solve/c/`` holds them: ``events.h`` (the shared mode table, event location and guard),
-``dopri5.c``, ``rk4.c``, ``ros2.c``, ``rosenbrock.c`` (RODAS3/4 with ``sparse_lu.h``) and
-``machine.c`` (the modes and channels of a
-trajectory). :func:`link` compiles them once into objects (cached under
+``dopri5.c``, ``rk4.c``, ``ros2.c``, ``rosenbrock.c`` (RODAS3/4 with ``sparse_lu.h``; both
+with ``dense_lu.h``) and ``machine.c`` (the modes and channels of a trajectory).
+:func:`link` compiles them once into objects (cached under
 :func:`~winder.model.codegen.cache_dir`, keyed by every source and header and the flags:
 the generated code's plus ``-ffp-contract=off -std=c99``, so no fused multiply–add
 changes a rounding), and :func:`winder.model.codegen.generate` links them with each

@@ -24,6 +24,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dense_lu.h"
+
 typedef struct {
     int64_t n;
     unsigned char* pat;  /* n x n, pat[r + n * c]: J[r, c] may be nonzero (original order,
@@ -161,36 +163,6 @@ static int slu_symbolic(Slu* s) {
     return 1;
 }
 
-/* Dense LU with partial pivoting of the row-major A (ros2.c's); 0 if singular. */
-static int slu_dense_lu(int64_t n, double* A, int64_t* piv) {
-    for (int64_t k = 0; k < n; k++) {
-        int64_t p = k;
-        double big = fabs(A[k * n + k]);
-        for (int64_t i = k + 1; i < n; i++)
-            if (fabs(A[i * n + k]) > big) {
-                big = fabs(A[i * n + k]);
-                p = i;
-            }
-        if (big == 0.0 || !isfinite(big))
-            return 0;
-        piv[k] = p;
-        if (p != k)
-            for (int64_t j = 0; j < n; j++) {
-                double a = A[k * n + j];
-                A[k * n + j] = A[p * n + j];
-                A[p * n + j] = a;
-            }
-        double inv = 1.0 / A[k * n + k];
-        for (int64_t i = k + 1; i < n; i++) {
-            double f = A[i * n + k] *= inv;
-            if (f != 0.0)
-                for (int64_t j = k + 1; j < n; j++)
-                    A[i * n + j] -= f * A[k * n + j];
-        }
-    }
-    return 1;
-}
-
 /* Factor W = d I - J (jac column-major); 0 if singular (or no memory: *nomem). */
 static int slu_factor(Slu* s, const double* jac, double d, int* nomem) {
     int64_t n = s->n;
@@ -243,7 +215,7 @@ dense:  /* a small pivot on the static pattern: the dense LU with partial pivoti
     for (int64_t i = 0; i < n; i++)
         for (int64_t j = 0; j < n; j++)
             W[i * n + j] = (i == j ? d : 0.0) - jac[i + n * j];
-    return slu_dense_lu(n, W, s->piv);
+    return lu(n, W, s->piv);
 }
 
 /* b := W^-1 b. */
@@ -251,26 +223,7 @@ static void slu_solve(const Slu* s, double* b) {
     int64_t n = s->n;
     const double* W = s->W;
     if (s->dense) {
-        for (int64_t k = 0; k < n; k++) {
-            int64_t p = s->piv[k];
-            if (p != k) {
-                double a = b[k];
-                b[k] = b[p];
-                b[p] = a;
-            }
-        }
-        for (int64_t i = 0; i < n; i++) {
-            double v = b[i];
-            for (int64_t j = 0; j < i; j++)
-                v -= W[i * n + j] * b[j];
-            b[i] = v;
-        }
-        for (int64_t i = n - 1; i >= 0; i--) {
-            double v = b[i];
-            for (int64_t j = i + 1; j < n; j++)
-                v -= W[i * n + j] * b[j];
-            b[i] = v / W[i * n + i];
-        }
+        lu_solve(n, W, s->piv, b);
         return;
     }
     double* x = s->x;
