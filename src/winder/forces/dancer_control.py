@@ -22,7 +22,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from winder._schema import Channel
-from winder.forces._base import ForceElement
+from winder.forces._unwind import UnwindController
 
 if TYPE_CHECKING:
     from winder.model.machine import Evaluation, Machine, Web
@@ -30,7 +30,7 @@ if TYPE_CHECKING:
 __all__ = ["DancerController"]
 
 
-class DancerController(ForceElement):
+class DancerController(UnwindController):
     """The unwind's dancer controller, one per dancer-controlled unwinding roll."""
 
     name = "dancer_control"
@@ -38,25 +38,14 @@ class DancerController(ForceElement):
                         doc="the dancer controller's error: the carriage position d "
                             "(set-point 0)"),)
     provides = frozenset({"drive_torque"})
+    HOLDS = "dancer"  # the drive key of what it holds (it changes the generated code)
 
     def declare(self, machine: Machine) -> None:
-        for w in machine.webs:
+        for w in self.controlled(machine):
             b = w.unwind
-            if b is None or self.name not in b.drives:
-                continue
             machine.parameter(f"{b.name}.bandwidth", b.part.drive.bandwidth)
             machine.state(f"{b.name}.position_integral", 0.0)
             machine.channel(self.CHANNELS[0], w.span_channel)
-
-    def structure_tag(self, machine: Machine) -> str:
-        """The dancer each controlled unwind holds (it changes the generated code)."""
-        return ",".join(f"{w.unwind.name}:{w.unwind.part.drive.dancer}" for w in machine.webs
-                        if w.unwind is not None and self.name in w.unwind.drives)
-
-    def apply(self, ev: Evaluation) -> None:
-        for w in ev.machine.webs:
-            if w.unwind is not None and self.name in w.unwind.drives:
-                self._control(ev, w)
 
     @staticmethod
     def _control(ev: Evaluation, w: Web) -> None:

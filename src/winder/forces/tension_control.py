@@ -52,7 +52,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from winder._schema import Channel
-from winder.forces._base import ForceElement
+from winder.forces._unwind import UnwindController
 
 if TYPE_CHECKING:
     from winder.model.machine import Evaluation, Machine, Web
@@ -87,7 +87,7 @@ def tension_gains(bandwidth: Any, g: Any, r: Any, transport: Any = None
     return 3.0 * bandwidth * bandwidth / g - r - kd * transport, bandwidth ** 3 / g, kd
 
 
-class TensionController(ForceElement):
+class TensionController(UnwindController):
     """The unwind's tension controller, one per tension-controlled unwinding roll (on the
     span ``span`` of its web); state ``ROLL.tension_integral`` [N·s]."""
 
@@ -96,26 +96,15 @@ class TensionController(ForceElement):
                         doc="the unwind controller's error T* − T"),)
     requires = frozenset({"span_rate"})
     provides = frozenset({"drive_torque"})
+    HOLDS = "span"  # the drive key of what it holds (it changes the generated code)
 
     def declare(self, machine: Machine) -> None:
-        for w in machine.webs:
+        for w in self.controlled(machine):
             b = w.unwind
-            if b is None or self.name not in b.drives:
-                continue
             machine.parameter(f"{b.name}.tension_setpoint", b.part.drive.tension)
             machine.parameter(f"{b.name}.bandwidth", b.part.drive.bandwidth)
             machine.state(f"{b.name}.tension_integral", 0.0)
             machine.channel(self.CHANNELS[0], w.span_channel)
-
-    def structure_tag(self, machine: Machine) -> str:
-        """The span each controlled unwind holds (it changes the generated code)."""
-        return ",".join(f"{w.unwind.name}:{w.unwind.part.drive.span}" for w in machine.webs
-                        if w.unwind is not None and self.name in w.unwind.drives)
-
-    def apply(self, ev: Evaluation) -> None:
-        for w in ev.machine.webs:
-            if w.unwind is not None and self.name in w.unwind.drives:
-                self._control(ev, w)
 
     @staticmethod
     def _control(ev: Evaluation, w: Web) -> None:
