@@ -1,8 +1,9 @@
 """The integrators in C, linked into every machine's library (issue #23).
 
 ``solve/c/`` holds them: ``events.h`` (the shared mode table, event location and guard),
-``dopri5.c``, ``rk4.c``, ``ros2.c``, ``rosenbrock.c`` (RODAS3/4 with ``sparse_lu.h``; both
-with ``dense_lu.h``) and ``machine.c`` (the modes and channels of a trajectory).
+``dopri5.c``, ``dop853.c`` (DOP853: order 8, 7th-order dense output), ``rk4.c``,
+``ros2.c``, ``rosenbrock.c`` (RODAS3/4 with ``sparse_lu.h``; both with ``dense_lu.h``) and
+``machine.c`` (the modes and channels of a trajectory).
 :func:`link` compiles them once into objects (cached under
 :func:`~winder.model.codegen.cache_dir`, keyed by every source and header and the flags:
 the generated code's plus ``-ffp-contract=off -std=c99``, so no fused multiply–add
@@ -40,7 +41,7 @@ __all__ = ["Kernels", "link", "SOURCES", "EXTRA_CFLAGS", "ROSENBROCK"]
 
 _DIR = Path(__file__).resolve().parent / "c"
 #: The translation units (each includes ``events.h``).
-SOURCES = ("dopri5.c", "rk4.c", "ros2.c", "rosenbrock.c", "machine.c")
+SOURCES = ("dopri5.c", "dop853.c", "rk4.c", "ros2.c", "rosenbrock.c", "machine.c")
 #: Flags beyond the generated code's: no contraction into FMA.
 EXTRA_CFLAGS = ("-ffp-contract=off", "-std=c99")
 
@@ -114,6 +115,7 @@ class Kernels:
         adaptive = [_ip, _ip, _i64, _i64, _f64, _f64, _dp, _i64, _dp, _dp, _f64, _f64, _f64,
                     _f64, _dp, _i64, _dp, _i64, _i64, _ip]
         self._dopri5 = self._fn(lib.winder_dopri5, [*adaptive, _i64, _dp, _dp, _ip])
+        self._dop853 = self._fn(lib.winder_dop853, [*adaptive, _i64, _dp, _dp, _ip])
         self._ros2 = self._fn(lib.winder_ros2, [*adaptive, _dp, _dp, _ip])
         self._rodas = self._fn(lib.winder_rodas, [*adaptive[:-1], _i64, _i64, _ip, _dp, _dp,
                                                   _ip])
@@ -155,10 +157,29 @@ class Kernels:
                budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
         """DOPRI5 from ``t0`` towards ``t1`` [s] until done, an event that ends the run,
         or ``budget`` evaluations (``PAUSED``); ``h <= 0``: it picks the first step."""
+        return self._explicit(self._dopri5, fns, table, t0, t1, y, p, m, rtol, atol, h,
+                              max_step, t_out, Y_out, k, budget, stats)
+
+    def dop853(self, fns: np.ndarray, table: np.ndarray, t0: float, t1: float,
+               y: np.ndarray, p: np.ndarray, m: np.ndarray, rtol: float, atol: float,
+               h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
+               budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
+        """DOP853 (``dop853.c``: Hairer's explicit method of order 8, scipy's tableau,
+        error estimator, step control and 7th-order dense output) as :meth:`dopri5`: 12
+        evaluations a step, 3 more on a step whose dense output is used (samples, events);
+        ``stats[4]`` counts Hairer's stiff steps (``h·|Δf|/|Δy| > 6.1``)."""
+        return self._explicit(self._dop853, fns, table, t0, t1, y, p, m, rtol, atol, h,
+                              max_step, t_out, Y_out, k, budget, stats)
+
+    def _explicit(self, fn: Any, fns: np.ndarray, table: np.ndarray, t0: float, t1: float,
+                  y: np.ndarray, p: np.ndarray, m: np.ndarray, rtol: float, atol: float,
+                  h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
+                  budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
+        """One call of an explicit kernel (DOPRI5's arguments) with ``fn``."""
         n = _check(fns, table, y, m, t_out, Y_out, stats, jacobian=False)
         self._sizes(y, p)
         tr, hr, kr = _f64(), _f64(), _i64()
-        status = self._dopri5(
+        status = fn(
             _ptr(fns, np.int64, "fns"), _ptr(table, np.int64, "table"), table.shape[0],
             self.n_switches, float(t0), float(t1), _ptr(y, np.float64, "y", True), n,
             _ptr(p, np.float64, "p"), _ptr(m, np.float64, "m", True), float(rtol),

@@ -37,9 +37,10 @@ __all__ = ["simulate", "DEFAULT_METHOD", "resolve_method", "COMPILED_METHODS", "
 
 #: What ``method="auto"`` picks (chosen from the work–precision study, docs/), per backend.
 DEFAULT_METHOD = MappingProxyType({"compiled": "DOPRI5", "pinocchio": "LSODA"})
-#: Methods that run entirely compiled (generated code only); ROS2 is the Rosenbrock method
-#: of :mod:`winder.solve.rosenbrock` (stiff machines, exact Jacobian).
-COMPILED_METHODS = ("DOPRI5", "ROS2", "RODAS3", "RODAS4", "ROS34PW2")
+#: Methods that run entirely compiled (generated code only); DOP853C is DOP853 in C
+#: (``solve/c/dop853.c``; "DOP853" is scipy's, step by step from Python); ROS2 is the
+#: Rosenbrock method of ``solve/c/ros2.c`` (stiff machines, exact Jacobian).
+COMPILED_METHODS = ("DOPRI5", "DOP853C", "ROS2", "RODAS3", "RODAS4", "ROS34PW2")
 #: Largest output grid :func:`simulate` allocates (about 2 GB of channels at the limit).
 #: Jacobians for scipy's implicit methods: ``exact`` (generated; ``pinocchio`` is its old
 #: name) or ``fd`` (the integrator's finite differences).
@@ -125,7 +126,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
     fns, table, p, modes = system.fns, system.table, system.params, system.modes.copy()
     lib = system.kernels  # the C integrators of the machine's library
     dopri5, rk4, ros2 = lib.dopri5, lib.rk4, lib.ros2
-    runs = {"DOPRI5": dopri5, "ROS2": ros2, **{
+    runs = {"DOPRI5": dopri5, "DOP853C": lib.dop853, "ROS2": ros2, **{
         name: functools.partial(lib.rodas, order=order, reuse=reuse)
         for name, (order, reuse) in ROSENBROCK.items()}}
     for tb in breaks:
@@ -146,7 +147,7 @@ def _run_compiled(meth: str, system: MachineSystem, y: np.ndarray, t_out: np.nda
                                             Ys, k, stats)
             at[:] = [t, h, k]
             guards.steps = int(stats[1])
-            if meth == "DOPRI5":
+            if meth in ("DOPRI5", "DOP853C"):
                 guards.stiff_steps = int(stats[4])
             if status == integ.NON_FINITE or not np.all(np.isfinite(y)):
                 raise guards.error(f"the state went non-finite with method {meth!r}; try a "
@@ -200,7 +201,8 @@ def simulate(scene: Scene | str | os.PathLike, *, t_end: float | None = None,
     t_end: end time [s], finite and > 0 (default: ``[scene] duration``).
     method: one of ``auto`` (compiled: DOPRI5 or RODAS4 by a short probe,
         :func:`winder.solve.auto.choose_method`, its numbers in ``meta["auto"]``; else
-        :data:`DEFAULT_METHOD`), DOPRI5 (compiled Dormand–Prince with contact events), RK4
+        :data:`DEFAULT_METHOD`), DOPRI5 (compiled Dormand–Prince with contact events),
+        DOP853C (compiled DOP853, order 8: fewer evaluations at tight tolerances), RK4
         (fixed step ``max_step``, default 1 ms), ROS2 (compiled Rosenbrock on the exact
         Jacobian), RODAS4, RODAS3, ROS34PW2 (compiled Rosenbrock methods on the exact
         Jacobian factored on its sparsity, for machines with fast damped modes), or

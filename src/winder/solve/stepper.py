@@ -69,16 +69,17 @@ class Stepper:
         finite in (0, 0.1], atol finite in (0, 1e-3] [state units].
     max_rhs, max_wall: budget of each :meth:`step`: evaluations and wall-clock seconds
         (default ``[solver] max_rhs``, else 50 million, and ``max_wall``).
-    method: the compiled integrator inside each step: ``DOPRI5`` (default), or one of the
-        Rosenbrock methods ``RODAS4``, ``RODAS3``, ``ROS34PW2`` (stiff machines: exact
-        sparse Jacobian), or ``auto`` (:func:`winder.solve.auto.choose_method`'s probe).
+    method: the compiled integrator inside each step: ``DOPRI5`` (default), ``DOP853C``
+        (order 8: fewer evaluations at tight tolerances), or one of the Rosenbrock methods
+        ``RODAS4``, ``RODAS3``, ``ROS34PW2`` (stiff machines: exact sparse Jacobian), or
+        ``auto`` (:func:`winder.solve.auto.choose_method`'s probe).
     """
 
     def __init__(self, scene: Scene | str | os.PathLike, *, rtol: float = 1e-8,
                  atol: float = 1e-10, max_rhs: int | None = None,
                  max_wall: float | None = None, method: str = "DOPRI5") -> None:
         scene = _as_scene(scene)
-        valid = ("auto", "DOPRI5", *ROSENBROCK)
+        valid = ("auto", "DOPRI5", "DOP853C", *ROSENBROCK)
         if not isinstance(method, str) or method not in valid:
             raise ArgumentError(f"method = {method!r} is not a Stepper method; valid: "
                                 f"{', '.join(valid)}")
@@ -101,7 +102,8 @@ class Stepper:
         #: the integrator inside each step
         self.method = method
         k = self.system.kernels
-        self._run = k.dopri5 if method == "DOPRI5" else functools.partial(
+        explicit = {"DOPRI5": k.dopri5, "DOP853C": k.dop853}
+        self._run = explicit[method] if method in explicit else functools.partial(
             k.rodas, order=ROSENBROCK[method][0], reuse=ROSENBROCK[method][1])
 
     def reset(self) -> None:
@@ -214,10 +216,11 @@ class Stepper:
                          {"scene": self.scene.name, "partial": True},
                          units={k: units[k] for k in ("t", *outputs) if k in units})
         limit: Any = self.max_rhs if kind == "max_rhs" else self.max_wall
-        return budget_error(kind, limit, meth="DOPRI5", t=self.t, t_start=t_start,
+        return budget_error(kind, limit, meth=self.method, t=self.t, t_start=t_start,
                             t_end=t_end, step=self._h or None,
                             steps=int(self._stats[1]) - steps0,
-                            stiff_steps=int(self._stats[4]) - stiff0, nfev=nfev,
+                            stiff_steps=int(self._stats[4]) - stiff0 if self.method in
+                            ("DOPRI5", "DOP853C") else None, nfev=nfev,
                             wall=time.perf_counter() - wall0, state=self.state,
                             partial=partial, how=_RAISE, alternatives="a looser rtol")
 

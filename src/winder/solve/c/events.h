@@ -1,10 +1,10 @@
 #ifndef WINDER_EVENTS_H
 #define WINDER_EVENTS_H
 
-/* What winder's C integrators share (dopri5.c, rk4.c): the locked modes of a generated
- * machine, their located switches, the penetration guard, the status codes and the call
- * of the generated functions. A line-by-line port of src/winder/solve/integrators.py
- * (read its docstrings for the contract): the same floating-point operations in the same
+/* What winder's C integrators share (dopri5.c, dop853.c, rk4.c, ros2.c, rosenbrock.c): the
+ * locked modes of a generated machine, their located switches, the penetration guard, the
+ * status codes and the call of the generated functions. A line-by-line port of
+ * src/winder/solve/integrators.py (read its docstrings for the contract): the same floating-point operations in the same
  * order (compiled with -ffp-contract=off), so the accepted steps, event times and states
  * agree with the numba kernels bit for bit. Static functions: each integrator's
  * translation unit includes this header.
@@ -52,7 +52,15 @@ typedef struct {
     double* g0;
     double* yt;
     double* ye;  /* guard_step's end of a cut step */
-    double* rl;  /* _chord's straight path as a dense output (5 x n) */
+    double* rl;  /* _chord's straight path as a dense output (rows x n) */
+    /* The dense output's form: rows of rc (dense()): 5 (the 4th-order polynomial of DOPRI5,
+     * and the cubic Hermite of ROS2, RODAS, RK4; the default) or 8 (DOP853's 7th-order
+     * one). Where lazy_rc is set, the rows of that rc are written on first use by
+     * complete(lazy_arg) (DOP853: its 3 extra stages only on steps that need them). */
+    int64_t rows;
+    const double* lazy_rc;
+    void (*complete)(void*);
+    void* lazy_arg;
     int64_t ns;  /* the switch buffers' length */
     /* the switches at an accepted step's end (next_event's, before any probe), kept as the
      * next step's switches at its start: g_end written by this step, g_start the last
@@ -105,11 +113,31 @@ static inline void modes_of(Ctx* cx, double t, const double* y, int contact_auto
     }
 }
 
-static inline void dense(const double* rc, int64_t n, double theta, double* out) {
+#define MAX_ROWS 8
+
+/* The dense output at theta in [0, 1] of a step: rc[0] + theta (rc[1] + (1 - theta)
+ * (rc[2] + theta (rc[3] + ...))), rows alternating theta and 1 - theta (scipy's
+ * Dop853DenseOutput's form; DOPRI5's with 5 rows, its arithmetic unchanged). */
+static inline void dense(Ctx* cx, const double* rc, double theta, double* out) {
+    int64_t n = cx->n;
     double th1 = 1.0 - theta;
-    for (int64_t i = 0; i < n; i++)
-        out[i] = rc[i] + theta * (rc[n + i] + th1 * (rc[2 * n + i] + theta
-                                  * (rc[3 * n + i] + th1 * rc[4 * n + i])));
+    if (rc == cx->lazy_rc) {
+        cx->lazy_rc = NULL;
+        cx->complete(cx->lazy_arg);
+    }
+    if (cx->rows == 5) {
+        for (int64_t i = 0; i < n; i++)
+            out[i] = rc[i] + theta * (rc[n + i] + th1 * (rc[2 * n + i] + theta
+                                      * (rc[3 * n + i] + th1 * rc[4 * n + i])));
+        return;
+    }
+    int64_t last = cx->rows - 1;
+    for (int64_t i = 0; i < n; i++) {
+        double acc = rc[last * n + i];
+        for (int64_t j = last - 1; j >= 0; j--)
+            acc = rc[j * n + i] + ((j & 1) ? th1 : theta) * acc;
+        out[i] = acc;
+    }
 }
 
 static inline double switch_at(Ctx* cx, int64_t gi, double t, const double* y, double* g) {
@@ -121,14 +149,13 @@ static inline double switch_at(Ctx* cx, int64_t gi, double t, const double* y, d
  * side; Illinois method to ~1e-12 s. */
 static inline double locate(Ctx* cx, int64_t gi, int new_pos, const double* rc, double t,
                      double hh) {
-    int64_t n = cx->n;
     double* yt = cx->yt;
     double* g = cx->g;
     int64_t before = cx->n_sw;
     cx->n_locate++;
-    dense(rc, n, 1.0, yt);
+    dense(cx, rc, 1.0, yt);
     double gb = switch_at(cx, gi, t + hh, yt, g);
-    dense(rc, n, 0.0, yt);
+    dense(cx, rc, 0.0, yt);
     double ga = switch_at(cx, gi, t, yt, g);
     if (new_pos && ga > 0.0)
         ga = -1e-300;
@@ -143,7 +170,7 @@ static inline double locate(Ctx* cx, int64_t gi, int new_pos, const double* rc, 
         double th = (ta * gb - tb_ * ga) / (gb - ga);
         if (!(ta < th && th < tb_))
             th = 0.5 * (ta + tb_);
-        dense(rc, n, th, yt);
+        dense(cx, rc, th, yt);
         double gv = switch_at(cx, gi, t + th * hh, yt, g);
         if ((gv > 0.0) == (new_pos != 0)) {
             tb_ = th;
@@ -235,20 +262,19 @@ static inline int beyond_at(Ctx* cx, double t, const double* y, double* g) {
 /* Where the nips beyond their bound at th_hi cross it: bisection on the dense output. */
 static inline double first_beyond(Ctx* cx, const double* rc, double t, double hh, double th_hi,
                            double* g) {
-    int64_t n = cx->n;
     double* yt = cx->yt;
     double best = th_hi;
     for (int64_t s = 0; s < cx->nslots; s++) {
         if (TAB(s, 0) != K_CONTACT)
             continue;
         int64_t gi = TAB(s, 2);
-        dense(rc, n, th_hi, yt);
+        dense(cx, rc, th_hi, yt);
         if (!(switch_at(cx, gi, t + th_hi * hh, yt, g) > 0.0))
             continue;
         double ta = 0.0, tb_ = th_hi;
         for (int it = 0; it < 60; it++) {
             double th = 0.5 * (ta + tb_);
-            dense(rc, n, th, yt);
+            dense(cx, rc, th, yt);
             if (switch_at(cx, gi, t + th * hh, yt, g) > 0.0)
                 tb_ = th;
             else
@@ -286,7 +312,7 @@ static inline double chord(Ctx* cx, double t, double hh, const double* y0, const
             yt[i] = y0[i] + th * (y1[i] - y0[i]);
         if (switch_at(cx, TAB(s, 2), t + th * hh, yt, g) > 0.0) {
             double* rl = cx->rl;
-            memset(rl, 0, sizeof(double) * 5 * (size_t)n);
+            memset(rl, 0, sizeof(double) * (size_t)(cx->rows * n));
             for (int64_t i = 0; i < n; i++) {
                 rl[i] = y0[i];
                 rl[n + i] = y1[i] - y0[i];
@@ -308,7 +334,7 @@ static inline double guard_step(Ctx* cx, const double* rc, double t, double hh, 
     double* g0 = cx->g0;
     const double* ye = y1;
     if (th_end < 1.0) {
-        dense(rc, n, th_end, cx->ye);
+        dense(cx, rc, th_end, cx->ye);
         ye = cx->ye;
     }
     double best = 2.0;
@@ -335,7 +361,7 @@ static inline double guard_step(Ctx* cx, const double* rc, double t, double hh, 
         straight = 1;
         for (int j = 1; j < 65; j++) {
             double tj = th_end * j / 64.0;
-            dense(rc, n, tj, yt);
+            dense(cx, rc, tj, yt);
             if (beyond_at(cx, t + tj * hh, yt, g)) {
                 best = first_beyond(cx, rc, t, hh, tj, g);
                 straight = 0;
@@ -345,7 +371,7 @@ static inline double guard_step(Ctx* cx, const double* rc, double t, double hh, 
     }
     while (k < n_out && t_out[k] <= t + pmin(best, th_end) * hh) {
         th = pmax(0.0, (t_out[k] - t) / hh);
-        dense(rc, n, th, yt);
+        dense(cx, rc, th, yt);
         if (beyond_at(cx, t + th * hh, yt, g)) {
             th = first_beyond(cx, rc, t, hh, th, g);
             if (th < best) {
@@ -361,7 +387,7 @@ static inline double guard_step(Ctx* cx, const double* rc, double t, double hh, 
             for (int64_t i = 0; i < n; i++)
                 y0[i] += best / th_end * (ye[i] - y0[i]);
         } else {
-            dense(rc, n, best, y0);
+            dense(cx, rc, best, y0);
         }
     }
     return best;
@@ -417,13 +443,13 @@ static inline int64_t sample_and_switch(Ctx* cx, const double* rc, double t, dou
             break;
         if (slot == GUARD && t_out[k] >= t_end)
             break;
-        dense(rc, n, pmin(theta_end, pmax(0.0, (t_out[k] - t) / hh)), yt);
+        dense(cx, rc, pmin(theta_end, pmax(0.0, (t_out[k] - t) / hh)), yt);
         for (int64_t i = 0; i < n; i++)
             Y_out[i * n_out + k] = yt[i];
         k++;
     }
     if (slot >= 0) {
-        dense(rc, n, theta_end, y);
+        dense(cx, rc, theta_end, y);
         if (new_mode == END || (TAB(slot, 0) == K_CORE && new_mode == AT_CORE))
             y[TAB(slot, 3)] = cx->p[TAB(slot, 4)];
     }
@@ -433,7 +459,6 @@ static inline int64_t sample_and_switch(Ctx* cx, const double* rc, double t, dou
     return slot;
 }
 
-/* Work buffers: g, g0 (switches), yt, ye (n), rl (5 n), then n_extra vectors of n. */
 /* What an accepted step's event (sample_and_switch's slot) does to the run: PENETRATED at
  * the guard, EXHAUSTED at an unwinding roll's run-out (t moved there), or DONE where the
  * integration goes on; a mode switch sets the slot's mode, moves t to the event, evaluates
@@ -459,6 +484,8 @@ static inline int end_of_step(Ctx* cx, int64_t slot, double new_mode, double t_e
     return DONE;
 }
 
+/* Work buffers: g, g0 (switches), yt, ye (n), rl (MAX_ROWS n), g_end, g_start, then n_extra
+ * vectors of n. */
 static inline int ctx_init(Ctx* cx, const int64_t* fns, const int64_t* table, int64_t nslots,
                     int64_t n_switches, int64_t n, const double* p, double* m, double** extra,
                     int64_t n_extra) {
@@ -470,13 +497,15 @@ static inline int ctx_init(Ctx* cx, const int64_t* fns, const int64_t* table, in
     for (int j = 0; j < 4; j++)
         cx->fns[j] = (wfn)(intptr_t)fns[j];
     cx->table = table; cx->nslots = nslots; cx->n = n; cx->p = p; cx->m = m;
-    double* buf = malloc(sizeof(double) * (size_t)(4 * ns + 7 * n + n_extra * n));
+    double* buf = malloc(sizeof(double) * (size_t)(4 * ns + (2 + MAX_ROWS) * n
+                                                  + n_extra * n));
     if (!buf)
         return 0;
     cx->g = buf; cx->g0 = buf + ns; cx->yt = buf + 2 * ns; cx->ye = cx->yt + n;
     cx->rl = cx->ye + n;
-    cx->ns = ns; cx->g_end = cx->rl + 5 * n; cx->g_start = cx->g_end + ns; cx->start_ok = 0;
+    cx->ns = ns; cx->g_end = cx->rl + MAX_ROWS * n; cx->g_start = cx->g_end + ns; cx->start_ok = 0;
     cx->n_sw = 0; cx->n_sw_locate = 0; cx->n_locate = 0; cx->legacy_probe = 0;
+    cx->rows = 5; cx->lazy_rc = NULL; cx->complete = NULL; cx->lazy_arg = NULL;
     double* e = cx->g_start + ns;
     for (int64_t j = 0; j < n_extra; j++)
         extra[j] = e + j * n;
