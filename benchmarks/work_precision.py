@@ -3,12 +3,13 @@
 Problems: the smooth paper scene (first 120 s), 0.5 s of the bouncing phase of the paper
 scene (from t = 25 s), free spin (closed form) and the two-drum winder's first 30 s (the
 speed ramp, the set settling into the valley under the rider). Methods: the compiled
-DOPRI5, ROS2 (Rosenbrock, exact Jacobian) and fixed-step RK4, and scipy's RK45, DOP853,
-Radau, BDF and LSODA on the generated right-hand side (the implicit ones with the exact
-generated Jacobian, and Radau/BDF also with their finite differences), plus LSODA on the
-numeric Pinocchio backend. Errors are the largest deviation over the output grid, scaled by
-the channel's largest magnitude, against the compiled DOPRI5 at rtol 1e-12 (the closed
-form for free spin); the spread to a second tight solution is reported with each problem.
+DOPRI5, DOP853C (DOP853 in C), ROS2 (Rosenbrock, exact Jacobian) and fixed-step RK4, and
+scipy's RK45, DOP853, Radau, BDF and LSODA on the generated right-hand side (the implicit
+ones with the exact generated Jacobian, and Radau/BDF also with their finite differences),
+plus LSODA on the numeric Pinocchio backend. Errors are the largest deviation over the
+output grid, scaled by the channel's largest magnitude, against the compiled DOPRI5 at rtol
+1e-12 (the closed form for free spin); the spread to a second tight solution is reported
+with each problem.
 Each point's wall time is the median of ``--repeats`` runs (runs longer than
 ``--repeat-below`` seconds are timed once); the RHS evaluation and event counts of every
 run are kept, so that the error can be read against a count that no other process on the
@@ -45,7 +46,7 @@ TWO_DRUM_CHANNELS = ("set_radius", "set_speed", "set_x", "set_z", "rear_nip_norm
 LINE_CHANNELS = (*TWO_DRUM_CHANNELS, "span_tension", "parent_speed", "parent_torque")
 TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 RK4_STEPS = (2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4, 6.25e-5)
-COMPILED = ("DOPRI5", "ROS2")
+COMPILED = ("DOPRI5", "DOP853C", "ROS2")
 SCIPY = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
 
