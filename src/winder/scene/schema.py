@@ -27,7 +27,7 @@ __all__ = ["EFFECT_NAMES", "METHODS", "BACKENDS", "DRIVE_KINDS", "MAX_SAMPLES", 
 #: :data:`winder.forces.FORCES` (:func:`effect_names` also those registered later).
 EFFECT_NAMES = tuple(FORCES)
 #: Integrators of ``[solver] method``.
-METHODS = ("auto", "DOPRI5", "DOP853C", "RK4", "ROS2", "RODAS3", "RODAS4", "ROS34PW2", "RK45",
+METHODS = ("auto", "DOPRI5", "RK4", "ROS2", "RODAS3", "RODAS4", "ROS34PW2", "DOP853C", "RK45",
            "DOP853", "Radau", "BDF", "LSODA", "RK23")
 #: Right-hand side backends: the compiled planar equations, or Pinocchio's ABA.
 BACKENDS = ("compiled", "pinocchio")
