@@ -55,7 +55,7 @@ typedef struct {
     double* rl;  /* _chord's straight path as a dense output (rows x n) */
     /* The dense output's form: rows of rc (dense()): 5 (the 4th-order polynomial of DOPRI5,
      * and the cubic Hermite of ROS2, RODAS, RK4; the default) or 8 (DOP853's 7th-order
-     * one). Where lazy_rc is set, the rows of that rc are written on first use by
+     * one; no other). Where lazy_rc is set, the rows of that rc are written on first use by
      * complete(lazy_arg) (DOP853: its 3 extra stages only on steps that need them). */
     int64_t rows;
     const double* lazy_rc;
@@ -131,13 +131,10 @@ static inline void dense(Ctx* cx, const double* rc, double theta, double* out) {
                                       * (rc[3 * n + i] + th1 * rc[4 * n + i])));
         return;
     }
-    int64_t last = cx->rows - 1;
-    for (int64_t i = 0; i < n; i++) {
-        double acc = rc[last * n + i];
-        for (int64_t j = last - 1; j >= 0; j--)
-            acc = rc[j * n + i] + ((j & 1) ? th1 : theta) * acc;
-        out[i] = acc;
-    }
+    for (int64_t i = 0; i < n; i++)  /* rows == 8 */
+        out[i] = rc[i] + theta * (rc[n + i] + th1 * (rc[2 * n + i] + theta
+                 * (rc[3 * n + i] + th1 * (rc[4 * n + i] + theta * (rc[5 * n + i] + th1
+                 * (rc[6 * n + i] + theta * rc[7 * n + i]))))));
 }
 
 static inline double switch_at(Ctx* cx, int64_t gi, double t, const double* y, double* g) {
