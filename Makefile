@@ -166,6 +166,10 @@ bench: $(STAMP)
 	$(PY) benchmarks/sweep_scaling.py
 	$(PY) benchmarks/flex_speed.py
 	$(PY) benchmarks/flex_cycle.py
+	$(PY) benchmarks/flex_cycle.py --methods
+	$(PY) benchmarks/dop853_cycle.py
+	$(PY) benchmarks/cycle_profile.py
+	$(if $(BEFORE),$(PY) benchmarks/cost_side_by_side.py --before $(BEFORE))
 	$(PY) benchmarks/event_cost.py
 	$(PY) benchmarks/fit_speed.py
 	$(PY) benchmarks/doc_numbers.py --write

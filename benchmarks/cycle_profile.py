@@ -42,6 +42,7 @@ RATE = 4000
 def child(scene_path: str, window: float, data: str) -> dict[str, Any]:
     """In the profiled process: warm up, attach perf, run the window, detach."""
     import winder
+    from winder.solve.system import MachineSystem
 
     scene = winder.load_scene(scene_path)
     winder.simulate(scene, t_end=1e-3, rtol=1e-6, method="DOPRI5")
@@ -55,8 +56,7 @@ def child(scene_path: str, window: float, data: str) -> dict[str, Any]:
     perf.send_signal(signal.SIGINT)
     perf.wait(timeout=60)
     return {"cpu": cpu, "rhs": int(res.meta["rhs_evaluations"]),
-            "events": int(res.meta["events"]), "states": len(res.meta["state_names"])
-            if "state_names" in res.meta else None}
+            "events": int(res.meta["events"]), "states": MachineSystem(scene).n_states}
 
 
 def _group(dso: str, sym: str) -> str:
@@ -111,12 +111,24 @@ def write(data: dict[str, Any]) -> str:
     lines.append("| CPU [s] | " + " | ".join(f"{r['cpu']:.2f}" for r in runs) + " |")
     lines.append("| CPU per evaluation [µs] | "
                  + " | ".join(f"{1e6 * r['cpu'] / r['rhs']:.2f}" for r in runs) + " |")
+    lines.append("| states | " + " | ".join(f"{r['states']}" for r in runs) + " |")
+    lines.append("| CPU per evaluation and state [ns] | "
+                 + " | ".join(f"{1e9 * r['cpu'] / r['rhs'] / r['states']:.1f}" for r in runs)
+                 + " |")
     groups = sorted({g for r in runs for g in r["share"]},
                     key=lambda g: -max(r["share"].get(g, 0.0) for r in runs))
     for g in groups:
         if max(r["share"].get(g, 0.0) for r in runs) >= 0.5:
             lines.append(f"| {g} [% of samples] | "
                          + " | ".join(f"{r['share'].get(g, 0.0):.1f}" for r in runs) + " |")
+    rg, fx = data["runs"]["rigid"], data["runs"]["flexible"]
+    per = [r["cpu"] / r["rhs"] / r["states"] for r in (rg, fx)]
+    lines += ["", f"Per evaluation and state the flexible machine costs {per[1] / per[0]:.2f} "
+              f"times the rigid one: an evaluation of the flexible machine costs "
+              f"{fx['cpu'] / fx['rhs'] / (rg['cpu'] / rg['rhs']):.1f} times the rigid one's "
+              f"because it has {fx['states'] / rg['states']:.1f} times the states. A whole "
+              "cycle's ratio is that times the ratio of evaluations "
+              "([flex_cycle.md](flex_cycle.md))."]
     md = "\n".join(lines) + "\n"
     if not data.get("no_docs"):
         from winder.io.files import atomic_write_all
