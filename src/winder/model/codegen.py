@@ -59,7 +59,7 @@ __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileErro
            "stats", "Link", "compile_flags", "link_flags", "run_compiler",
            "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash", "write_source",
            "OPTIMISE", "function_flags", "LAYOUT", "LARGE", "level", "JAC_SPLIT",
-           "MAIN", "JACOBIAN"]
+           "MAIN", "JACOBIAN", "RHS_PART", "with_level"]
 
 #: The generated functions, in the order of :attr:`Generated.addresses`.
 FUNCTIONS = ("rhs", "jac", "out", "sw")
@@ -73,7 +73,18 @@ CFLAGS = ("-O3", "-shared", "-fPIC", "-fno-semantic-interposition")
 #: -O1 at run time, 30 % cheaper to compile: the flexible two-drum winder's Jacobian, 58,825
 #: instructions, 7.8 s CPU against 10.9 s at -O1 and 24.7 s at -O3, 20 µs a call). None
 #: changes a result: no fast-math, no FMA contraction on the default target.
-OPTIMISE = {"rhs": "-O3", "jac": "-Og", "out": "-Og", "sw": "-O3"}
+OPTIMISE = {"rhs": "-O3", "jac": "-Og", "out": "-Og", "sw": "-O3",
+            "part": "-O1 -fstrict-aliasing -finline-small-functions"}
+#: A right-hand side of more CasADi instructions than this is cut into parts of about this
+#: many each (:mod:`winder.model.c_split`: the same operations, bitwise the same results),
+#: one C file each, compiled at once at ``OPTIMISE["part"]``: -O1 with the two -O2 passes
+#: that matter for straight-line code (``-finline-small-functions``: CasADi's ``sq``,
+#: ``fmax``, ``fabs`` helpers inlined; ``-fstrict-aliasing``: ``arg[i]`` not reloaded after
+#: each store), 0-1 % more instructions per call than -O3 (valgrind) at half its compile
+#: time. Not -O1 on the whole: its register allocation grows faster than the function
+#: (the flexible drum's rhs at N = 32, 11,187 instructions: 3.1 s at -O1 against 2.9 s at
+#: -O3; in 3 parts 1.2-1.4 s).
+RHS_PART = 4000
 #: A channel function of more CasADi instructions than this compiles at -O0 (called once
 #: per output row: the flexible two-drum winder's, 8394 instructions, 2.0 s CPU at -O1, 0.7 s
 #: at -O0). Not the Jacobian: at -O0 it compiles in half the time of -Og (3.9 s) but runs
@@ -88,8 +99,8 @@ SAY_AFTER = 5.0
 #: The layout of the generated code (in the cache key): one C file per function, the
 #: Jacobian on its nonzeros scattered by its flat entry point (beside it its nonzeros' entry
 #: point and CCS pattern) in a library of its own built on first use, CasADi's null checks
-#: removed.
-LAYOUT = "lazy-jac-split-sparse-unguarded-4"
+#: removed; a large right-hand side in parts (:data:`RHS_PART`).
+LAYOUT = "lazy-jac-split-sparse-unguarded-rhs-parts-5"
 #: ``WINDER_SANITIZE=1`` (``make test-asan``): AddressSanitizer and UBSan on every object
 #: and the link (Python then needs libasan preloaded; see the Makefile).
 SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
@@ -132,18 +143,23 @@ def compile_flags() -> tuple[str, ...]:
 
 
 def level(which: str, size: int) -> str:
-    """The optimisation level of one generated function (one of :data:`FUNCTIONS`) of
-    ``size`` CasADi instructions: :data:`OPTIMISE`, and -O0 for a channel function over
-    :data:`LARGE`."""
+    """The optimisation level of one generated function (one of :data:`FUNCTIONS`, or
+    ``"part"``: a part of a right-hand side over :data:`RHS_PART`) of ``size`` CasADi
+    instructions: :data:`OPTIMISE`, and -O0 for a channel function over :data:`LARGE`."""
     return "-O0" if which == "out" and size > LARGE else OPTIMISE[which]
+
+
+def with_level(flags: tuple[str, ...] | list[str], lv: str) -> tuple[str, ...]:
+    """``flags`` with their ``-O3`` replaced by the level ``lv`` (one or more flags, such as
+    ``OPTIMISE["part"]``)."""
+    return tuple(g for f in flags for g in (lv.split() if f == "-O3" else (f,)))
 
 
 def function_flags(which: str, size: int) -> tuple[str, ...]:
     """The flags the object of one generated function is compiled with:
     :func:`compile_flags` at its :func:`level` (sanitized: -O1 throughout)."""
     flags = compile_flags()
-    lv = level(which, size)
-    return flags if sanitized() else tuple(lv if f == "-O3" else f for f in flags)
+    return flags if sanitized() else with_level(flags, level(which, size))
 
 
 def link_flags() -> tuple[str, ...]:
@@ -356,7 +372,7 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
     # the order of generation: the rhs first (its compile is long for its size), the
     # Jacobian's file with the flat entry point last of its blocks
     if "rhs" in which:
-        outs.append(("rhs", "rhs", lambda: ca.densify(xdot)))
+        outs.append(("rhs", "rhs", lambda: ca.densify(xdot)))  # cut into parts if large
     if "jac" in which:
         jac = sym.jac
         colind = jac.sparsity().colind()
@@ -377,6 +393,9 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
     made: dict[str, Any] = {}
     for kind, name, expr in outs:
         f = made[name] = ca.Function(f"{symbol}_{name}", [t, x, p, m], [expr()], {"cse": True})
+        if kind == "rhs" and f.n_instructions() > RHS_PART:
+            files += _parts(f, symbol, directory, ready)
+            continue
         cg = ca.CodeGenerator(f"{symbol}_{name}.c", {"with_header": False})
         cg.add(f)
         # dump() rather than generate(): the same code, written here, without loading
@@ -394,6 +413,37 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
     return files, patterns
 
 
+def _parts(f: Any, symbol: str, directory: Path,
+           ready: Callable[[str, Path, int], None] | None) -> list[tuple[str, Path, int]]:
+    """The right-hand side ``f`` cut into about ``f.n_instructions() / RHS_PART`` parts
+    (:func:`winder.model.c_split.split`), one file each: ``SYMBOL_rhs1.c``, ... and last
+    ``SYMBOL_rhs.c`` with the flat entry point that calls them in turn; ``ready`` called on
+    each file as it is written."""
+    import casadi as ca
+
+    from winder.model.c_entry import parts_entry
+    from winder.model.c_split import split
+
+    k = -(-f.n_instructions() // RHS_PART)
+    names = [f"{symbol}_rhs{j}" for j in range(1, k)] + [f"{symbol}_rhs"]
+    parts = split(f, names)
+    files = []
+    for j, (name, part) in enumerate(zip(names, parts, strict=True)):
+        cg = ca.CodeGenerator(f"{name}.c", {"with_header": False})
+        cg.add(part.function)
+        entry = "" if j < k - 1 else parts_entry(
+            symbol, "rhs", [(n, q.function, q.offset) for n, q in zip(names, parts,
+                                                                      strict=True)],
+            part.n_carried)
+        path = directory / f"{name}.c"
+        path.write_text(f"/* {name}: part {j + 1} of {k} of {symbol}_rhs, generated by CasADi "
+                        f"{ca.__version__} for winder */\n" + _unguarded(cg.dump()) + entry)
+        files.append(("part", path, part.function.n_instructions()))
+        if ready is not None:
+            ready(*files[-1])
+    return files
+
+
 def _say(line: str) -> None:
     """One line on stderr about a build (a build is never silent: it can take a minute)."""
     print(line, file=sys.stderr, flush=True)
@@ -402,7 +452,8 @@ def _say(line: str) -> None:
 def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
     """The cache key of a machine's generated code (:func:`generate`): its structure, the
     physics' source, CasADi, the route, the layout and every object's flags."""
-    levels = f"{sorted(OPTIMISE.items())} out -O0 over {LARGE}; jac split at {JAC_SPLIT}"
+    levels = (f"{sorted(OPTIMISE.items())} out -O0 over {LARGE}; jac split at {JAC_SPLIT}; "
+              f"rhs parts of {RHS_PART}")
     return hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(),
                                     route, LAYOUT, levels, " ".join(cflags))).encode()
                           ).hexdigest()[:20]
