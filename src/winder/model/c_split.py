@@ -41,49 +41,47 @@ def split(f: Any, names: list[str]) -> list[Part]:
 
     parts = len(names)
     n = f.n_instructions()
+    code = [f.instruction_id(k) for k in range(n)]
     special = (ca.OP_INPUT, ca.OP_OUTPUT, ca.OP_CONST)
-    ops = [k for k in range(n) if f.instruction_id(k) not in special]
-    part_of_op = {k: min(i * parts // max(len(ops), 1), parts - 1) for i, k in enumerate(ops)}
-    # first pass: single-assignment values (CasADi reuses its work variables), where each
-    # is defined and where it is used
+    n_ops = sum(op not in special for op in code)
+    # one pass: single-assignment values (CasADi reuses its work variables), where each is
+    # defined (its part; -1: inputs and constants, made where used) and used
     work: dict[int, int] = {}  # work variable -> value
-    kind: list[tuple[str, Any]] = []  # value -> ("in", (input, nz)) | ("const", v) | ("op", k)
-    home: list[int] = []  # value -> part (-1: inputs and constants, made where used)
-    args: dict[int, list[int]] = {}  # instruction -> its operands' values
+    kind: list[Any] = []  # value -> (input, nz) | constant (float) | None (an operation)
+    home: list[int] = []  # value -> its part
+    steps: list[list[tuple[int, list[int], int]]] = [[] for _ in range(parts)]
     outputs: dict[int, int] = {}  # output nonzero -> value
-    carried: dict[int, int] = {}  # value -> index in c, in the order of definition
-    later_use: set[int] = set()
-    value_of: dict[int, int] = {}  # instruction -> the value it defines
-    for k in range(n):
-        op, ins, out = f.instruction_id(k), f.instruction_input(k), f.instruction_output(k)
+    later_use: set[int] = set()  # values used in a later part than theirs (or outputs)
+    i = 0
+    for k, op in enumerate(code):
+        ins, out = f.instruction_input(k), f.instruction_output(k)
         if op == ca.OP_OUTPUT:
             if out[0] != 0:
                 raise ValueError("split: one output only")
             outputs[out[1]] = work[ins[0]]
             continue
         if op == ca.OP_INPUT:
-            kind.append(("in", (ins[0], ins[1])))
+            kind.append((ins[0], ins[1]))
             home.append(-1)
         elif op == ca.OP_CONST:
-            kind.append(("const", f.instruction_constant(k)))
+            kind.append(f.instruction_constant(k))
             home.append(-1)
         else:
-            args[k] = [work[i] for i in ins]
-            for v in args[k]:
-                if 0 <= home[v] < part_of_op[k]:
-                    later_use.add(v)
-            kind.append(("op", k))
-            home.append(part_of_op[k])
-            value_of[k] = len(kind) - 1
+            j = min(i * parts // n_ops, parts - 1)  # parts of about equal operations
+            i += 1
+            args = [work[w] for w in ins]
+            later_use.update(v for v in args if 0 <= home[v] < j)
+            kind.append(None)
+            home.append(j)
+            steps[j].append((op, args, len(kind) - 1))
         work[out[0]] = len(kind) - 1
-    for v in outputs.values():
-        if 0 <= home[v] < parts - 1:
-            later_use.add(v)
-    for v in sorted(later_use):  # values are numbered in the order of definition
-        carried[v] = len(carried)
+    later_use.update(v for v in outputs.values() if 0 <= home[v] < parts - 1)
+    carried = {v: i for i, v in enumerate(sorted(later_use))}  # in the order of definition
     n_c = len(carried)
     syms = [f.sx_in(i) for i in range(f.n_in())]
+    elements = [ca.vertsplit(s) for s in syms]  # inputs: dense vectors
     c = ca.SX.sym("c", n_c)
+    c_el = ca.vertsplit(c)
     result: list[Part] = []
     was = ca.GlobalOptions.getSimplificationOnTheFly()
     ca.GlobalOptions.setSimplificationOnTheFly(False)  # every operation as it is in f
@@ -92,22 +90,17 @@ def split(f: Any, names: list[str]) -> list[Part]:
             made: dict[int, Any] = {}
 
             def get(v: int, j: int = j, made: dict[int, Any] = made) -> Any:
-                what, data = kind[v]
-                if what == "in":
-                    return syms[data[0]].nz[data[1]]
-                if what == "const":
-                    return ca.SX(data)
-                if home[v] == j:
-                    return made[v]
-                return c[carried[v]]
+                what = kind[v]
+                if what is None:
+                    return made[v] if home[v] == j else c_el[carried[v]]
+                if isinstance(what, tuple):
+                    return elements[what[0]][what[1]]
+                return ca.SX(what)
 
-            for k in ops:
-                if part_of_op[k] != j:
-                    continue
-                a = [get(v) for v in args[k]]
-                val = ca.SX.unary(f.instruction_id(k), a[0]) if len(a) == 1 else \
-                    ca.SX.binary(f.instruction_id(k), a[0], a[1])
-                made[value_of[k]] = val
+            for op, args, v in steps[j]:
+                a = [get(u) for u in args]
+                made[v] = ca.SX.unary(op, a[0]) if len(a) == 1 else \
+                    ca.SX.binary(op, a[0], a[1])
             if j < parts - 1:
                 mine = [v for v in carried if home[v] == j]
                 expr = ca.vertcat(*[made[v] for v in mine]) if mine else ca.SX(0, 1)
