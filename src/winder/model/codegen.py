@@ -592,16 +592,37 @@ def _compile_sources(machine: Machine, symbol: str, tmp: Path, route: str,
     """Write the C of the functions ``which`` into ``tmp`` and compile each into an object
     beside it (one compiler process each, started as soon as its file is written); the
     sources' paths. ``sizes``: each file's CasADi instructions, by its function's name."""
+    these: dict[str, int] = {}  # this call's files
     with _Compiles() as jobs:  # each function compiles while the next is made
         def ready(kind: str, src: Path, size: int) -> None:
-            sizes[src.stem.rsplit("_", 1)[1]] = size
+            sizes[src.stem.rsplit("_", 1)[1]] = these[src.stem.rsplit("_", 1)[1]] = size
             jobs.start([*function_flags(kind, size), "-c", str(src), "-o",
                         str(src.with_suffix(".o"))], "the generated model")
 
         srcs = [f for _, f, _ in _c_source(machine, symbol, tmp, route, ready, which=which,
                                            symbols=symbols)[0]]
+        if sum(these.values()) > RHS_PART:  # a build of seconds: what it compiles, how big
+            kb = sum(s.stat().st_size for s in srcs) / 1024
+            _say(f"winder: compiling {_what(these)} ({kb:.0f} kB of C, {len(srcs)} compiler "
+                 "processes)")
         jobs.wait()
     return srcs
+
+
+#: The generated functions' names in the lines a build says (:func:`_what`).
+_NAMES = {"rhs": "rhs", "jac": "Jacobian", "out": "channels", "sw": "switching functions"}
+
+
+def _what(sizes: dict[str, int]) -> str:
+    """``sizes`` (CasADi instructions by file, :func:`_compile_sources`) in words: each
+    function's instructions and its files when more than one."""
+    words = []
+    for k, label in _NAMES.items():
+        mine = [v for f, v in sizes.items() if f.rstrip("0123456789") == k]
+        if mine:
+            words.append(f"{label} {sum(mine):,}"
+                         + (f" (in {len(mine)} files)" if len(mine) > 1 else ""))
+    return ", ".join(words) + " CasADi instructions"
 
 
 def _jacobian_library(machine: Machine, symbol: str, root: Path, route: str, name: str,
