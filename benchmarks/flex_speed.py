@@ -184,9 +184,17 @@ COSTS = (("compile_cpu_s", "build CPU (explicit run)"), ("rhs_us", "rhs [µs]"),
          ("jac_us", "Jacobian [µs]"), ("jac_nnz", "Jacobian nonzeros"))
 
 
+def _rhs_size(sizes: dict[str, int]) -> float:
+    """The rhs's CasADi instructions: its one file's, or the sum of its parts' (a large rhs
+    is cut into parts: ``rhs1``, ``rhs2``, ..., ``rhs``; each part reads its inputs and
+    carried values and writes its own, so the sum is a little over the one function's)."""
+    parts = [v for k, v in sizes.items() if k.rstrip("0123456789") == "rhs"]
+    return float(sum(parts)) if parts else math.nan
+
+
 def _value(r: dict[str, Any], key: str) -> float:
     if key == "rhs_instructions":
-        return float(r.get("sizes", {}).get("rhs", math.nan))
+        return _rhs_size(r.get("sizes", {}))
     return float(r.get(key, math.nan))
 
 
@@ -231,6 +239,12 @@ def main() -> None:
         partial = Path(tempfile.gettempdir()) / "flex_speed.partial.json"
         partial.write_text(json.dumps(rows))
     write_docs(rows)
+
+
+def _parts(sizes: dict[str, int]) -> str:
+    """`` (in K parts)`` for a rhs cut into parts, else nothing."""
+    k = sum(1 for w in sizes if w.rstrip("0123456789") == "rhs")
+    return f" (in {k} parts)" if k > 1 else ""
 
 
 def _cell(v: float, fmt: str) -> str:
@@ -289,7 +303,8 @@ def write_docs(rows: list[dict[str, Any]]) -> None:
             f"| {r['segments']} | {r['states']} | {r['compile_s']:.1f} | "
             f"{r['compile_cpu_s']:.1f} ({_cell(r.get('python_cpu_s', math.nan), '.1f')} + "
             f"{_cell(r.get('compiler_cpu_s', math.nan), '.1f')}) | "
-            f"{sz.get('rhs', '–')} / {sz.get('out', '–')} / {sz.get('sw', '–')} | "
+            f"{_cell(_rhs_size(sz), '.0f')}{_parts(sz)} / {sz.get('out', '–')} / "
+            f"{sz.get('sw', '–')} | "
             f"{r['rhs_us']:.2f} | {_cell(r['jac_build_cpu_s'], '.1f')} | "
             f"{_cell(r['jac_instructions'], '.0f')} | {_cell(r['jac_nnz'], '.0f')} "
             f"({_cell(r['jac_structural'], '.0f')}) | {_cell(r['jac_us'], '.1f')} | "
