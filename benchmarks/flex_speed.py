@@ -13,6 +13,10 @@ library, best of repeats in the thread's CPU time); the numeric Pinocchio path
 against log N: fitted over N >= 8 (least squares) and the issue's two points (issue #33:
 at most log(4.5)/log(4) = 1.08 from N = 8 to 32); a log-log plot of them.
 
+Where valgrind is installed, the rhs's cost is also counted in instructions per call
+(``rhs_instr_per_call``: cachegrind over a small C program calling the library's
+``SYMBOL_rhs_flat``, 200 calls less 0): the machine's load does not move it.
+
 Run:  python benchmarks/flex_speed.py [--quick] [--sizes 1 4 8 16 32 64] [--no-numeric]
       [--jac-max 32] [--from-json]
 """
@@ -146,6 +150,7 @@ def measure(n: int, quick: bool, numeric: bool = True, jac_max: int = 32) -> dic
             loop(fns, integ.F_RHS, 1, 0.1, y, p, m, out_rhs)
             row["rhs_us"] = best_cpu_us(lambda: loop(fns, integ.F_RHS, calls, 0.1, y, p, m,
                                                      out_rhs), 1, 4 * reps) / calls
+            row["rhs_instr_per_call"] = rhs_instructions_per_call(gen, y)
             row.update(jac_build_s=nan, jac_build_cpu_s=nan, jac_us=nan, jac_nnz=nan,
                        jac_structural=nan, jac_instructions=nan)
             if n <= jac_max:
@@ -173,6 +178,61 @@ def measure(n: int, quick: bool, numeric: bool = True, jac_max: int = 32) -> dic
     return row
 
 
+#: The C program whose instructions valgrind counts: ``CALLS`` calls of the rhs's flat
+#: entry point from the library (argv: library, symbol, inputs file, calls).
+_COUNT_C = r"""
+#include <dlfcn.h>
+#include <stdio.h>
+#include <stdlib.h>
+typedef int (*fn_t)(const double*, const double*, const double*, const double*, double*);
+int main(int argc, char** argv) {
+  void* h = dlopen(argv[1], RTLD_NOW); fn_t f = (fn_t) dlsym(h, argv[2]);
+  FILE* in = fopen(argv[3], "rb"); long n[3];
+  if (!h || !f || !in || fread(n, sizeof(long), 3, in) != 3) return 2;
+  double* a = malloc(sizeof(double) * (1 + n[0] + n[1] + n[2] + n[0]));
+  if (fread(a, sizeof(double), 1 + n[0] + n[1] + n[2], in) != (size_t)(1 + n[0] + n[1] + n[2]))
+    return 2;
+  for (int k = 0; k < atoi(argv[4]); k++)
+    f(a, a + 1, a + 1 + n[0], a + 1 + n[0] + n[1], a + 1 + n[0] + n[1] + n[2]);
+  return 0;
+}
+"""
+
+
+def rhs_instructions_per_call(system: MachineSystem, y: np.ndarray,
+                              calls: int = 200) -> float:
+    """Instructions per call of the generated rhs under valgrind (cachegrind), ``calls``
+    calls less none; NaN without valgrind or a C compiler."""
+    import re
+    import subprocess
+
+    g = system.generated
+    if shutil.which("valgrind") is None or g is None:
+        return math.nan
+    with tempfile.TemporaryDirectory() as d:
+        src, exe, inp = Path(d) / "count.c", Path(d) / "count", Path(d) / "in.bin"
+        src.write_text(_COUNT_C)
+        if subprocess.run(["cc", "-O1", str(src), "-o", str(exe), "-ldl"],
+                          capture_output=True).returncode != 0:
+            return math.nan
+        arrays = [np.array([0.1]), np.asarray(y, float), np.asarray(system.params, float),
+                  np.asarray(system.modes, float)]
+        inp.write_bytes(np.array([len(arrays[1]), len(arrays[2]), len(arrays[3])],
+                                 dtype=np.int64).tobytes()
+                        + np.concatenate(arrays).tobytes())
+        counts = []
+        for k in (0, calls):
+            err = subprocess.run(["valgrind", "--tool=cachegrind", "--cache-sim=no",
+                                  "--cachegrind-out-file=/dev/null", str(exe), str(g.path),
+                                  f"{g.symbol}_rhs_flat", str(inp), str(k)],
+                                 capture_output=True, text=True).stderr
+            hit = re.search(r"I\s+refs:\s+([\d,]+)", err)
+            if hit is None:
+                return math.nan
+            counts.append(int(hit.group(1).replace(",", "")))
+    return (counts[1] - counts[0]) / calls
+
+
 def _jac_nnz(system: MachineSystem, y: np.ndarray) -> int:
     """Nonzeros of the exact Jacobian at ``y`` (the structural ones that are not 0 there)."""
     return int(np.count_nonzero(system.jac(0.1, y)))
@@ -180,6 +240,7 @@ def _jac_nnz(system: MachineSystem, y: np.ndarray) -> int:
 
 #: The costs whose growth with N is fitted: (row key, label).
 COSTS = (("compile_cpu_s", "build CPU (explicit run)"), ("rhs_us", "rhs [µs]"),
+         ("rhs_instr_per_call", "rhs [instructions per call, valgrind]"),
          ("rhs_instructions", "rhs instructions"), ("jac_build_cpu_s", "Jacobian build CPU"),
          ("jac_us", "Jacobian [µs]"), ("jac_nnz", "Jacobian nonzeros"))
 
@@ -294,9 +355,10 @@ def write_docs(rows: list[dict[str, Any]]) -> None:
              "time); the numeric Pinocchio path from Python (wall time). A shared 2-core "
              "machine: wall seconds move with its load.", "",
              "| N | states | build [s] | build CPU [s] (Python + compiler) | rhs / channels / "
-             "switches [CasADi instructions] | rhs [µs] | Jacobian build CPU [s] | Jacobian "
+             "switches [CasADi instructions] | rhs [µs] | rhs [instructions per call] | "
+             "Jacobian build CPU [s] | Jacobian "
              "instructions | Jacobian nonzeros (structural) | Jacobian [µs] | numeric rhs "
-             "[µs] |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "[µs] |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         sz = r.get("sizes", {})
         lines.append(
@@ -305,7 +367,8 @@ def write_docs(rows: list[dict[str, Any]]) -> None:
             f"{_cell(r.get('compiler_cpu_s', math.nan), '.1f')}) | "
             f"{_cell(_rhs_size(sz), '.0f')}{_parts(sz)} / {sz.get('out', '–')} / "
             f"{sz.get('sw', '–')} | "
-            f"{r['rhs_us']:.2f} | {_cell(r['jac_build_cpu_s'], '.1f')} | "
+            f"{r['rhs_us']:.2f} | {_cell(r.get('rhs_instr_per_call', math.nan), ',.0f')} | "
+            f"{_cell(r['jac_build_cpu_s'], '.1f')} | "
             f"{_cell(r['jac_instructions'], '.0f')} | {_cell(r['jac_nnz'], '.0f')} "
             f"({_cell(r['jac_structural'], '.0f')}) | {_cell(r['jac_us'], '.1f')} | "
             f"{_cell(r['numeric_rhs_us'], '.0f')} |")

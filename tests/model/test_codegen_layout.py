@@ -6,6 +6,7 @@ for bit (no fast-math, no FMA: the optimisation level changes no result)."""
 
 from __future__ import annotations
 
+import ctypes
 from pathlib import Path
 
 import machines as mc
@@ -162,3 +163,42 @@ def test_rhs_parts_are_the_same_operations(parts: int) -> None:
         assert not np.isnan(carried).any()  # every carried value written by its part
         np.testing.assert_array_equal(got, want)
         assert np.count_nonzero(want) > m.n_states // 2
+
+
+def test_sources_with_rhs_parts_compile_as_the_fmu_does(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """write_source (the FMU's path) with the rhs over :data:`RHS_PART`: its parts' files
+    before the last (``rhs1``, ``rhs2``, ``rhs3``, then ``rhs`` with the flat entry point),
+    each at ``OPTIMISE["part"]`` (several flags: :func:`with_level`); compiled from those
+    files and levels, the rhs equals the one-piece rhs of :func:`generate` bit for bit."""
+    m = Machine(mc.two_drum())
+    monkeypatch.setenv("WINDER_CACHE_DIR", str(tmp_path / "cache"))
+    whole = codegen.generate(m)
+    monkeypatch.setattr(codegen, "RHS_PART", 150)
+    (tmp_path / "src").mkdir()
+    paths, symbol, _, levels = codegen.write_source(m, tmp_path / "src")
+    assert [p.stem.removeprefix(symbol + "_") for p in paths] == [
+        "rhs1", "rhs2", "rhs3", "rhs", "jac", "out", "sw"]
+    assert levels[:4] == [codegen.OPTIMISE["part"]] * 4 and levels[4:] == [
+        codegen.OPTIMISE[k] for k in ("jac", "out", "sw")]
+    objs = []
+    for path, lv in zip(paths, levels, strict=True):
+        flags = codegen.with_level(codegen.compile_flags(), lv)
+        assert len(flags) == len(codegen.compile_flags()) + len(lv.split()) - 1
+        codegen.run_compiler([*flags, "-c", str(path), "-o", str(path.with_suffix(".o"))],
+                             path.name)
+        objs.append(str(path.with_suffix(".o")))
+    lib = tmp_path / "parts.so"
+    codegen.run_compiler([*codegen.link_flags(), *objs, "-o", str(lib), "-lm"], "parts")
+    fn = getattr(ctypes.CDLL(str(lib)), f"{symbol}_rhs_flat")
+    dp = np.ctypeslib.ndpointer(dtype=float, flags="C_CONTIGUOUS")
+    fn.argtypes = [dp] * 5
+    x0 = np.array(m.state_initial, dtype=float)
+    modes = np.array([AUTO if n.endswith(".contact") else CORE_AUTO for n in m.mode_names],
+                     dtype=float)
+    rng = np.random.default_rng(9)
+    for k in range(3):
+        x = x0 * (1 + 1e-3 * rng.standard_normal(m.n_states))
+        out = np.full(m.n_states, np.nan)
+        fn(np.array([1.0 + k]), x, m.parameters(), modes, out)
+        np.testing.assert_array_equal(out, whole.call("rhs", 1.0 + k, x, m.parameters(), modes))
