@@ -79,7 +79,7 @@ def run_child(scene: Path, src: Path) -> dict[str, Any]:
     if proc.returncode != 0:
         raise RuntimeError(proc.stderr[-2000:])
     out = json.loads(proc.stdout.strip().splitlines()[-1])
-    kb = [ln for ln in proc.stderr.splitlines() if "kB of C" in ln and "Jacobian built" not in ln]
+    kb = [ln for ln in proc.stderr.splitlines() if "code built in" in ln and "kB of C" in ln]
     out["kB_of_C"] = float(kb[-1].split("(")[-1].split()[0]) if kb else float("nan")
     return out
 
