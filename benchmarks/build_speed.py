@@ -167,6 +167,26 @@ and the parts on CasADi's virtual machine against the whole (tests/model). The s
 instructions now says, once its C is written, what it compiles and how big (functions,
 instructions, files, kB of C, compiler processes).
 
+The symbolic build (`winder.model.spatial`): the joints' kinematics (placements,
+velocities) were built three times per evaluation (the velocities the force elements read,
+ABA, the channels' RNEA) and each body's inertia, velocity-product acceleration and bias
+force twice (ABA, RNEA), on the same symbols; now once, kept for the next call on the same
+symbols. The flexible winder's symbolic build: 0.72-0.78 → 0.50-0.52 s CPU. The generated C
+of four shipped scenes (the two-drum winder, rigid and flexible, the dancer line, the paper
+winding; rhs, Jacobian, channels and switching functions) is byte for byte the same.
+
+Side by side with the tree before (1b64572), three runs of five pairs (the last six rows):
+the wall ratio, median of pairs, 9.4 → 6.2 (load 3.6-3.8, the rhs in parts only), 10.2 →
+6.1 (load 6.1-6.6, the same) and 10.6 → 6.1 (load 3.8-4.8, the kinematics shared too;
+pairs 6.5, 5.7, 6.1, 6.3, 5.9); the CPU ratio 9.7 → 7.6, 9.0 → 7.0 and 10.1 → 6.4. The
+flexible build's CPU in the last run 3.1-4.0 s (compilers 2.0-3.1 s, Python 0.8-1.1 s),
+the rigid's 0.5-0.6 s. Not yet reliably under 6: what is left of the flexible build
+(single runs, load ~4): the rhs's three parts 1.1-1.2 s, the channels at -O0 (8,776
+instructions) 0.56 s, the switching functions at -O3 0.2-0.3 s, the symbolic build 0.5 s,
+the Functions, CSE, cut and C 0.4 s (the cut 0.1 s). Of the rigid build's 0.5 s, 0.3-0.45 s
+are three compiler processes of 0.1-0.2 s each (their fixed cost: an empty file compiles in
+0.01 s, a 115-instruction one in 0.1 s).
+
 ## Where the build goes (the flexible two-drum winder, 213 states)
 
 Measured 2026-11-27 by hand (gcc 12.2, CasADi 3.8.2; CPU seconds of one compiler run
