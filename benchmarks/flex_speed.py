@@ -403,26 +403,27 @@ compiler runs, load ~3): register allocation over one function of thousands of v
 (`winder.model.c_split`, `codegen.RHS_PART`) a rhs of more than 4,000 instructions is cut
 into parts of about 4,000 (2 / 3 / 6 at N = 16 / 32 / 64; the same operations, each once,
 bitwise the same results), one C file each at -O1 -fstrict-aliasing
--finline-small-functions, compiled at once. The table above is this tree; the tree before
-(1b64572) measured with the same script right after it (load 4-5.5):
+-finline-small-functions, compiled at once; and the joints' kinematics built once per
+evaluation (they were built three times: velocities, ABA, RNEA). The table above is this
+tree (18252f4, load 4-5); "parts only" is the run before it (f9da1c0), and the tree before
+(1b64572) was measured with the same script right after that (load 4-5.5):
 
-| N | build CPU [s], before → now | rhs, instructions per call (valgrind) | rhs [µs] |
+| N | build CPU [s]: before / parts only / now | rhs, instructions per call (valgrind) | rhs [µs] |
 |---|---|---|---|
-| 8 | 1.6 → 1.5 | 5,965 → 5,965 (one file, -O3, unchanged) | 0.71 → 0.65 |
-| 16 | 3.4 → 2.4 | 11,556 → 11,336 | 2.69 → 1.85 |
-| 32 | 6.4 → 3.7 | 23,007 → 21,505 | 5.08 → 3.69 |
-| 64 | 18.3 → 9.8 | 46,517 → 42,851 | 7.62 → 9.55 |
-| N = 32 ÷ N = 8 | 4.0 → 2.5 | 3.86 → 3.61 | 7.2 → 5.7 |
+| 8 | 1.6 / 1.5 / 1.4 | 5,965 → 5,965 (one file at -O3, unchanged) | 0.71 / 0.65 / 0.65 |
+| 16 | 3.4 / 2.4 / 2.1 | 11,556 → 11,336 | 2.69 / 1.85 / 1.80 |
+| 32 | 6.4 / 3.7 / 4.3 | 23,007 → 21,505 | 5.08 / 3.69 / 3.57 |
+| 64 | 18.3 / 9.8 / 8.5 | 46,517 → 42,851 | 7.62 / 9.55 / 7.77 |
+| N = 32 ÷ N = 8 | 4.0 / 2.5 / 3.1 | 3.86 → 3.61 | 7.2 / 5.7 / 5.5 |
 
-The issue's growth goals (N = 32 within 4.5 times N = 8) now hold for the build CPU (2.5)
-and the rhs's instructions per call (3.6). The thread-CPU µs grow faster than the
-instructions in both trees (5.7-7.2 times): the rhs is straight-line code, at N = 8 about
-the size of the core's L1 instruction cache (36 kB of text against 32 kB), at N = 32 four
-times it (130-143 kB), so each call streams its code from L2; and these µs move by up to
-40 % with the machine's load (N = 64 now: 7.2 µs in the first run, 9.6 in this one). The
-"rhs instructions" slope above sums the parts' CasADi instructions, each part reading its
-inputs and carried values and writing its own (N = 32: 13,056 in 3 parts against 11,187 in
-one); the operations are the same.
+The issue's growth goals (N = 32 within 4.5 times N = 8) now hold for the build CPU (2.5
+and 3.1 in two runs) and the rhs's instructions per call (3.6). The thread-CPU µs grow
+faster than the instructions in both trees (5.5-7.2 times): the rhs is straight-line code,
+at N = 8 about the size of the core's L1 instruction cache (36 kB of text against 32 kB),
+at N = 32 four times it (130-143 kB), so each call streams its code from L2; and these µs
+move by up to 40 % with the machine's load. The "rhs instructions" slope above sums the
+parts' CasADi instructions, each part reading its inputs and carried values and writing its
+own (N = 32: 13,056 in 3 parts against 11,187 in one); the operations are the same.
 
 ## What grew faster than N, and the fix
 
