@@ -3,8 +3,9 @@ functions, compiled once per structure and cached on disk.
 
 The machine's dynamics (:meth:`~winder.model.machine.Machine.evaluate`) runs once on CasADi
 symbols; four functions of ``(t, x, p, m)`` (time, state, parameters, locked modes) are
-generated as C, one file each, wrapped with flat entry points ``int NAME(const double* t,
-const double* x, const double* p, const double* m, double* out)``. Each file goes to its
+generated as C, one file each (a large right-hand side in parts, :data:`RHS_PART`), wrapped
+with flat entry points ``int NAME(const double* t, const double* x, const double* p, const
+double* m, double* out)``. Each file goes to its
 own compiler process as soon as it is written (the right-hand side first), at the
 optimisation level of its function (:data:`OPTIMISE`). The right-hand side, channels and
 switching functions (:data:`MAIN`: all an explicit run needs) are joined into one
@@ -245,7 +246,8 @@ class Generated:
     from_cache: bool = False
     route: str = "py"
     #: CasADi instructions of each function (file) built in this process (empty when
-    #: loaded from the cache): ``rhs``, ``out``, ``sw``, and ``jac`` (``jac1``) once built
+    #: loaded from the cache): ``rhs`` (a large one in parts: ``rhs1``, ``rhs2``, ...,
+    #: ``rhs``), ``out``, ``sw``, and ``jac`` (``jac1``) once built
     sizes: dict[str, int] = field(default_factory=dict)
     _lib: Any = field(default=None, repr=False)
     _jac_lib: Any = field(default=None, repr=False)
