@@ -79,7 +79,7 @@ def run_child(scene: Path, src: Path) -> dict[str, Any]:
     if proc.returncode != 0:
         raise RuntimeError(proc.stderr[-2000:])
     out = json.loads(proc.stdout.strip().splitlines()[-1])
-    kb = [ln for ln in proc.stderr.splitlines() if "kB of C" in ln and "Jacobian built" not in ln]
+    kb = [ln for ln in proc.stderr.splitlines() if "code built in" in ln and "kB of C" in ln]
     out["kB_of_C"] = float(kb[-1].split("(")[-1].split()[0]) if kb else float("nan")
     return out
 
@@ -121,6 +121,72 @@ def main() -> None:
 #: 12.2, CPU seconds of single compiler runs: a loaded machine stretches wall time, not
 #: these), the study behind the layout of :mod:`winder.model.codegen`.
 STUDY = """
+## The right-hand side in parts (issue #33, 2026-11-28)
+
+Measured by hand (gcc 12.2, CasADi 3.8.2; CPU seconds of single compiler runs; run cost in
+instructions per call under valgrind (cachegrind), which the machine's load does not move,
+and thread CPU µs in a C loop; a 2-core machine at load 2-5). The flexible two-drum winder
+(309 states) before: symbolic build 0.63 s, the rhs's Function with CSE 0.04 s and its C
+0.03 s, then the rhs (10,050 instructions, 205 kB of C) at -O3 2.2-3.5 s, channels (8,776,
+-O0) 0.56 s, switching functions (889, -O3) 0.2 s, the links 0.02 s. The rigid winder:
+symbolic 0.09 s, compilers 0.3-0.5 s (three processes of 0.1-0.2 s: mostly each compiler's
+fixed cost), so no fixed cost hides in the ratio's denominator. `-ftime-report` on the
+flexible rhs at -O3: 92 % in the passes after RTL expansion, register allocation (IRA, LRA)
+and post-reload CSE and scheduling the largest; -O2 compiles in the same time.
+
+| flexible winder's rhs | compile CPU [s] | run: instructions per call | bitwise |
+|---|---|---|---|
+| -O3, one file (before) | 2.2-3.5 | 1 (about 22 k) | – |
+| -O2 | 2.3-2.9 | 1.000 | same |
+| -O1 | 1.7-1.9 | 1.07 (`sq`, `fmax`, `fabs` not inlined) | same |
+| -O1 -fstrict-aliasing -finline-small-functions (-O1+) | 1.4-1.5 | 1.007 | same |
+| -O2 without sched2, gcse, PRE; -fira-region=one | 2.3-2.5 | 1.000 | same |
+| -O2 -fira-algorithm=priority | 3.1 | 1.03 | same |
+| -O1+, 2 / 3 / 4 / 6 parts | 1.2 / 1.1-1.2 / 1.2-1.5 / 1.4-1.6 | .998 / 1 / 1.004 / 1.009 | same |
+
+-O1+ on one large function does not carry to larger machines: on the flexible drum's rhs at
+N = 32 (11,187 instructions) LRA's hard-register assignment grew to a third of the time,
+-O1+ 3.1 s against -O3 2.9 s; in 4 parts 1.4 s against 2.1-2.4 s at -O3 in 4 parts, and
+25.6 k instructions per call at -O3 in one against 24.3 k in parts. The compiler's time on
+one function grows faster than the function (the flexible drum's rhs at -O3: 0.5 s at
+N = 8, 2.9 s at N = 32, 7.8 s at N = 64 for 2.8 k / 11.2 k / 22.3 k instructions): parts
+of bounded size make it linear.
+
+Now (`winder.model.c_split`, `codegen.RHS_PART`): a rhs of more than 4,000 CasADi
+instructions is cut into parts of about 4,000 (the flexible winder's in 3: 3,619 + 3,418 +
+4,296 instructions, 305 values carried between them), its CSE'd algorithm replayed on fresh
+symbols with CasADi's simplification on the fly off, so that every part holds exactly the
+operations of the whole, each once (the parts' operations add up to the whole's; the
+carried values are stored and read through one array on the stack); one C file per part
+at `OPTIMISE["part"]` (-O1+), all compiled at once with the channels and switching
+functions. A smaller rhs (the rigid winder's, 516) is one file at -O3 as before. Every
+result is bitwise the same as before: the flexible winder's rhs, channels, switching
+functions and Jacobian at four states (385,640 values) against the tree before (1b64572),
+and the parts on CasADi's virtual machine against the whole (tests/model). The split costs
+0.1 s of Python and each part's Function and C about 0.03 s. A build of more than 4,000
+instructions now says, once its C is written, what it compiles and how big (functions,
+instructions, files, kB of C, compiler processes).
+
+The symbolic build (`winder.model.spatial`): the joints' kinematics (placements,
+velocities) were built three times per evaluation (the velocities the force elements read,
+ABA, the channels' RNEA) and each body's inertia, velocity-product acceleration and bias
+force twice (ABA, RNEA), on the same symbols; now once, kept for the next call on the same
+symbols. The flexible winder's symbolic build: 0.72-0.78 → 0.50-0.52 s CPU. The generated C
+of four shipped scenes (the two-drum winder, rigid and flexible, the dancer line, the paper
+winding; rhs, Jacobian, channels and switching functions) is byte for byte the same.
+
+Side by side with the tree before (1b64572), three runs of five pairs (the last six rows):
+the wall ratio, median of pairs, 9.4 → 6.2 (load 3.6-3.8, the rhs in parts only), 10.2 →
+6.1 (load 6.1-6.6, the same) and 10.6 → 6.1 (load 3.8-4.8, the kinematics shared too;
+pairs 6.5, 5.7, 6.1, 6.3, 5.9); the CPU ratio 9.7 → 7.6, 9.0 → 7.0 and 10.1 → 6.4. The
+flexible build's CPU in the last run 3.1-4.0 s (compilers 2.0-3.1 s, Python 0.8-1.1 s),
+the rigid's 0.5-0.6 s. Not yet reliably under 6: what is left of the flexible build
+(single runs, load ~4): the rhs's three parts 1.1-1.2 s, the channels at -O0 (8,776
+instructions) 0.56 s, the switching functions at -O3 0.2-0.3 s, the symbolic build 0.5 s,
+the Functions, CSE, cut and C 0.4 s (the cut 0.1 s). Of the rigid build's 0.5 s, 0.3-0.45 s
+are three compiler processes of 0.1-0.2 s each (their fixed cost: an empty file compiles in
+0.01 s, a 115-instruction one in 0.1 s).
+
 ## Where the build goes (the flexible two-drum winder, 213 states)
 
 Measured 2026-11-27 by hand (gcc 12.2, CasADi 3.8.2; CPU seconds of one compiler run

@@ -176,4 +176,5 @@ def without_build_lines(err: str) -> str:
     depend on the cache, not on what a test checks)."""
     import re
 
-    return re.sub(r"(?m)^winder: (building .*|.*'s (code|Jacobian) built in .*)\n", "", err)
+    return re.sub(r"(?m)^winder: (building .*|compiling .*|.*'s (code|Jacobian) built in .*)\n",
+                  "", err)

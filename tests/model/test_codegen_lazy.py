@@ -54,7 +54,7 @@ def _eager_jacobian(m: Machine, directory: Path) -> ctypes.CDLL:
     paths, symbol, _, levels = codegen.write_source(m, directory)
     objs = []
     for path, lv in zip(paths, levels, strict=True):
-        flags = [lv if f == "-O3" else f for f in codegen.compile_flags()]
+        flags = codegen.with_level(codegen.compile_flags(), lv)
         codegen.run_compiler([*flags, "-c", str(path), "-o", str(path.with_suffix(".o"))],
                              path.name)
         objs.append(str(path.with_suffix(".o")))

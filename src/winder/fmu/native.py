@@ -36,7 +36,7 @@ from winder.fmu.balance import Balance, balance_of, write_balance_source
 from winder.fmu.description import build_description, model_description
 from winder.fmu.interface import NativeInterface, indicators, native_interface, zero_sides
 from winder.fmu.parameters import FmuError, scene_with_parameters
-from winder.model.codegen import CFLAGS, SANITIZE_CFLAGS, run_compiler, write_source
+from winder.model.codegen import CFLAGS, SANITIZE_CFLAGS, run_compiler, with_level, write_source
 from winder.parts import body_elements
 from winder.scene.load import Scene, load_scene
 
@@ -117,7 +117,7 @@ def _compile(sources: Path, model: str, out: Path, symbol: str, generated: dict[
     for src in (*generated, f"{symbol}_balance.c", *_INTEGRATORS, *wrappers):
         flags = base if src.startswith(symbol) else strict
         if src in generated and not sanitize:  # each at its level, as codegen compiles it
-            flags = [generated[src] if f == "-O3" else f for f in flags]
+            flags = list(with_level(flags, generated[src]))
         obj = sources.parent.parent / (Path(src).stem + ".o")
         run_compiler([*flags, "-I", str(sources), "-c", str(sources / src), "-o", str(obj)],
                      src)

@@ -1,14 +1,15 @@
 """The C text around CasADi's generated functions (:mod:`winder.model.codegen`): CasADi's
 null checks removed (:func:`unguarded`) and the flat, reentrant entry points
 ``SYMBOL_K_flat(t, x, p, m, out)`` (:func:`flat_entry`), the Jacobian's with its
-nonzeros' entry point and CCS pattern."""
+nonzeros' entry point and CCS pattern, and that of a function cut into parts
+(:func:`parts_entry`, :mod:`winder.model.c_split`)."""
 
 from __future__ import annotations
 
 import re
 from typing import Any
 
-__all__ = ["unguarded", "flat_entry"]
+__all__ = ["unguarded", "flat_entry", "parts_entry"]
 
 
 def unguarded(code: str) -> str:
@@ -74,3 +75,27 @@ def flat_entry(symbol: str, k: str, f: Any, blocks: list[tuple[str, Any, int]] |
             f"    out[k] = 0.;\n"
             f"    out[{symbol}_jac_place[k]] = v;\n  }}\n"
             f"  return flag;\n}}\n")
+
+
+def parts_entry(symbol: str, k: str, parts: list[tuple[str, Any, int | None]],
+                n_carried: int) -> str:
+    """The flat, reentrant entry point ``SYMBOL_K_flat(t, x, p, m, out)`` of a function cut
+    into parts (:func:`winder.model.c_split.split`; ``parts``: each part's C name, function
+    and offset into the carried values, ``None`` for the last): the parts called in turn,
+    each writing its carried values into one array on the stack (``c``, ``n_carried``
+    doubles), the last the output."""
+    fs = [g for _, g, _ in parts]
+    decls = "".join(f"int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, "
+                    "casadi_real* w, int mem);\n" for name, _, _ in parts[:-1])
+    calls = "".join(f"  res[0] = {'out' if off is None else f'c + {off}'};\n"
+                    f"  flag |= {name}(arg, res, iw, w, 0);\n" for name, _, off in parts)
+    return (f"\n{decls}/* flat, reentrant entry point: the {len(parts)} parts in turn */\n"
+            f"int {symbol}_{k}_flat(const double* t, const double* x, const double* p, "
+            f"const double* m, double* out) {{\n"
+            f"  casadi_real c[{max(n_carried, 1)}];\n"
+            f"  const casadi_real* arg[{max(5, *(g.sz_arg() for g in fs))}] = "
+            "{t, x, p, m, c};\n"
+            f"  casadi_real* res[{max(1, *(g.sz_res() for g in fs))}];\n"
+            f"  casadi_int iw[{max(g.sz_iw() for g in fs) + 1}];\n"
+            f"  casadi_real w[{max(g.sz_w() for g in fs) + 1}];\n"
+            f"  int flag = 0;\n" + calls + "  return flag;\n}\n")

@@ -3,8 +3,9 @@ functions, compiled once per structure and cached on disk.
 
 The machine's dynamics (:meth:`~winder.model.machine.Machine.evaluate`) runs once on CasADi
 symbols; four functions of ``(t, x, p, m)`` (time, state, parameters, locked modes) are
-generated as C, one file each, wrapped with flat entry points ``int NAME(const double* t,
-const double* x, const double* p, const double* m, double* out)``. Each file goes to its
+generated as C, one file each (a large right-hand side in parts, :data:`RHS_PART`), wrapped
+with flat entry points ``int NAME(const double* t, const double* x, const double* p, const
+double* m, double* out)``. Each file goes to its
 own compiler process as soon as it is written (the right-hand side first), at the
 optimisation level of its function (:data:`OPTIMISE`). The right-hand side, channels and
 switching functions (:data:`MAIN`: all an explicit run needs) are joined into one
@@ -53,13 +54,14 @@ import numpy as np
 from winder._errors import WinderError
 from winder.model.c_entry import flat_entry as _flat_entry
 from winder.model.c_entry import unguarded as _unguarded
+from winder.model.c_split import write_parts
 from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
            "stats", "Link", "compile_flags", "link_flags", "run_compiler",
            "sanitized", "SANITIZE_CFLAGS", "CFLAGS", "source_hash", "write_source",
            "OPTIMISE", "function_flags", "LAYOUT", "LARGE", "level", "JAC_SPLIT",
-           "MAIN", "JACOBIAN"]
+           "MAIN", "JACOBIAN", "RHS_PART", "with_level"]
 
 #: The generated functions, in the order of :attr:`Generated.addresses`.
 FUNCTIONS = ("rhs", "jac", "out", "sw")
@@ -73,7 +75,16 @@ CFLAGS = ("-O3", "-shared", "-fPIC", "-fno-semantic-interposition")
 #: -O1 at run time, 30 % cheaper to compile: the flexible two-drum winder's Jacobian, 58,825
 #: instructions, 7.8 s CPU against 10.9 s at -O1 and 24.7 s at -O3, 20 µs a call). None
 #: changes a result: no fast-math, no FMA contraction on the default target.
-OPTIMISE = {"rhs": "-O3", "jac": "-Og", "out": "-Og", "sw": "-O3"}
+OPTIMISE = {"rhs": "-O3", "jac": "-Og", "out": "-Og", "sw": "-O3",
+            "part": "-O1 -fstrict-aliasing -finline-small-functions"}
+#: A right-hand side of more CasADi instructions than this is cut into parts of about this
+#: many (:mod:`winder.model.c_split`: the same operations, bitwise the same results), one
+#: file each, compiled at once at ``OPTIMISE["part"]``: -O1 and the two -O2 passes that
+#: matter here (CasADi's ``sq``, ``fmax``, ``fabs`` inlined; ``arg[i]`` not reloaded after
+#: each store): 0-1 % more instructions per call than -O3 (valgrind), half its compile
+#: time. One large function at -O1+ would not do: its register allocation grows faster
+#: than it (the flexible drum's rhs at N = 32: 3.1 s against 2.9 s at -O3; 3 parts 1.2 s).
+RHS_PART = 4000
 #: A channel function of more CasADi instructions than this compiles at -O0 (called once
 #: per output row: the flexible two-drum winder's, 8394 instructions, 2.0 s CPU at -O1, 0.7 s
 #: at -O0). Not the Jacobian: at -O0 it compiles in half the time of -Og (3.9 s) but runs
@@ -88,8 +99,8 @@ SAY_AFTER = 5.0
 #: The layout of the generated code (in the cache key): one C file per function, the
 #: Jacobian on its nonzeros scattered by its flat entry point (beside it its nonzeros' entry
 #: point and CCS pattern) in a library of its own built on first use, CasADi's null checks
-#: removed.
-LAYOUT = "lazy-jac-split-sparse-unguarded-4"
+#: removed; a large right-hand side in parts (:data:`RHS_PART`).
+LAYOUT = "lazy-jac-split-sparse-unguarded-rhs-parts-5"
 #: ``WINDER_SANITIZE=1`` (``make test-asan``): AddressSanitizer and UBSan on every object
 #: and the link (Python then needs libasan preloaded; see the Makefile).
 SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
@@ -132,18 +143,23 @@ def compile_flags() -> tuple[str, ...]:
 
 
 def level(which: str, size: int) -> str:
-    """The optimisation level of one generated function (one of :data:`FUNCTIONS`) of
-    ``size`` CasADi instructions: :data:`OPTIMISE`, and -O0 for a channel function over
-    :data:`LARGE`."""
+    """The optimisation level of one generated function (one of :data:`FUNCTIONS`, or
+    ``"part"``: a part of a right-hand side over :data:`RHS_PART`) of ``size`` CasADi
+    instructions: :data:`OPTIMISE`, and -O0 for a channel function over :data:`LARGE`."""
     return "-O0" if which == "out" and size > LARGE else OPTIMISE[which]
+
+
+def with_level(flags: tuple[str, ...] | list[str], lv: str) -> tuple[str, ...]:
+    """``flags`` with their ``-O3`` replaced by the level ``lv`` (one or more flags, such as
+    ``OPTIMISE["part"]``)."""
+    return tuple(g for f in flags for g in (lv.split() if f == "-O3" else (f,)))
 
 
 def function_flags(which: str, size: int) -> tuple[str, ...]:
     """The flags the object of one generated function is compiled with:
     :func:`compile_flags` at its :func:`level` (sanitized: -O1 throughout)."""
     flags = compile_flags()
-    lv = level(which, size)
-    return flags if sanitized() else tuple(lv if f == "-O3" else f for f in flags)
+    return flags if sanitized() else with_level(flags, level(which, size))
 
 
 def link_flags() -> tuple[str, ...]:
@@ -230,7 +246,8 @@ class Generated:
     from_cache: bool = False
     route: str = "py"
     #: CasADi instructions of each function (file) built in this process (empty when
-    #: loaded from the cache): ``rhs``, ``out``, ``sw``, and ``jac`` (``jac1``) once built
+    #: loaded from the cache): ``rhs`` (a large one in parts: ``rhs1``, ``rhs2``, ...,
+    #: ``rhs``), ``out``, ``sw``, and ``jac`` (``jac1``) once built
     sizes: dict[str, int] = field(default_factory=dict)
     _lib: Any = field(default=None, repr=False)
     _jac_lib: Any = field(default=None, repr=False)
@@ -356,7 +373,7 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
     # the order of generation: the rhs first (its compile is long for its size), the
     # Jacobian's file with the flat entry point last of its blocks
     if "rhs" in which:
-        outs.append(("rhs", "rhs", lambda: ca.densify(xdot)))
+        outs.append(("rhs", "rhs", lambda: ca.densify(xdot)))  # cut into parts if large
     if "jac" in which:
         jac = sym.jac
         colind = jac.sparsity().colind()
@@ -377,6 +394,9 @@ def _c_source(machine: Machine, symbol: str, directory: Path, route: str,
     made: dict[str, Any] = {}
     for kind, name, expr in outs:
         f = made[name] = ca.Function(f"{symbol}_{name}", [t, x, p, m], [expr()], {"cse": True})
+        if kind == "rhs" and f.n_instructions() > RHS_PART:  # in parts, one file each
+            files += write_parts(f, symbol, directory, RHS_PART, ready)
+            continue
         cg = ca.CodeGenerator(f"{symbol}_{name}.c", {"with_header": False})
         cg.add(f)
         # dump() rather than generate(): the same code, written here, without loading
@@ -402,7 +422,8 @@ def _say(line: str) -> None:
 def _key(machine: Machine, route: str, cflags: tuple[str, ...]) -> str:
     """The cache key of a machine's generated code (:func:`generate`): its structure, the
     physics' source, CasADi, the route, the layout and every object's flags."""
-    levels = f"{sorted(OPTIMISE.items())} out -O0 over {LARGE}; jac split at {JAC_SPLIT}"
+    levels = (f"{sorted(OPTIMISE.items())} out -O0 over {LARGE}; jac split at {JAC_SPLIT}; "
+              f"rhs parts of {RHS_PART}")
     return hashlib.sha256("|".join((machine.structure_key(), source_hash(), _casadi_version(),
                                     route, LAYOUT, levels, " ".join(cflags))).encode()
                           ).hexdigest()[:20]
@@ -541,16 +562,33 @@ def _compile_sources(machine: Machine, symbol: str, tmp: Path, route: str,
     """Write the C of the functions ``which`` into ``tmp`` and compile each into an object
     beside it (one compiler process each, started as soon as its file is written); the
     sources' paths. ``sizes``: each file's CasADi instructions, by its function's name."""
+    these: dict[str, int] = {}  # this call's files
     with _Compiles() as jobs:  # each function compiles while the next is made
         def ready(kind: str, src: Path, size: int) -> None:
-            sizes[src.stem.rsplit("_", 1)[1]] = size
+            sizes[src.stem.rsplit("_", 1)[1]] = these[src.stem.rsplit("_", 1)[1]] = size
             jobs.start([*function_flags(kind, size), "-c", str(src), "-o",
                         str(src.with_suffix(".o"))], "the generated model")
 
         srcs = [f for _, f, _ in _c_source(machine, symbol, tmp, route, ready, which=which,
                                            symbols=symbols)[0]]
+        if sum(these.values()) > RHS_PART:  # a build of seconds: what it compiles, how big
+            kb = sum(s.stat().st_size for s in srcs) / 1024
+            _say(f"winder: compiling {_what(these)} ({kb:.0f} kB of C, {len(srcs)} compiler "
+                 "processes)")
         jobs.wait()
     return srcs
+
+
+def _what(sizes: dict[str, int]) -> str:
+    """``sizes`` (CasADi instructions by file) in words: each function's and its files."""
+    words = []
+    for k, label in (("rhs", "rhs"), ("jac", "Jacobian"), ("out", "channels"),
+                     ("sw", "switching functions")):
+        mine = [v for f, v in sizes.items() if f.rstrip("0123456789") == k]
+        if mine:
+            words.append(f"{label} {sum(mine):,}"
+                         + (f" (in {len(mine)} files)" if len(mine) > 1 else ""))
+    return ", ".join(words) + " CasADi instructions"
 
 
 def _jacobian_library(machine: Machine, symbol: str, root: Path, route: str, name: str,

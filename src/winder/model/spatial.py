@@ -100,10 +100,18 @@ class SpatialFunctions:
     def __init__(self, model: pin.Model) -> None:
         self.joints = joint_infos(model)
         self.nv = model.nv
+        self._last: tuple[Any, Any, tuple[list[Any], list[Any], list[Any]]] | None = None
+        self._last_bodies: tuple[Any, Any, Any, tuple[list[Any], ...]] | None = None
 
     def _kinematics(self, q: Any, v: Any) -> tuple[list[Any], list[Any], list[Any]]:
+        """Each joint's placement (motion transform from its parent), spatial velocity and
+        motion subspace; those of the last call again when ``q`` and ``v`` are the same
+        symbols (the velocities, ABA and RNEA of one evaluation share them: built once)."""
         import casadi as ca
 
+        last = self._last
+        if last is not None and ca.is_equal(last[0], q, 0) and ca.is_equal(last[1], v, 0):
+            return last[2]
         X, V, S = [], [], []
         for i, j in enumerate(self.joints):
             axis = ca.DM(j.axis)
@@ -120,7 +128,28 @@ class SpatialFunctions:
             V.append(A @ vp + s * v[i])
             X.append(A)
             S.append(s)
+        self._last = (q, v, (X, V, S))
         return X, V, S
+
+    def _bodies(self, q: Any, v: Any, dyn: Any) -> tuple[list[Any], ...]:
+        """:meth:`_kinematics` and, per joint, the velocity-product acceleration ``C = v ×
+        S q̇``, the spatial inertia ``Y`` and the bias force ``v ×* Y v``; those of the last
+        call again for the same symbols (ABA and RNEA of one evaluation share them)."""
+        import casadi as ca
+
+        last = self._last_bodies
+        if last is not None and all(ca.is_equal(a, b, 0) for a, b in zip(last[:3], (q, v, dyn),
+                                                                          strict=True)):
+            return last[3]
+        X, V, S = self._kinematics(q, v)
+        C, Y, B = [], [], []
+        for i in range(len(self.joints)):
+            C.append(_motion_cross(ca, V[i], S[i] * v[i]))
+            Y.append(inertia_matrix(ca, dyn[10 * i:10 * i + 10]))
+            B.append(_force_cross(ca, V[i], Y[i] @ V[i]))
+        out = (X, V, S, C, Y, B)
+        self._last_bodies = (q, v, dyn, out)
+        return out
 
     def vel(self, q: Any, v: Any) -> list[Any]:
         """Spatial velocity of every joint in its frame (``data.v[1:]``)."""
@@ -130,14 +159,10 @@ class SpatialFunctions:
         """Joint accelerations ``q̈`` (``pin.aba(model, data, q, v, tau, fext)``)."""
         import casadi as ca
 
-        X, V, S = self._kinematics(q, v)
+        X, V, S, C, Y, B = self._bodies(q, v, dyn)
         n = len(self.joints)
-        Ia, pA, C = [], [], []
-        for i in range(n):
-            Y = inertia_matrix(ca, dyn[10 * i:10 * i + 10])
-            Ia.append(Y)
-            pA.append(_force_cross(ca, V[i], Y @ V[i]) - fext[6 * i:6 * i + 6])
-            C.append(_motion_cross(ca, V[i], S[i] * v[i]))
+        Ia = list(Y)
+        pA = [B[i] - fext[6 * i:6 * i + 6] for i in range(n)]
         U, D, u = [None] * n, [None] * n, [None] * n
         for i in reversed(range(n)):
             U[i] = Ia[i] @ S[i]
@@ -164,17 +189,15 @@ class SpatialFunctions:
         """Joint torques ``τ`` (``pin.rnea(model, data, q, v, a, fext)``)."""
         import casadi as ca
 
-        X, V, S = self._kinematics(q, v)
+        X, V, S, C, Y, B = self._bodies(q, v, dyn)
         n = len(self.joints)
         a0 = ca.vertcat(-g, ca.DM.zeros(3))
         A: list[Any] = [None] * n
         F = []
         for i in range(n):
             par = self.joints[i].parent
-            A[i] = X[i] @ (A[par - 1] if par > 0 else a0) + S[i] * a[i] \
-                + _motion_cross(ca, V[i], S[i] * v[i])
-            Y = inertia_matrix(ca, dyn[10 * i:10 * i + 10])
-            F.append(Y @ A[i] + _force_cross(ca, V[i], Y @ V[i]) - fext[6 * i:6 * i + 6])
+            A[i] = X[i] @ (A[par - 1] if par > 0 else a0) + S[i] * a[i] + C[i]
+            F.append(Y[i] @ A[i] + B[i] - fext[6 * i:6 * i + 6])
         tau: list[Any] = [None] * n
         for i in reversed(range(n)):
             tau[i] = S[i].T @ F[i]
