@@ -147,17 +147,26 @@ class Side:
         if not self.python.exists():
             self.python = Path(sys.executable)
         self.winder = self.python.parent / "winder"
+        # each side imports its own tree: a PYTHONPATH inherited from the caller (the shared
+        # venv's `PYTHONPATH=$PWD/src`) would make the baseline's interpreter import this
+        # tree's winder and the comparison measure this tree against itself
+        self.env = {**os.environ, "PYTHONPATH": str(root / "src")}
+        found = self.json("import json, winder; print(json.dumps(winder.__file__))")
+        if not Path(found).resolve().is_relative_to(root.resolve()):
+            raise SystemExit(f"{label}: {self.python} imports winder from {found}, not from "
+                             f"{root}")
 
     def json(self, code: str, *args: str, env: dict[str, str] | None = None) -> Any:
         proc = subprocess.run([str(self.python), "-c", code, *args], cwd=self.root,
-                              capture_output=True, text=True, env=env, check=False)
+                              capture_output=True, text=True, env={**self.env, **(env or {})},
+                              check=False)
         if proc.returncode != 0:
             raise SystemExit(f"{self.label}: {proc.stderr[-2000:]}")
         return json.loads(proc.stdout.strip().splitlines()[-1])
 
     def seconds(self, args: list[str]) -> float:
         t0 = time.perf_counter()
-        subprocess.run(args, cwd=self.root, capture_output=True, check=True)
+        subprocess.run(args, cwd=self.root, capture_output=True, env=self.env, check=True)
         return time.perf_counter() - t0
 
 
@@ -190,7 +199,7 @@ def measure(sides: list[Side], repeats: int, process_repeats: int) -> dict[str, 
         print(f"{s.label}: winder run {out[s.label]['winder_run']:.2f} s, import+parse "
               f"{out[s.label]['import_parse']:.3f} s", flush=True)
     with tempfile.TemporaryDirectory() as cache:
-        env = {**os.environ, "WINDER_CACHE_DIR": cache}
+        env = {"WINDER_CACHE_DIR": cache}
         out[sides[0].label]["compile"] = sides[0].json(_COMPILE, json.dumps(SCENES), env=env)
     return out
 
