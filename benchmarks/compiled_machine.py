@@ -72,7 +72,10 @@ if lib is not None:
         return lib.repeat(fns, which, count, t, y, p, m, out)
 else:  # a baseline with the numba kernels
     from numba import njit
-    from winder.solve.dopri5 import dopri5
+    try:  # the numba DOPRI5's module: solve/dopri5.py (3f69a51), integrators.py (3a29466)
+        from winder.solve.dopri5 import dopri5
+    except ImportError:
+        dopri5 = integ.dopri5
     g = integ.switch_buffer(table)
     def modes(t, y, m):
         integ.modes_of(fns, table, np.empty(1), t, y, p, m, g, False)
