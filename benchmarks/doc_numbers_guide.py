@@ -182,7 +182,8 @@ def _link(s) -> str:  # noqa: ANN001
     cm = s.bench("compiled_machine")
     tree = next(v for k, v in cm.items() if k.startswith("this tree"))
     links = [m["link_only"] for m in tree["compile"]["machines"].values()]
-    return f"{min(links):.3f}–{max(links):.3f} s each"
+    lo, hi = f"{min(links):.3f}", f"{max(links):.3f}"
+    return f"{lo} s each" if lo == hi else f"{lo}–{hi} s each"
 
 
 def _python_call(s) -> str:  # noqa: ANN001
