@@ -39,8 +39,6 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
-import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -51,10 +49,10 @@ from typing import Any
 
 import numpy as np
 
-from winder._errors import WinderError
 from winder.model.c_entry import flat_entry as _flat_entry
 from winder.model.c_entry import unguarded as _unguarded
 from winder.model.c_split import write_parts
+from winder.model.compiler import CompileError, CompilerMissing, Compiles, run_compiler
 from winder.model.machine import Machine
 
 __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileError", "FUNCTIONS",
@@ -110,14 +108,6 @@ SANITIZE_CFLAGS = ("-fsanitize=address,undefined", "-fno-sanitize-recover=undefi
 stats = {"compiled": 0, "linked": 0, "cached": 0, "jacobians": 0}
 
 
-class CompilerMissing(WinderError, RuntimeError):
-    """No C compiler: the generated path is unavailable (the numeric path remains)."""
-
-
-class CompileError(WinderError, RuntimeError):
-    """The C compiler failed on the generated model: the message holds its output."""
-
-
 def cache_dir() -> Path:
     """``$WINDER_CACHE_DIR`` or ``$XDG_CACHE_HOME/winder`` (``~/.cache/winder``)."""
     env = os.environ.get("WINDER_CACHE_DIR")
@@ -167,15 +157,6 @@ def link_flags() -> tuple[str, ...]:
     return (*CFLAGS, *SANITIZE_CFLAGS) if sanitized() else CFLAGS
 
 
-def run_compiler(args: list[str], what: str) -> None:
-    """Run the C compiler with ``args``; :class:`CompileError` with its output if it
-    fails."""
-    cc = _compiler()
-    proc = subprocess.run([cc, *args], capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise CompileError(f"compiling {what} failed ({cc}):\n" + proc.stderr[-2000:])
-
-
 def source_hash() -> str:
     """A hash of the physics' source (:mod:`winder.model`, :mod:`winder.parts`,
     :mod:`winder.forces`; computed once per process)."""
@@ -210,20 +191,6 @@ def _casadi_version() -> str:
         import casadi as ca
 
         return str(ca.__version__)
-
-
-def _compiler() -> str:
-    """The C compiler: ``$CC``, else ``cc`` or ``gcc`` on the PATH."""
-    env = os.environ.get("CC")
-    if env:
-        cc = shutil.which(env)
-        if cc is None:
-            raise CompilerMissing(f"the C compiler CC={env!r} is not found")
-        return cc
-    cc = shutil.which("cc") or shutil.which("gcc")
-    if cc is None:
-        raise CompilerMissing("no C compiler (cc or gcc) on the PATH")
-    return cc
 
 
 @dataclass
@@ -447,35 +414,6 @@ def write_source(machine: Machine, directory: Path, *, route: str | None = None
             [level(which, size) for which, _, size in files])
 
 
-class _Compiles:
-    """The generated functions' objects compiled at once (one compiler process each,
-    started as soon as its source is written); :meth:`wait` raises :class:`CompileError`
-    on the first failure; leaving the ``with`` block ends any still running."""
-
-    def __init__(self) -> None:
-        self.running: list[tuple[subprocess.Popen[str], str]] = []
-
-    def start(self, args: list[str], what: str) -> None:
-        self.running.append((subprocess.Popen([_compiler(), *args], stdout=subprocess.DEVNULL,
-                                              stderr=subprocess.PIPE, text=True), what))
-
-    def wait(self) -> None:
-        for proc, what in self.running:
-            _, err = proc.communicate()
-            if proc.returncode != 0:
-                raise CompileError(f"compiling {what} failed ({proc.args[0]}):\n"
-                                   + err[-2000:])
-
-    def __enter__(self) -> _Compiles:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for proc, _ in self.running:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait()
-
-
 @dataclass(frozen=True)
 class Link:
     """Objects linked into every machine's library, and a key of their sources and
@@ -563,7 +501,7 @@ def _compile_sources(machine: Machine, symbol: str, tmp: Path, route: str,
     beside it (one compiler process each, started as soon as its file is written); the
     sources' paths. ``sizes``: each file's CasADi instructions, by its function's name."""
     these: dict[str, int] = {}  # this call's files
-    with _Compiles() as jobs:  # each function compiles while the next is made
+    with Compiles() as jobs:  # each function compiles while the next is made
         def ready(kind: str, src: Path, size: int) -> None:
             sizes[src.stem.rsplit("_", 1)[1]] = these[src.stem.rsplit("_", 1)[1]] = size
             jobs.start([*function_flags(kind, size), "-c", str(src), "-o",
