@@ -266,8 +266,10 @@ def goal(out: dict[str, Any], labels: list[str]) -> list[str]:
         return []
     a, b = out[labels[0]]["two_drum"], out[labels[1]]["two_drum"]
     return [f"Two-drum cycle, this tree ÷ baseline (issue #33, goal ≤ 0.60): "
-            f"{a['cpu'] / b['cpu']:.3f} in CPU time ({a['wall'] / b['wall']:.3f} in wall "
-            "time, which, where more processes run than there are cores, measures the "
+            f"{a['cpu'] / b['cpu']:.3f} in CPU time (of the whole `simulate` call: set-up, "
+            "balance, integration and channels, a small fixed share of a cycle) "
+            f"({a['wall'] / b['wall']:.3f} in wall time of the integration alone, which, "
+            "where more processes run than there are cores, measures the "
             "machine's load as much as the code: the best of a few runs of either side may "
             f"or may not have been descheduled); evaluations {a['nfev']:,} against "
             f"{b['nfev']:,}.", ""]

@@ -65,12 +65,10 @@ def _group(dso: str, sym: str) -> str:
         return "calls through the PLT"
     if "libm" in dso:
         return "libm " + re.sub(r"^__(ieee754_)?|_(fma|avx2|sse2|fma4)$", "", sym)
-    if re.search(r"_jac\d*_f\d", sym):
-        return "generated Jacobian"
-    for part, row in (("_rhs_", "generated rhs"), ("_sw_", "generated switching functions"),
-                      ("_out_", "generated channels")):
-        if part in sym:
-            return row
+    gen = re.search(r"_(jac|rhs|sw|out)\d*(_|$)", sym)  # a rhs in parts: _rhs1, _rhs2, ...
+    if gen is not None:
+        return {"jac": "generated Jacobian", "rhs": "generated rhs",
+                "sw": "generated switching functions", "out": "generated channels"}[gen[1]]
     if sym.startswith("winder_") or (dso.endswith(".so") and re.match(r"w[0-9a-f]{8}", dso)):
         return "C integrators, events (winder_*)"
     return "the rest (Python, numpy, kernel)"

@@ -103,6 +103,9 @@ def split(f: Any, names: list[str]) -> list[Part]:
 
             for op, args, v in steps[j]:
                 a = [get(u) for u in args]
+                if len(a) not in (1, 2):  # a call node, say: not an operation replayed here
+                    raise NotImplementedError(f"c_split: operation {op} of {len(a)} operands "
+                                              "(only unary and binary operations are split)")
                 made[v] = ca.SX.unary(op, a[0]) if len(a) == 1 else \
                     ca.SX.binary(op, a[0], a[1])
             if j < parts - 1:

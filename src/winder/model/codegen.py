@@ -65,8 +65,10 @@ __all__ = ["Generated", "generate", "cache_dir", "CompilerMissing", "CompileErro
 FUNCTIONS = ("rhs", "jac", "out", "sw")
 #: ``-fno-semantic-interposition``: the generated helpers (``sq``, ``fmax``, ...) are inlined
 #: into the functions that call them rather than called through the PLT (the rhs 1.7×
-#: faster; the same operations, so the same results).
-CFLAGS = ("-O3", "-shared", "-fPIC", "-fno-semantic-interposition")
+#: faster; the same operations, so the same results). ``-ffp-contract=off``: no fused
+#: multiply–add on any target (x86-64 without ``-march`` has none; aarch64 fuses at -O2 and
+#: not at -O1), so the optimisation levels and the rhs in parts change no rounding.
+CFLAGS = ("-O3", "-shared", "-fPIC", "-fno-semantic-interposition", "-ffp-contract=off")
 #: The optimisation level of each generated function's object (:func:`level`): the
 #: right-hand side and the switching functions, called at every stage of every step, at -O3;
 #: the Jacobian and the channels, called once per step or per output, at -Og (as fast as

@@ -165,7 +165,8 @@ class Kernels:
                h: float, max_step: float, t_out: np.ndarray, Y_out: np.ndarray, k: int,
                budget: int, stats: np.ndarray) -> tuple[int, float, float, int]:
         """DOP853 (``dop853.c``: Hairer's explicit method of order 8, scipy's tableau,
-        error estimator, step control and 7th-order dense output) as :meth:`dopri5`: 12
+        error estimator, step control and 7th-order dense output; DOPRI5's first-step
+        guess; a non-finite extra stage ends with ``NON_FINITE``) as :meth:`dopri5`: 12
         evaluations a step, 3 more on a step whose dense output is used (samples, events);
         ``stats[4]`` counts Hairer's stiff steps (``h·|Δf|/|Δy| > 6.1``)."""
         return self._explicit(self._dop853, fns, table, t0, t1, y, p, m, rtol, atol, h,

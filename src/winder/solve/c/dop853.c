@@ -9,7 +9,10 @@
  * output needs 3 more stages: they are evaluated only on the steps whose dense output is
  * used (an output sample, a located switch, the guard's probes: events.h's dense() calls
  * complete() on first use), and counted in nfev. The stiffness test is Hairer's
- * (h |f(y1) - f(Y12)| / |y1 - Y12| > 6.1, Y12 the last stage's argument, at c = 1). */
+ * (h |f(y1) - f(Y12)| / |y1 - Y12| > 6.1, Y12 the last stage's argument, at c = 1).
+ * The first step is guessed as DOPRI5's (events.h's first_step), not by scipy's
+ * select_initial_step. A non-finite extra stage ends the run with NON_FINITE (they lie
+ * outside the error control: no NaN reaches the samples unannounced). */
 
 #include "events.h"
 
@@ -194,6 +197,7 @@ typedef struct {
     double* rc;  /* 8 rows: y0 (written with the step), then F0..F6 (by complete) */
     double* ys;  /* a stage's argument */
     int64_t nfev;
+    int nonfinite;  /* an extra stage was not finite */
 } Step;
 
 /* The 3 extra stages and the 7 rows of the 7th-order interpolant (scipy's
@@ -208,6 +212,9 @@ static void complete(void* arg) {
     for (int st = 13; st < 16; st++) {
         stage_arg(st, n, K, rc, h, s->ys);
         evaluate(cx, F_RHS, s->t + C_[st] * h, s->ys, K[st]);
+        for (int64_t i = 0; i < n; i++)
+            if (!isfinite(K[st][i]))
+                s->nonfinite = 1;
     }
     s->nfev += 3;
     for (int64_t i = 0; i < n; i++) {
@@ -236,7 +243,7 @@ int winder_dop853(const int64_t* fns, const int64_t* table, int64_t nslots,
     double** K = v;  /* v[0..15] the stages */
     double *y1 = v[16], *rc = v[17], *ys = v[25];
     double* yt = cx->yt;
-    Step step = {cx, 0.0, 0.0, y1, K, rc, ys, 0};
+    Step step = {cx, 0.0, 0.0, y1, K, rc, ys, 0, 0};
     cx->complete = complete;
     cx->lazy_arg = &step;
     double t = t0;
@@ -312,6 +319,10 @@ int winder_dop853(const int64_t* fns, const int64_t* table, int64_t nslots,
                                          &new_mode, &t_end);
         cx->lazy_rc = NULL;
         nfev += step.nfev;
+        if (step.nonfinite) {
+            status = NON_FINITE;
+            break;
+        }
         stats[1] += 1;
         int switched;
         status = end_of_step(cx, slot, new_mode, t_end, y, K[0], &t, &nfev, stats, &switched);

@@ -4,10 +4,10 @@
 /* What winder's C integrators share (dopri5.c, dop853.c, rk4.c, ros2.c, rosenbrock.c): the
  * locked modes of a generated machine, their located switches, the penetration guard, the
  * status codes and the call of the generated functions. A line-by-line port of
- * src/winder/solve/integrators.py (read its docstrings for the contract): the same floating-point operations in the same
- * order (compiled with -ffp-contract=off), so the accepted steps, event times and states
- * agree with the numba kernels bit for bit. Static functions: each integrator's
- * translation unit includes this header.
+ * src/winder/solve/integrators.py (read its docstrings for the contract): the same
+ * floating-point operations in the same order (compiled with -ffp-contract=off), so the
+ * accepted steps, event times and states agree with the numba kernels bit for bit. Static
+ * functions: each integrator's translation unit includes this header.
  *
  * The machine's functions: fns (int64 addresses) [F_RHS, F_JAC, F_OUT, F_SW], each
  * int f(const double* t, const double* x, const double* p, const double* m, double* out).
