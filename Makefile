@@ -159,7 +159,7 @@ mutants: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/rhs_speed.py
-	$(PY) benchmarks/compiled_machine.py $(if $(BASELINE),--baseline $(BASELINE))
+	$(if $(BASELINE),$(PY) benchmarks/compiled_machine.py --baseline $(BASELINE))
 	$(PY) benchmarks/work_precision.py
 	$(PY) benchmarks/fmu_native.py
 	$(PY) benchmarks/cli_speed.py

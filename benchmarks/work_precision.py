@@ -53,7 +53,10 @@ SCIPY = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 #: Why DOPRI5's curves zigzagged in the bouncing and two-drum panels (written from the
 #: measurements of this study: see each problem's "DOPRI5 from rtol ..." line).
 ZIGZAG = [
-    "## Why the DOPRI5 curves zigzagged", "",
+    "## Why the DOPRI5 curves zigzagged (a record of 2026-11-25, 040f03b)", "",
+    "This section records a study of 2026-11-25 at commit 040f03b, with the numba "
+    "integrators of then: its numbers are that study's, not the tables' below, which "
+    "this script writes from today's run.", "",
     "The previous version of this figure (one timing per point) showed DOPRI5's curves in the "
     "bouncing and two-drum panels going back and forth. Measured, not guessed:", "",
     "- **The error is monotone in the tolerance** on every problem: see each problem's "
