@@ -13,19 +13,17 @@ seconds)."""
 
 from __future__ import annotations
 
-import ctypes
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from linear_c import build, rhs_source
+from linear_c import closed_form as linear_c_closed_form
 from scipy.integrate import DOP853
-from scipy.linalg import expm
 
 import winder
-from winder.model.codegen import Generated, compile_flags, run_compiler
 from winder.solve import integrators as integ
-from winder.solve.cint import EXTRA_CFLAGS, Kernels, link
+from winder.solve.cint import Kernels
 from winder.solve.system import MachineSystem
 
 #: A linear machine x' = A x + b sin(w t): a damped oscillator at 3 rad/s driven at 2
@@ -41,14 +39,9 @@ X0 = np.array([1.0, 0.0, 0.5, -0.2])
 
 
 def _c_source() -> str:
-    rows = []
-    for i in range(N):
-        terms = " + ".join(f"({float(A[i, j])!r}) * x[{j}]" for j in range(N) if A[i, j] != 0.0)
-        rows.append(f"  out[{i}] = {terms} + ({float(B[i])!r}) * sin({W!r} * t[0]);")
     return ("#include <math.h>\n"
-            "int lin_rhs(const double* t, const double* x, const double* p, const double* m,"
-            " double* out) {\n" + "\n".join(rows) + "\n  return 0;\n}\n"
-            "int lin_none(const double* t, const double* x, const double* p, const double* m,"
+            + rhs_source(A, B, W)
+            + "int lin_none(const double* t, const double* x, const double* p, const double* m,"
             " double* out) { out[0] = 0.0; return 0; }\n")
 
 
@@ -59,26 +52,13 @@ def rhs(t: float, x: np.ndarray) -> np.ndarray:
 @pytest.fixture(scope="module")
 def linear(tmp_path_factory) -> tuple[Kernels, np.ndarray]:
     """The linear machine's library, linked with the integrators as a machine's is."""
-    d: Path = tmp_path_factory.mktemp("linear853")
-    (d / "lin.c").write_text(_c_source())
-    flags = (*compile_flags(), *EXTRA_CFLAGS)
-    run_compiler([*flags, "-c", str(d / "lin.c"), "-o", str(d / "lin.o")], "the test machine")
-    objects = [str(o) for o in link().objects]
-    run_compiler([*flags, "-shared", "-o", str(d / "lin.so"), str(d / "lin.o"), *objects,
-                  "-lm"], "the test library")  # the flags: sanitized builds link the runtime
-    lib = ctypes.CDLL(str(d / "lin.so"))
-    fns = np.array([ctypes.cast(getattr(lib, f"lin_{k}"), ctypes.c_void_p).value
-                    for k in ("rhs", "none", "none", "none")], dtype=np.int64)
-    gen = Generated("lin", d / "lin.so", N, 1, 0, 1, 1, fns, _lib=lib)
-    return Kernels(gen), fns
+    return build(tmp_path_factory.mktemp("linear853"), _c_source(),
+                 ("lin_rhs", "lin_none", "lin_none", "lin_none"), N)
 
 
 def closed_form(t: float) -> np.ndarray:
-    """x(t): ``expm`` of the system augmented by s = sin(w t), c = cos(w t)."""
-    big = np.zeros((N + 2, N + 2))
-    big[:N, :N], big[:N, N] = A, B
-    big[N, N + 1], big[N + 1, N] = W, -W
-    return (expm(big * t) @ np.concatenate((X0, [0.0, 1.0])))[:N]
+    """x(t) (:func:`linear_c.closed_form`)."""
+    return linear_c_closed_form(A, B, W, X0, t)
 
 
 def _run(k: Kernels, fns: np.ndarray, t1: float, rtol: float, *, h: float = 0.0,

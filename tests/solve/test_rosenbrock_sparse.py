@@ -9,18 +9,16 @@ contact events located at the times DOPRI5 locates them)."""
 
 from __future__ import annotations
 
-import ctypes
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.linalg import expm
+from linear_c import build, rhs_source
+from linear_c import closed_form as linear_c_closed_form
 
 import winder
-from winder.model.codegen import Generated, compile_flags, run_compiler
 from winder.solve import integrators as integ
-from winder.solve.cint import EXTRA_CFLAGS, ROSENBROCK, Kernels, link
+from winder.solve.cint import ROSENBROCK, Kernels
 from winder.solve.system import MachineSystem
 
 #: A stiff linear machine x' = A x + b sin(w t): a chain of 6 states (a damped oscillator
@@ -39,15 +37,10 @@ B = np.array([0.0, 1.0, 0.0, 0.0, 0.0, 0.2])
 
 
 def _c_source() -> str:
-    rows = []
-    for i in range(N):
-        terms = " + ".join(f"({float(A[i, j])!r}) * x[{j}]" for j in range(N) if A[i, j] != 0.0)
-        rows.append(f"  out[{i}] = {terms} + ({float(B[i])!r}) * sin({W!r} * t[0]);")
     jac = ", ".join(repr(float(A[r, c])) for c in range(N) for r in range(N))
     return ("#include <math.h>\n#include <string.h>\n"
-            "int lin_rhs(const double* t, const double* x, const double* p, const double* m,"
-            " double* out) {\n" + "\n".join(rows) + "\n  return 0;\n}\n"
-            f"static const double JAC[{N * N}] = {{{jac}}};\n"
+            + rhs_source(A, B, W)
+            + f"static const double JAC[{N * N}] = {{{jac}}};\n"
             "int lin_jac(const double* t, const double* x, const double* p, const double* m,"
             " double* out) {\n"
             f"  for (int k = 0; k < {N * N}; k++) out[k] = JAC[k] * (1.0 + p[0]);\n"
@@ -59,29 +52,16 @@ def _c_source() -> str:
 @pytest.fixture(scope="module")
 def linear(tmp_path_factory) -> tuple[Kernels, np.ndarray]:
     """The linear machine's library, linked with the integrators as a machine's is."""
-    d: Path = tmp_path_factory.mktemp("linear")
-    (d / "lin.c").write_text(_c_source())
-    flags = (*compile_flags(), *EXTRA_CFLAGS)
-    run_compiler([*flags, "-c", str(d / "lin.c"), "-o", str(d / "lin.o")], "the test machine")
-    objects = [str(o) for o in link().objects]
-    run_compiler([*flags, "-shared", "-o", str(d / "lin.so"), str(d / "lin.o"), *objects,
-                  "-lm"], "the test library")  # the flags: sanitized builds link the runtime
-    lib = ctypes.CDLL(str(d / "lin.so"))
-    fns = np.array([ctypes.cast(getattr(lib, f"lin_{k}"), ctypes.c_void_p).value
-                    for k in ("rhs", "jac", "none", "none")], dtype=np.int64)
-    gen = Generated("lin", d / "lin.so", N, 1, 0, 1, 1, fns, _lib=lib)
-    return Kernels(gen), fns
+    return build(tmp_path_factory.mktemp("linear"), _c_source(),
+                 ("lin_rhs", "lin_jac", "lin_none", "lin_none"), N)
 
 
 X0 = np.array([1.0, 0.0, 0.5, -0.2, 0.1, 0.3])
 
 
 def closed_form(t: float) -> np.ndarray:
-    """x(t): ``expm`` of the system augmented by s = sin(w t), c = cos(w t)."""
-    big = np.zeros((N + 2, N + 2))
-    big[:N, :N], big[:N, N] = A, B
-    big[N, N + 1], big[N + 1, N] = W, -W
-    return (expm(big * t) @ np.concatenate((X0, [0.0, 1.0])))[:N]
+    """x(t) (:func:`linear_c.closed_form`)."""
+    return linear_c_closed_form(A, B, W, X0, t)
 
 
 def _run(k: Kernels, fns: np.ndarray, method: str, t1: float, rtol: float, *,
