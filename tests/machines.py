@@ -15,12 +15,14 @@ from collections.abc import Iterable
 from types import SimpleNamespace as NS
 from typing import Any
 
+import numpy as np
+
 from winder.forces import FORCES, force_elements
 from winder.parts import body_elements
 
 __all__ = ["EFFECTS", "effects", "contact", "friction", "speed_profile", "torque_drive",
            "drum", "wound_roll", "rider", "nip", "machine_scene", "override", "two_drum",
-           "single_drum", "free_roll"]
+           "single_drum", "free_roll", "state_matrix"]
 
 #: The ``[effects]`` keys, in the order of the scene schema: the registry's.
 EFFECTS = tuple(FORCES)
@@ -183,3 +185,17 @@ def free_roll(*, free: Iterable[str] = ("x", "z"), values: dict[str, Any] | None
     sc = machine_scene("free_roll", rolls=(wound_roll("roll", (0.0, 1.0), free),),
                        effect_flags=effects(**flags))
     return override(sc, values or {})
+
+
+def state_matrix(system: Any, names: list[str], *, h: float) -> np.ndarray:
+    """``∂ẏ/∂y`` of a :class:`~winder.solve.system.MachineSystem` over the states ``names``
+    at its initial state, by central differences of step ``h`` [state units]."""
+    idx = [system.index(k) for k in names]
+    y0 = system.initial_state()
+    A = np.empty((len(idx), len(idx)))
+    for k, c in enumerate(idx):
+        a, b = y0.copy(), y0.copy()
+        a[c] += h
+        b[c] -= h
+        A[:, k] = (system.rhs(0.0, a)[idx] - system.rhs(0.0, b)[idx]) / (2 * h)
+    return A

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 import tomllib
 
+import machines as mc
 import numpy as np
 import pytest
 
@@ -67,17 +68,10 @@ damping_ratio = {ZETA} }}
     return MachineSystem(sc, backend="pinocchio")
 
 
-def state_matrix(sys_: MachineSystem, names: list[str], h: float = 1e-6) -> np.ndarray:
-    """``∂ẏ/∂y`` over the states ``names`` at the initial state, by central differences."""
-    idx = [sys_.index(k) for k in names]
-    y0 = sys_.initial_state()
-    A = np.empty((len(idx), len(idx)))
-    for k, c in enumerate(idx):
-        a, b = y0.copy(), y0.copy()
-        a[c] += h
-        b[c] -= h
-        A[:, k] = (sys_.rhs(0.0, a)[idx] - sys_.rhs(0.0, b)[idx]) / (2 * h)
-    return A
+def state_matrix(sys_: MachineSystem, names: list[str]) -> np.ndarray:
+    """``∂ẏ/∂y`` over the states ``names`` at rest (:func:`machines.state_matrix`, step
+    1e-6)."""
+    return mc.state_matrix(sys_, names, h=1e-6)
 
 
 def chain_modes(sys_: MachineSystem, segs: list[str]) -> tuple[np.ndarray, np.ndarray]:
